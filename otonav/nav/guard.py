@@ -1,0 +1,105 @@
+"""Front-sector obstacle guard on a planar laser scan.
+
+Scan convention follows ``sensor_msgs/LaserScan`` in the sensor frame (REP 103: x
+forward, y left): beam ``i`` points at ``angle_min + i*angle_increment`` rad, CCW from
+x; ranges are in m.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ("GuardParams", "guard_blocked")
+
+
+@dataclass(frozen=True, slots=True)
+class GuardParams:
+    """Obstacle guard settings.
+
+    Attributes:
+        sector_half_angle: half-width of the guarded sector around straight ahead,
+            rad, in [0, pi].
+        stop_distance: blocked when a valid return in the sector is at or below this
+            range, m (>= 0).
+    """
+
+    sector_half_angle: float = 0.5
+    stop_distance: float = 0.35
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.sector_half_angle) and 0.0 <= self.sector_half_angle <= math.pi):
+            raise ValueError(
+                f"GuardParams.sector_half_angle must be in [0, pi], got {self.sector_half_angle!r}"
+            )
+        if not (math.isfinite(self.stop_distance) and self.stop_distance >= 0.0):
+            raise ValueError(
+                f"GuardParams.stop_distance must be finite and >= 0, got {self.stop_distance!r}"
+            )
+
+
+@lru_cache(maxsize=16)
+def _sector_mask(
+    n: int, angle_min: float, angle_increment: float, half_angle: float
+) -> NDArray[np.bool_]:
+    """Read-only mask of beams whose wrapped angle lies within ±half_angle of 0."""
+    angles = angle_min + angle_increment * np.arange(n, dtype=np.float64)
+    wrapped = np.remainder(angles + math.pi, math.tau) - math.pi  # in [-pi, pi)
+    mask = np.abs(wrapped) <= half_angle
+    mask.flags.writeable = False
+    return mask
+
+
+def guard_blocked(
+    ranges: NDArray[np.floating[Any]],
+    angle_min: float,
+    angle_increment: float,
+    params: GuardParams,
+    *,
+    range_min: float = 0.0,
+    range_max: float = math.inf,
+) -> tuple[bool, float]:
+    """Is anything too close straight ahead?
+
+    A beam counts only if its angle is inside the front sector and its range is a
+    valid return: finite, > 0, and within ``[range_min, range_max]`` (the LaserScan
+    fields; by default no extra bound). So -1 (no hit), 0, inf and NaN are ignored.
+
+    Args:
+        ranges: 1-D array of ranges, m.
+        angle_min: angle of the first beam, rad (CCW from x forward).
+        angle_increment: angle between consecutive beams, rad.
+        params: sector and stop distance.
+        range_min: smallest valid range, m.
+        range_max: largest valid range, m.
+
+    Returns:
+        ``(blocked, closest)``: ``closest`` is the smallest valid range in the sector
+        in m (``inf`` if none); ``blocked`` is ``closest <= params.stop_distance``.
+
+    Raises:
+        ValueError: if ``ranges`` is not 1-D or an angle is not finite.
+    """
+    if ranges.ndim != 1:
+        raise ValueError(f"ranges must be 1-D, got shape {ranges.shape}")
+    if not math.isfinite(angle_min):
+        raise ValueError(f"angle_min must be finite, got {angle_min!r}")
+    if not math.isfinite(angle_increment):
+        raise ValueError(f"angle_increment must be finite, got {angle_increment!r}")
+    sector = _sector_mask(
+        ranges.shape[0], float(angle_min), float(angle_increment), params.sector_half_angle
+    )
+    valid = np.isfinite(ranges)
+    # Compare only finite entries so NaN never reaches a comparison.
+    finite = np.where(valid, ranges, 0.0)
+    valid &= (finite > 0.0) & (finite >= range_min) & (finite <= range_max)
+    candidates = ranges[sector & valid]
+    if candidates.size == 0:
+        return False, math.inf
+    closest = float(candidates.min())
+    return closest <= params.stop_distance, closest

@@ -1,0 +1,77 @@
+"""The actor runtime: generic, no robot, no MuJoCo.
+
+- ``loop``: the virtual-time asyncio loop (sim time is loop time) and ``run_blocking``.
+- ``timesource``: what advances time (a physics world, or ``JumpSource``).
+- ``clock``: sim time for actors in virtual or real-time mode; ``Rate``.
+- ``qos`` / ``mailbox``: QoS with ROS 2 matching, typed topics, publishers, mailboxes.
+- ``actor`` / ``system``: actors with typed ports, wired and supervised by a ``System``.
+- ``waits``: ``until`` and ``next_message``, awaitables on sim time.
+- ``graph``: the wiring and statistics as data.
+"""
+
+from otonav.runtime.actor import Actor, Input, Output
+from otonav.runtime.clock import Clock, Rate, RealTimeClock, VirtualClock, current_clock
+from otonav.runtime.errors import (
+    ActorCrashedError,
+    DeadlockError,
+    OtonavRuntimeError,
+    QoSIncompatibleError,
+    SimTimeoutError,
+    TopicTypeError,
+    WallClockCeilingError,
+    WiringError,
+)
+from otonav.runtime.graph import Graph
+from otonav.runtime.loop import VirtualTimeLoop, run_blocking, virtual_loop_factory
+from otonav.runtime.mailbox import Bus, MailboxStatistics, Publisher, Subscription
+from otonav.runtime.qos import (
+    DEFAULT_QOS,
+    LATCHED_QOS,
+    SENSOR_DATA_QOS,
+    Durability,
+    QoS,
+    Reliability,
+)
+from otonav.runtime.system import RestartPolicy, System, SystemEvent
+from otonav.runtime.timesource import JumpSource, TimeSource
+from otonav.runtime.waits import next_message, until
+
+__all__ = (
+    "DEFAULT_QOS",
+    "LATCHED_QOS",
+    "SENSOR_DATA_QOS",
+    "Actor",
+    "ActorCrashedError",
+    "Bus",
+    "Clock",
+    "DeadlockError",
+    "Durability",
+    "Graph",
+    "Input",
+    "JumpSource",
+    "MailboxStatistics",
+    "OtonavRuntimeError",
+    "Output",
+    "Publisher",
+    "QoS",
+    "QoSIncompatibleError",
+    "Rate",
+    "RealTimeClock",
+    "Reliability",
+    "RestartPolicy",
+    "SimTimeoutError",
+    "Subscription",
+    "System",
+    "SystemEvent",
+    "TimeSource",
+    "TopicTypeError",
+    "VirtualClock",
+    "VirtualTimeLoop",
+    "WallClockCeilingError",
+    "WiringError",
+    "current_clock",
+    "next_message",
+    "run_blocking",
+    "until",
+    "virtual_loop_factory",
+)

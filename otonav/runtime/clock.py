@@ -1,0 +1,176 @@
+"""Sim time as actors see it, in both modes, behind one small interface.
+
+Actors never read the wall clock and never pick a mode: they ask their :class:`Clock`
+for ``now()`` and sleep until a sim time. In virtual mode the loop's time *is* sim time
+(:class:`VirtualClock`); in real-time mode a stock loop runs on the wall clock and the
+world is stepped to follow it, optionally scaled (:class:`RealTimeClock`).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextvars
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Callable
+
+import anyio
+
+from otonav.runtime.loop import VirtualTimeLoop
+from otonav.runtime.timesource import TimeSource
+
+_current: contextvars.ContextVar[Clock] = contextvars.ContextVar("otonav_clock")
+
+
+class Clock(ABC):
+    """Sim time for actors and waits."""
+
+    @abstractmethod
+    def now(self) -> float:
+        """Current sim time, seconds."""
+
+    @abstractmethod
+    def to_loop_time(self, sim_time: float) -> float:
+        """The running loop's ``time()`` at which sim time reaches ``sim_time`` (for
+        anyio cancel-scope deadlines)."""
+
+    @abstractmethod
+    def watch(self, check: Callable[[], bool]) -> Callable[[], None]:
+        """Evaluate ``check()`` as sim time advances until it returns True.
+        Returns a function that stops watching."""
+
+    async def sleep_until(self, sim_time: float) -> None:
+        """Sleep until sim time reaches ``sim_time``."""
+        await anyio.sleep_until(self.to_loop_time(sim_time))
+
+    async def sleep(self, seconds: float) -> None:
+        """Sleep ``seconds`` of sim time."""
+        await self.sleep_until(self.now() + seconds)
+
+    def rate(self, hz: float) -> Rate:
+        """A drift-free periodic timer at ``hz`` (like ``rclpy`` ``Rate``)."""
+        return Rate(self, hz)
+
+
+class Rate:
+    """Wakes at ``start + k / hz`` for k = 1, 2, ...: no drift, however long each
+    iteration takes, and identical instants in every run."""
+
+    __slots__ = ("_clock", "_k", "_start", "period")
+
+    def __init__(self, clock: Clock, hz: float) -> None:
+        if not hz > 0:
+            raise ValueError(f"rate must be > 0 Hz, got {hz!r}")
+        self._clock = clock
+        self.period = 1.0 / hz
+        self._start = clock.now()
+        self._k = 0
+
+    async def sleep(self) -> None:
+        """Sleep until the next period boundary (skipping any already past)."""
+        now = self._clock.now()
+        self._k = max(self._k + 1, math.floor((now - self._start) / self.period + 1e-9) + 1)
+        await self._clock.sleep_until(self._start + self._k * self.period)
+
+
+class VirtualClock(Clock):
+    """Sim time on a :class:`VirtualTimeLoop`: the loop's time is sim time."""
+
+    def __init__(self, loop: VirtualTimeLoop) -> None:
+        self._loop = loop
+
+    def now(self) -> float:
+        return self._loop.time()
+
+    def to_loop_time(self, sim_time: float) -> float:
+        return sim_time
+
+    def watch(self, check: Callable[[], bool]) -> Callable[[], None]:
+        return self._loop.add_idle_watcher(check)
+
+
+class RealTimeClock(Clock):
+    """Sim time on any loop, paced to the wall clock times ``scale``.
+
+    The world is stepped lazily to follow the wall clock: whenever anyone asks for the
+    time or wakes from a sleep, ``source`` is advanced to the tick the wall clock has
+    reached. Watchers are evaluated after each advance.
+    """
+
+    def __init__(self, source: TimeSource, *, scale: float = 1.0) -> None:
+        if not scale > 0:
+            raise ValueError(f"real-time scale must be > 0, got {scale!r}")
+        self._source = source
+        self._tick = source.tick
+        self.scale = scale
+        self._ticks = 0
+        self._wall0: float | None = None
+        self._watchers: list[Callable[[], bool]] = []
+
+    def _wall(self) -> float:
+        loop = asyncio.get_running_loop()
+        if self._wall0 is None:
+            self._wall0 = loop.time()
+        return loop.time()
+
+    def _advance_to(self, ticks: int) -> None:
+        if ticks > self._ticks:
+            self._source.advance(ticks - self._ticks)
+            self._ticks = ticks
+            for watcher in tuple(self._watchers):
+                if watcher() and watcher in self._watchers:
+                    self._watchers.remove(watcher)
+
+    def _follow_wall(self) -> None:
+        wall = self._wall()
+        assert self._wall0 is not None
+        self._advance_to(math.floor((wall - self._wall0) * self.scale / self._tick + 1e-9))
+
+    def now(self) -> float:
+        self._follow_wall()
+        return self._ticks * self._tick
+
+    def to_loop_time(self, sim_time: float) -> float:
+        self._wall()
+        assert self._wall0 is not None
+        return self._wall0 + sim_time / self.scale
+
+    async def sleep_until(self, sim_time: float) -> None:
+        await anyio.sleep_until(self.to_loop_time(sim_time))
+        self._follow_wall()
+        # A timer may fire a hair early; the world still reaches the asked instant.
+        self._advance_to(max(self._ticks, math.ceil(sim_time / self._tick - 1e-9)))
+
+    def watch(self, check: Callable[[], bool]) -> Callable[[], None]:
+        self._watchers.append(check)
+
+        def remove() -> None:
+            if check in self._watchers:
+                self._watchers.remove(check)
+
+        return remove
+
+
+def current_clock() -> Clock:
+    """The clock of the running system; on a virtual-time loop with no system, that
+    loop's clock."""
+    clock = _current.get(None)
+    if clock is not None:
+        return clock
+    loop = asyncio.get_running_loop()
+    if isinstance(loop, VirtualTimeLoop):
+        return VirtualClock(loop)
+    raise RuntimeError(
+        "no otonav clock here: run inside a System (which sets one), on a VirtualTimeLoop, "
+        "or pass clock= explicitly"
+    )
+
+
+def set_current_clock(clock: Clock) -> contextvars.Token[Clock]:
+    """Make ``clock`` the clock of this context (the System does this for its actors)."""
+    return _current.set(clock)
+
+
+def reset_current_clock(token: contextvars.Token[Clock]) -> None:
+    """Undo :func:`set_current_clock`."""
+    _current.reset(token)

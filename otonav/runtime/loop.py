@@ -1,0 +1,308 @@
+"""The virtual-time asyncio loop: the world is the clock.
+
+``loop.time()`` is simulated time, kept as an integer tick count (pitfall 1 of
+notes/virtual-time.md: float time stalls). When no callback is ready, the loop asks its
+:class:`~otonav.runtime.timesource.TimeSource` to advance to the earliest due timer and
+runs what woke. Equal deadlines wake in FIFO order (asyncio's heap alone scrambles
+them). It also watches for the two ways a simulation hangs: a deadlock (nothing can ever
+wake) and a livelock (sim time runs on, the run never ends: a wall-clock ceiling).
+
+The hook is the selector: asyncio's ``_run_once`` calls ``select(timeout)`` exactly
+once per iteration with the time to the next timer, or 0 when callbacks are ready;
+that is where real waiting would happen, so that is where time jumps instead.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextvars
+import heapq
+import math
+import selectors
+import time
+from collections.abc import Callable, Coroutine, Generator
+from concurrent.futures import Executor
+from typing import Any, TypeVar, TypeVarTuple
+
+from otonav.runtime.errors import DeadlockError, WallClockCeilingError
+from otonav.runtime.timesource import JumpSource, TimeSource
+
+_T = TypeVar("_T")
+_Ts = TypeVarTuple("_Ts")
+_Watcher = Callable[[], bool]
+
+
+class _FifoTimerHandle(asyncio.TimerHandle):
+    """A timer that breaks deadline ties by scheduling order (FIFO)."""
+
+    __slots__ = ("_seq",)
+
+    def __init__(
+        self,
+        when: float,
+        callback: Callable[..., object],
+        args: tuple[Any, ...],
+        loop: asyncio.AbstractEventLoop,
+        context: contextvars.Context | None,
+        seq: int,
+    ) -> None:
+        super().__init__(when, callback, args, loop, context)
+        self._seq = seq
+
+    def __lt__(self, other: object) -> bool:
+        if isinstance(other, _FifoTimerHandle):
+            mine: float = self._when  # type: ignore[attr-defined]
+            theirs: float = other._when  # type: ignore[attr-defined]
+            return mine < theirs or (mine == theirs and self._seq < other._seq)
+        return NotImplemented
+
+
+class _VirtualSelector:
+    """Wraps the real selector; ``select`` advances virtual time instead of waiting."""
+
+    def __init__(self, inner: selectors.BaseSelector) -> None:
+        self._inner = inner
+        self.loop: VirtualTimeLoop | None = None
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._inner, name)
+
+    def select(self, timeout: float | None = None) -> list[tuple[selectors.SelectorKey, int]]:
+        loop = self.loop
+        assert loop is not None
+        return loop._idle_select(self._inner, timeout)
+
+
+class VirtualTimeLoop(asyncio.SelectorEventLoop):
+    """An asyncio loop whose ``time()`` is the simulated time of ``source``.
+
+    ``wall_ceiling``: seconds of wall time after which the run is cancelled with
+    :class:`WallClockCeilingError` (``None``: no ceiling). ``deadlock_grace``: wall seconds
+    the loop waits for outside I/O when nothing else can wake it before raising
+    :class:`DeadlockError` (``None``: wait forever, e.g. when a host thread drives it).
+    """
+
+    def __init__(
+        self,
+        source: TimeSource | None = None,
+        *,
+        wall_ceiling: float | None = None,
+        deadlock_grace: float | None = 0.5,
+    ) -> None:
+        selector = _VirtualSelector(selectors.DefaultSelector())
+        super().__init__(selector)  # type: ignore[arg-type]
+        selector.loop = self
+        self._source: TimeSource = source if source is not None else JumpSource()
+        self._tick = self._source.tick
+        self._base = 0.0
+        self._ticks = 0
+        self._clock_resolution = self._tick / 2
+        self._seq = 0
+        self._holds = 0
+        self._watchers: list[_Watcher] = []
+        self._wall_ceiling = wall_ceiling
+        self._wall_start = time.monotonic()
+        self._deadlock_grace = deadlock_grace
+        self._owner: asyncio.Future[Any] | None = None
+        self._failure: BaseException | None = None
+        self._fail_stop_at = 0.0
+        self.wakes = 0  # time jumps taken, for benchmarks and introspection
+
+    # -- time ---------------------------------------------------------------------------
+
+    def time(self) -> float:
+        return self._base + self._ticks * self._tick
+
+    @property
+    def source(self) -> TimeSource:
+        return self._source
+
+    @property
+    def ticks(self) -> int:
+        """Ticks advanced since the current source was attached."""
+        return self._ticks
+
+    def attach_source(self, source: TimeSource) -> None:
+        """Let ``source`` drive time from now on; time continues, never goes back."""
+        self._base = self.time()
+        self._ticks = 0
+        self._source = source
+        self._tick = source.tick
+        self._clock_resolution = self._tick / 2
+
+    def call_at(
+        self,
+        when: float,
+        callback: Callable[[*_Ts], object],
+        *args: *_Ts,
+        context: contextvars.Context | None = None,
+    ) -> asyncio.TimerHandle:
+        self._check_closed()  # type: ignore[attr-defined]
+        self._seq += 1
+        timer = _FifoTimerHandle(when, callback, args, self, context, self._seq)
+        heapq.heappush(self._scheduled, timer)  # type: ignore[attr-defined]
+        timer._scheduled = True  # type: ignore[attr-defined]
+        return timer
+
+    # -- watchers: predicates evaluated whenever the system is idle at an instant -------
+
+    def add_idle_watcher(self, watcher: _Watcher) -> Callable[[], None]:
+        """Call ``watcher()`` each time the loop is idle, before time moves on; it is
+        dropped once it returns True. Returns a function that removes it."""
+        self._watchers.append(watcher)
+
+        def remove() -> None:
+            if watcher in self._watchers:
+                self._watchers.remove(watcher)
+
+        return remove
+
+    def _run_watchers(self) -> None:
+        if not self._watchers:
+            return
+        # Iterate a snapshot in registration order: deterministic, and safe if a watcher
+        # registers or removes others.
+        for watcher in tuple(self._watchers):
+            if watcher():
+                self._watchers.remove(watcher)
+
+    # -- blocking work: the one way to run it while sim time holds still ----------------
+
+    def run_in_executor(
+        self, executor: Executor | None, func: Callable[[*_Ts], _T], *args: *_Ts
+    ) -> asyncio.Future[_T]:
+        future = super().run_in_executor(executor, func, *args)
+        self._holds += 1
+        future.add_done_callback(self._release_hold)
+        return future
+
+    def _release_hold(self, _future: asyncio.Future[Any]) -> None:
+        self._holds -= 1
+
+    async def shutdown_default_executor(self, *args: Any) -> None:
+        self._holds += 1
+        try:
+            await super().shutdown_default_executor(*args)
+        finally:
+            self._holds -= 1
+
+    # -- the idle path ------------------------------------------------------------------
+
+    def _idle_select(
+        self, inner: selectors.BaseSelector, timeout: float | None
+    ) -> list[tuple[selectors.SelectorKey, int]]:
+        if self._wall_ceiling is not None:
+            self._check_wall_ceiling()
+        if timeout == 0:
+            return inner.select(0)
+        # Nothing is ready: the system has settled at this instant.
+        if self._watchers:
+            self._run_watchers()
+            if self._ready:  # type: ignore[attr-defined]
+                return inner.select(0)
+        events = inner.select(0)
+        if events:
+            return events
+        if self._holds:
+            # A thread is doing sanctioned blocking work: hold sim time, wait for it.
+            return inner.select(0.05)
+        if timeout is None:
+            return self._wait_or_deadlock(inner)
+        steps = max(0, math.floor(timeout / self._tick - 0.5) + 1)
+        if steps:
+            self._source.advance(steps)
+            self._ticks += steps
+            self.wakes += 1
+        return []
+
+    def _wait_or_deadlock(
+        self, inner: selectors.BaseSelector
+    ) -> list[tuple[selectors.SelectorKey, int]]:
+        # Only the loop's self-pipe registered means no outside I/O can wake us either.
+        has_io = len(inner.get_map()) > 1
+        if has_io or self._deadlock_grace is None:
+            return inner.select(0.05)
+        events = inner.select(self._deadlock_grace)
+        if events or self._ready:  # type: ignore[attr-defined]
+            return events
+        self._fail(
+            DeadlockError(
+                f"deadlock at sim time {self.time():.6f} s: no timer is scheduled, no "
+                "callback is ready, no I/O or thread can wake the loop (every task waits on "
+                "something only another waiting task could provide)"
+            )
+        )
+        return []
+
+    def _check_wall_ceiling(self) -> None:
+        assert self._wall_ceiling is not None
+        elapsed = time.monotonic() - self._wall_start
+        if elapsed > self._wall_ceiling:
+            self._fail(
+                WallClockCeilingError(
+                    f"run exceeded its wall-clock ceiling of {self._wall_ceiling:g} s "
+                    f"(sim time reached {self.time():.3f} s): a hang or livelock, "
+                    "e.g. a wait whose predicate never becomes true while actors keep ticking"
+                )
+            )
+
+    def _fail(self, error: BaseException) -> None:
+        """Cancel the run with ``error``; if it has not ended 2 wall seconds later (its
+        cleanup hangs too), stop the loop."""
+        if self._failure is None:
+            self._failure = error
+            self._fail_stop_at = time.monotonic() + 2.0
+            if self._owner is not None and not self._owner.done():
+                self._owner.cancel(msg=str(error))
+                return
+        if time.monotonic() >= self._fail_stop_at:
+            self.stop()
+
+    def run_until_complete(  # type: ignore[override]
+        self,
+        future: Coroutine[Any, Any, _T] | Generator[Any, None, _T] | asyncio.Future[_T],
+    ) -> _T | None:
+        owner: asyncio.Future[_T] = asyncio.ensure_future(future, loop=self)  # type: ignore[arg-type]
+        self._owner = owner
+        self._wall_start = time.monotonic()
+        result: _T | None = None
+        try:
+            result = super().run_until_complete(owner)
+        except (asyncio.CancelledError, RuntimeError):
+            if self._failure is None:
+                raise
+        finally:
+            self._owner = None
+        failure, self._failure = self._failure, None
+        if failure is not None:
+            raise failure
+        return result
+
+
+def virtual_loop_factory(
+    source: TimeSource | None = None,
+    *,
+    wall_ceiling: float | None = None,
+    deadlock_grace: float | None = 0.5,
+) -> Callable[[], VirtualTimeLoop]:
+    """A zero-argument loop factory for ``asyncio.Runner``, ``anyio.run`` and pytest.
+
+    Each call makes a fresh loop (a new world gets a new loop: time never goes back).
+    """
+
+    def factory() -> VirtualTimeLoop:
+        return VirtualTimeLoop(
+            source if source is not None else JumpSource(),
+            wall_ceiling=wall_ceiling,
+            deadlock_grace=deadlock_grace,
+        )
+
+    return factory
+
+
+async def run_blocking(func: Callable[..., _T], *args: Any) -> _T:
+    """Run blocking ``func(*args)`` in a worker thread. On the virtual-time loop sim time
+    holds still until it returns; on a real-time loop the world keeps following the wall
+    clock. (``anyio.to_thread.run_sync`` is invisible to the loop: sim time would race.)"""
+    loop = asyncio.get_running_loop()
+    return await loop.run_in_executor(None, func, *args)

@@ -1,0 +1,298 @@
+"""Typed topics, publishers and mailboxes (subscriptions), with QoS.
+
+A message is a frozen object shared, never copied, by every subscriber. Best-effort
+mailboxes keep the last ``depth`` messages and count what they drop; reliable ones
+make the publisher wait for room and lose nothing. Transient-local publishers keep
+their last ``depth`` messages for subscribers that join late.
+"""
+
+from __future__ import annotations
+
+import asyncio
+from collections import deque
+from dataclasses import dataclass
+from typing import Any, Generic, NamedTuple, TypeVar
+
+import anyio
+
+from otonav.runtime.errors import QoSIncompatibleError, TopicTypeError
+from otonav.runtime.qos import DEFAULT_QOS, Durability, QoS, Reliability, incompatibility
+
+M = TypeVar("M")
+
+
+def _type_name(tp: type[Any]) -> str:
+    return f"{tp.__module__}.{tp.__qualname__}"
+
+
+class MailboxStatistics(NamedTuple):
+    """Counters of one mailbox (a subscription)."""
+
+    received: int
+    """Messages put into the mailbox."""
+    taken: int
+    """Messages the subscriber took out."""
+    dropped: int
+    """Messages lost to overflow (best-effort only; always 0 for reliable)."""
+    queued: int
+    """Messages waiting now."""
+    depth: int
+    """Capacity (keep-last N)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Endpoint:
+    """Who owns a port: actor name, port name (for error messages and the graph)."""
+
+    actor: str
+    port: str
+
+    def __str__(self) -> str:
+        return f"{self.actor}.{self.port}"
+
+
+class Subscription(Generic[M]):
+    """A mailbox: the receiving end of a topic for one subscriber."""
+
+    __slots__ = (
+        "_depth",
+        "_loop_waiter",
+        "_queue",
+        "_reliable",
+        "_space_waiters",
+        "dropped",
+        "endpoint",
+        "msg_type",
+        "qos",
+        "received",
+        "taken",
+        "topic",
+    )
+
+    def __init__(self, topic: str, msg_type: type[M], qos: QoS, endpoint: Endpoint) -> None:
+        self.topic = topic
+        self.msg_type = msg_type
+        self.qos = qos
+        self.endpoint = endpoint
+        self._queue: deque[M] = deque()
+        self._depth = qos.depth
+        self._reliable = qos.reliability is Reliability.RELIABLE
+        self._loop_waiter: asyncio.Future[None] | None = None
+        self._space_waiters: deque[asyncio.Future[None]] = deque()
+        self.received = 0
+        self.taken = 0
+        self.dropped = 0
+
+    def _offer(self, message: M) -> bool:
+        """Put ``message`` in; False when a reliable mailbox is full (caller waits)."""
+        queue = self._queue
+        if len(queue) >= self._depth:
+            if self._reliable:
+                return False
+            queue.popleft()
+            self.dropped += 1
+        queue.append(message)
+        self.received += 1
+        waiter = self._loop_waiter
+        if waiter is not None and not waiter.done():
+            waiter.set_result(None)
+        return True
+
+    async def _wait_for_room(self) -> None:
+        waiter = asyncio.get_running_loop().create_future()
+        self._space_waiters.append(waiter)
+        try:
+            await waiter
+        finally:
+            if waiter in self._space_waiters:
+                self._space_waiters.remove(waiter)
+
+    def _took_one(self) -> None:
+        self.taken += 1
+        while self._space_waiters:
+            waiter = self._space_waiters.popleft()
+            if not waiter.done():
+                waiter.set_result(None)
+                return
+
+    def try_recv(self) -> M | None:
+        """The oldest waiting message, or None when the mailbox is empty."""
+        if not self._queue:
+            return None
+        message = self._queue.popleft()
+        self._took_one()
+        return message
+
+    def take_latest(self) -> M | None:
+        """The newest waiting message, discarding older ones (counted as taken), or None."""
+        if not self._queue:
+            return None
+        message = self._queue[-1]
+        for _ in range(len(self._queue)):
+            self._queue.popleft()
+            self._took_one()
+        return message
+
+    async def recv(self) -> M:
+        """Wait for and return the oldest message."""
+        queue = self._queue
+        while not queue:
+            if self._loop_waiter is not None and not self._loop_waiter.done():
+                raise RuntimeError(
+                    f"two tasks receive from mailbox {self.endpoint} of '{self.topic}' at once; "
+                    "give each task its own subscription"
+                )
+            self._loop_waiter = asyncio.get_running_loop().create_future()
+            try:
+                await self._loop_waiter
+            finally:
+                self._loop_waiter = None
+        message = queue.popleft()
+        self._took_one()
+        return message
+
+    def __aiter__(self) -> Subscription[M]:
+        return self
+
+    async def __anext__(self) -> M:
+        return await self.recv()
+
+    def statistics(self) -> MailboxStatistics:
+        return MailboxStatistics(
+            self.received, self.taken, self.dropped, len(self._queue), self._depth
+        )
+
+
+class Publisher(Generic[M]):
+    """The sending end of a topic for one publisher."""
+
+    __slots__ = ("_history", "_subscriptions", "endpoint", "msg_type", "published", "qos", "topic")
+
+    def __init__(
+        self,
+        topic: Topic[M],
+        qos: QoS,
+        endpoint: Endpoint,
+    ) -> None:
+        self.topic = topic.name
+        self.msg_type = topic.msg_type
+        self.qos = qos
+        self.endpoint = endpoint
+        # The topic's subscriber list, shared (not copied): a late joiner is seen at once.
+        self._subscriptions = topic.subscriptions
+        self._history: deque[M] | None = (
+            deque(maxlen=qos.depth) if qos.durability is Durability.TRANSIENT_LOCAL else None
+        )
+        self.published = 0
+
+    def _check_type(self, message: object) -> None:
+        if type(message) is not self.msg_type:
+            raise TopicTypeError(
+                f"{self.endpoint} published a {_type_name(type(message))} on '{self.topic}', "
+                f"whose type is {_type_name(self.msg_type)}; publish a "
+                f"{self.msg_type.__qualname__} or wire the port to a topic of that type"
+            )
+
+    async def publish(self, message: M) -> None:
+        """Deliver ``message`` to every subscriber; waits only while a reliable
+        subscriber's mailbox is full (backpressure)."""
+        if type(message) is not self.msg_type:
+            self._check_type(message)
+        self.published += 1
+        if self._history is not None:
+            self._history.append(message)
+        for subscription in self._subscriptions:
+            while not subscription._offer(message):
+                await subscription._wait_for_room()
+
+    def publish_nowait(self, message: M) -> None:
+        """Like :meth:`publish` for callers that cannot wait: raises ``anyio.WouldBlock``
+        rather than wait when a reliable mailbox is full (no subscriber receives it)."""
+        if type(message) is not self.msg_type:
+            self._check_type(message)
+        for subscription in self._subscriptions:
+            if subscription._reliable and len(subscription._queue) >= subscription._depth:
+                raise anyio.WouldBlock(f"mailbox {subscription.endpoint} of '{self.topic}' is full")
+        self.published += 1
+        if self._history is not None:
+            self._history.append(message)
+        for subscription in self._subscriptions:
+            subscription._offer(message)
+
+
+class Topic(Generic[M]):
+    """A named, typed channel: its publishers and subscriptions, in wiring order."""
+
+    __slots__ = ("msg_type", "name", "publishers", "subscriptions")
+
+    def __init__(self, name: str, msg_type: type[M]) -> None:
+        self.name = name
+        self.msg_type = msg_type
+        self.publishers: list[Publisher[M]] = []
+        self.subscriptions: list[Subscription[M]] = []
+
+
+class Bus:
+    """All topics of a system. Wiring checks types and QoS here, once."""
+
+    def __init__(self) -> None:
+        self.topics: dict[str, Topic[Any]] = {}
+
+    def _topic(self, name: str, msg_type: type[M], endpoint: Endpoint) -> Topic[M]:
+        if not name.startswith("/"):
+            raise ValueError(f"{endpoint}: topic name '{name}' must be absolute, e.g. '/{name}'")
+        topic = self.topics.get(name)
+        if topic is None:
+            topic = Topic(name, msg_type)
+            self.topics[name] = topic
+            return topic
+        if topic.msg_type is not msg_type:
+            ends = [str(p.endpoint) for p in topic.publishers] + [
+                str(s.endpoint) for s in topic.subscriptions
+            ]
+            raise TopicTypeError(
+                f"{endpoint} wants topic '{name}' as {_type_name(msg_type)}, but "
+                f"{', '.join(ends) or 'an earlier port'} already use it as "
+                f"{_type_name(topic.msg_type)}; use one message type per topic "
+                "(rename one of the topics or change the port's type)"
+            )
+        return topic
+
+    def publisher(
+        self, name: str, msg_type: type[M], qos: QoS = DEFAULT_QOS, *, endpoint: Endpoint
+    ) -> Publisher[M]:
+        """Add a publisher; raises if its type or QoS cannot serve existing subscribers."""
+        topic = self._topic(name, msg_type, endpoint)
+        for subscription in topic.subscriptions:
+            _check_pair(name, qos, endpoint, subscription.qos, subscription.endpoint)
+        publisher = Publisher(topic, qos, endpoint)
+        topic.publishers.append(publisher)
+        return publisher
+
+    def subscribe(
+        self, name: str, msg_type: type[M], qos: QoS = DEFAULT_QOS, *, endpoint: Endpoint
+    ) -> Subscription[M]:
+        """Add a mailbox; raises if its type or QoS cannot be served by existing
+        publishers. A transient-local mailbox gets the publishers' kept history."""
+        topic = self._topic(name, msg_type, endpoint)
+        for publisher in topic.publishers:
+            _check_pair(name, publisher.qos, publisher.endpoint, qos, endpoint)
+        subscription = Subscription(name, msg_type, qos, endpoint)
+        if qos.durability is Durability.TRANSIENT_LOCAL:
+            kept = [m for p in topic.publishers for m in (p._history or ())]
+            for message in kept[-qos.depth :]:
+                subscription._offer(message)
+        topic.subscriptions.append(subscription)
+        return subscription
+
+
+def _check_pair(
+    topic: str, offered: QoS, publisher: Endpoint, requested: QoS, subscriber: Endpoint
+) -> None:
+    reason = incompatibility(offered, requested)
+    if reason is not None:
+        raise QoSIncompatibleError(
+            f"QoS mismatch on '{topic}': publisher {publisher} ({offered}) cannot serve "
+            f"subscriber {subscriber} ({requested}): {reason}. ROS 2 would leave this pair "
+            "silently unconnected; otonav refuses to wire it."
+        )

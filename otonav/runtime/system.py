@@ -1,0 +1,279 @@
+"""A system: actors wired onto one bus, run under supervision in one task group.
+
+    async with System([bridge, base, nav]) as system:
+        await until(lambda: ..., within=20.0)
+
+Wiring happens in the constructor, so every type and QoS error surfaces before anything
+runs. Actors run under structured concurrency: an actor that raises is reported with
+its name and traceback; by default the whole system then stops cleanly (every
+``on_stop`` runs) and :class:`ActorCrashedError` is raised; a :class:`RestartPolicy`
+restarts it instead, up to a cap within a sim-time window.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import contextvars
+import logging
+import traceback
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from types import TracebackType
+from typing import Any
+
+import anyio
+from anyio.abc import TaskGroup
+
+from otonav.runtime.actor import Actor
+from otonav.runtime.clock import Clock, VirtualClock, reset_current_clock, set_current_clock
+from otonav.runtime.errors import ActorCrashedError, WiringError
+from otonav.runtime.graph import Graph, build_graph
+from otonav.runtime.loop import VirtualTimeLoop
+from otonav.runtime.mailbox import Bus, Endpoint, Publisher, Subscription
+from otonav.runtime.qos import DEFAULT_QOS, QoS
+
+log = logging.getLogger("otonav.runtime")
+
+
+@dataclass(frozen=True, slots=True)
+class RestartPolicy:
+    """Restart a crashed actor, at most ``max_restarts`` times within ``window`` seconds
+    of sim time; one more crash inside the window stops the system."""
+
+    max_restarts: int = 3
+    window: float = 10.0
+
+    def __post_init__(self) -> None:
+        if self.max_restarts < 0 or not self.window > 0:
+            raise ValueError(
+                f"RestartPolicy needs max_restarts >= 0 and window > 0 s, got "
+                f"max_restarts={self.max_restarts}, window={self.window}"
+            )
+
+
+@dataclass(frozen=True, slots=True)
+class SystemEvent:
+    """A lifecycle event: started, crashed, restarted, stopped, finished."""
+
+    sim_time: float
+    actor: str
+    kind: str
+    detail: str = ""
+
+
+@dataclass(slots=True)
+class _ActorState:
+    actor: Actor
+    policy: RestartPolicy | None
+    restarts: int = 0
+    crash_times: list[float] = field(default_factory=list)
+    status: str = "created"
+
+
+class System:
+    """Actors on one bus; see the module docstring."""
+
+    def __init__(
+        self,
+        actors: Sequence[Actor],
+        *,
+        clock: Clock | None = None,
+        restart: RestartPolicy | Mapping[str, RestartPolicy] | None = None,
+        bus: Bus | None = None,
+    ) -> None:
+        self.bus = bus or Bus()
+        self._clock = clock
+        self._states: dict[str, _ActorState] = {}
+        self.events: list[SystemEvent] = []
+        self._failure: ActorCrashedError | None = None
+        self._tg: TaskGroup | None = None
+        self._clock_token: contextvars.Token[Clock] | None = None
+        for actor in actors:
+            if actor.name in self._states:
+                raise WiringError(
+                    f"two actors are named '{actor.name}'; give each a unique name= "
+                    "(names identify actors in the graph, logs and recordings)"
+                )
+            policy = restart.get(actor.name) if isinstance(restart, Mapping) else restart
+            self._states[actor.name] = _ActorState(actor, policy)
+        # Publishers first, so transient-local history and QoS checks see every pair
+        # whatever the order of the actors.
+        for direction in ("out", "in"):
+            for state in self._states.values():
+                self._wire(state.actor, direction)
+
+    def _wire(self, actor: Actor, direction: str) -> None:
+        for port in actor.ports():
+            if port.direction != direction:
+                continue
+            topic = actor.topic_of(port)
+            endpoint = Endpoint(actor.name, port.name)
+            if direction == "out":
+                bound: Any = self.bus.publisher(topic, port.msg_type, port.qos, endpoint=endpoint)
+            else:
+                bound = self.bus.subscribe(topic, port.msg_type, port.qos, endpoint=endpoint)
+            actor._otonav_ports[port.name] = bound
+
+    # -- for code outside the actors (tests, hosts) -------------------------------------
+
+    def subscribe(
+        self, topic: str, msg_type: type[Any], qos: QoS = DEFAULT_QOS, *, name: str = "external"
+    ) -> Subscription[Any]:
+        """A mailbox on ``topic`` for code outside the actors; same checks as ports."""
+        return self.bus.subscribe(topic, msg_type, qos, endpoint=Endpoint(name, topic))
+
+    def publisher(
+        self, topic: str, msg_type: type[Any], qos: QoS = DEFAULT_QOS, *, name: str = "external"
+    ) -> Publisher[Any]:
+        """A publisher on ``topic`` for code outside the actors; same checks as ports."""
+        return self.bus.publisher(topic, msg_type, qos, endpoint=Endpoint(name, topic))
+
+    @property
+    def clock(self) -> Clock:
+        if self._clock is None:
+            loop = asyncio.get_running_loop()
+            if not isinstance(loop, VirtualTimeLoop):
+                raise RuntimeError(
+                    "System on a stock event loop needs clock=RealTimeClock(world) "
+                    "(real-time mode); on a VirtualTimeLoop the loop is the clock"
+                )
+            self._clock = VirtualClock(loop)
+        return self._clock
+
+    def actor(self, name: str) -> Actor:
+        return self._states[name].actor
+
+    def graph(self) -> Graph:
+        """Actors, ports, topics, types, QoS and live statistics, as plain data."""
+        return build_graph(
+            self.bus,
+            {
+                name: (type(s.actor).__name__, s.status, s.restarts)
+                for name, s in self._states.items()
+            },
+        )
+
+    # -- running ------------------------------------------------------------------------
+
+    def _event(self, actor: str, kind: str, detail: str = "") -> None:
+        now = self._clock.now() if self._clock is not None else 0.0
+        self.events.append(SystemEvent(now, actor, kind, detail))
+        log.log(
+            logging.ERROR if kind == "crashed" else logging.INFO,
+            "[%.3f] %s %s %s",
+            now,
+            actor,
+            kind,
+            detail,
+        )
+
+    async def _supervise(self, state: _ActorState) -> None:
+        actor = state.actor
+        actor._otonav_clock = self.clock
+        started = False
+        try:
+            while True:
+                try:
+                    await actor.on_start()
+                    started = True
+                    state.status = "running"
+                    self._event(actor.name, "started")
+                    await actor.run()
+                    state.status = "finished"
+                    self._event(actor.name, "finished")
+                    return
+                except Exception as exc:
+                    text = "".join(traceback.format_exception(exc))
+                    now = self.clock.now()
+                    self._event(actor.name, "crashed", text)
+                    if self._may_restart(state, now):
+                        state.restarts += 1
+                        self._event(actor.name, "restarted", f"restart {state.restarts}")
+                        await self._stop_actor(state)
+                        continue
+                    state.status = "crashed"
+                    if self._failure is None:
+                        self._failure = ActorCrashedError(actor.name, now, text)
+                        self._failure.__cause__ = exc
+                    assert self._tg is not None
+                    self._tg.cancel_scope.cancel()
+                    return
+        finally:
+            if started or state.status == "crashed":
+                await self._stop_actor(state)
+
+    def _may_restart(self, state: _ActorState, now: float) -> bool:
+        policy = state.policy
+        if policy is None:
+            return False
+        state.crash_times = [t for t in state.crash_times if t > now - policy.window]
+        state.crash_times.append(now)
+        return len(state.crash_times) <= policy.max_restarts
+
+    async def _stop_actor(self, state: _ActorState) -> None:
+        with anyio.CancelScope(shield=True):
+            try:
+                await state.actor.on_stop()
+            except Exception as exc:
+                self._event(
+                    state.actor.name,
+                    "crashed",
+                    "in on_stop: " + "".join(traceback.format_exception(exc)),
+                )
+        if state.status == "running":
+            state.status = "stopped"
+        self._event(state.actor.name, "stopped")
+
+    async def __aenter__(self) -> System:
+        self._clock_token = set_current_clock(self.clock)
+        self._tg = anyio.create_task_group()
+        await self._tg.__aenter__()
+        for state in self._states.values():
+            self._tg.start_soon(self._supervise, state, name=f"actor:{state.actor.name}")
+        return self
+
+    async def __aexit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> bool:
+        assert self._tg is not None
+        self._tg.cancel_scope.cancel()
+        try:
+            suppressed = await self._tg.__aexit__(exc_type, exc, tb)
+        finally:
+            self._tg = None
+            _reset_clock(self._clock_token)
+        if self._failure is not None:
+            failure, self._failure = self._failure, None
+            raise failure
+        return bool(suppressed)
+
+    def stop(self) -> None:
+        """Stop every actor (each ``on_stop`` runs); ``run()`` then returns."""
+        if self._tg is not None:
+            self._tg.cancel_scope.cancel()
+
+    async def run(self) -> None:
+        """Run until every actor's ``run`` returned, :meth:`stop` is called, or a crash."""
+        token = set_current_clock(self.clock)
+        self._tg = anyio.create_task_group()
+        try:
+            async with self._tg:
+                for state in self._states.values():
+                    self._tg.start_soon(self._supervise, state, name=f"actor:{state.actor.name}")
+        finally:
+            self._tg = None
+            _reset_clock(token)
+        if self._failure is not None:
+            failure, self._failure = self._failure, None
+            raise failure
+
+
+def _reset_clock(token: contextvars.Token[Clock] | None) -> None:
+    if token is not None:
+        # ValueError: exited in another context (e.g. a different task).
+        with contextlib.suppress(ValueError):
+            reset_current_clock(token)

@@ -1,0 +1,43 @@
+"""What moves time forward: the contract between the loop and the world.
+
+The virtual-time loop never invents time: when nothing is ready it asks its time source
+to advance a whole number of ticks. A physics world steps (``otonav.hal``); the
+:class:`JumpSource` below just jumps, for runtime tests with no physics.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol, runtime_checkable
+
+
+@runtime_checkable
+class TimeSource(Protocol):
+    """Anything that can advance the world by whole ticks.
+
+    ``tick`` is the length of one tick in seconds (the physics step). ``advance(n)`` moves
+    the world ``n`` ticks forward; nothing else may step it.
+    """
+
+    @property
+    def tick(self) -> float: ...
+
+    def advance(self, n: int) -> None: ...
+
+
+class JumpSource:
+    """A time source with no world: advancing costs nothing. 1 µs ticks by default."""
+
+    __slots__ = ("_tick", "ticks")
+
+    def __init__(self, tick: float = 1e-6) -> None:
+        if not tick > 0:
+            raise ValueError(f"JumpSource tick must be > 0 seconds, got {tick!r}")
+        self._tick = tick
+        self.ticks = 0
+
+    @property
+    def tick(self) -> float:
+        return self._tick
+
+    def advance(self, n: int) -> None:
+        self.ticks += n

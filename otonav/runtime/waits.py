@@ -1,0 +1,96 @@
+"""Conditional waits on sim time: ``await until(...)`` and ``await next_message(...)``.
+
+Both are evaluated as sim time advances (on the virtual loop: each time the system is
+idle at an instant, before time moves on), never by polling the wall clock, and fail
+with :class:`~otonav.runtime.errors.SimTimeoutError` naming the sim time, the budget
+and the last observed value.
+"""
+
+from __future__ import annotations
+
+import asyncio
+from collections.abc import Callable
+from typing import TypeVar
+
+import anyio
+
+from otonav.runtime.clock import Clock, current_clock
+from otonav.runtime.errors import SimTimeoutError
+from otonav.runtime.mailbox import Subscription
+
+_M = TypeVar("_M")
+_MISSING = object()
+
+
+async def until(
+    predicate: Callable[[], object],
+    *,
+    within: float,
+    observe: Callable[[], object] | None = None,
+    what: str | None = None,
+    clock: Clock | None = None,
+) -> None:
+    """Wait until ``predicate()`` is truthy, at most ``within`` seconds of sim time.
+
+    ``observe`` gives the value to report on timeout (default: the predicate's last
+    result); ``what`` names the condition in the error.
+    """
+    clock = clock or current_clock()
+    budget = within
+    deadline = clock.now() + budget
+    last: object = _MISSING
+
+    def check() -> bool:
+        nonlocal last
+        result = predicate()
+        last = observe() if observe is not None else result
+        return bool(result)
+
+    if check():
+        return
+    done = asyncio.get_running_loop().create_future()
+
+    def watcher() -> bool:
+        if done.done():
+            return True
+        if check():
+            done.set_result(None)
+            return True
+        return False
+
+    unwatch = clock.watch(watcher)
+    try:
+        with anyio.CancelScope(deadline=clock.to_loop_time(deadline)) as scope:
+            await done
+        if scope.cancelled_caught and not check():
+            raise SimTimeoutError(
+                what or str(getattr(predicate, "__name__", "condition")),
+                clock.now(),
+                budget,
+                last,
+            )
+    finally:
+        unwatch()
+
+
+async def next_message(
+    subscription: Subscription[_M],
+    predicate: Callable[[_M], object] = lambda _m: True,
+    *,
+    within: float,
+    what: str | None = None,
+    clock: Clock | None = None,
+) -> _M:
+    """The next message on ``subscription`` for which ``predicate`` holds, within
+    ``within`` seconds of sim time."""
+    clock = clock or current_clock()
+    last: object = "no message"
+    with anyio.CancelScope(deadline=clock.to_loop_time(clock.now() + within)):
+        while True:
+            message = await subscription.recv()
+            last = message
+            if predicate(message):
+                return message
+    raise SimTimeoutError(
+        what or f"a matching message on '{subscription.topic}'", clock.now(), within, last
+    )

@@ -1,0 +1,58 @@
+"""The test gate: four layers, cheapest first, stopping at the first red one.
+
+    python scripts/gate.py            # all layers
+    python scripts/gate.py static     # only the named layers, in gate order
+
+Each layer prints its wall time. The same script runs for people (`make test`) and CI
+(`.ci/run`).
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+PY = sys.executable
+
+LAYERS: dict[str, list[list[str]]] = {
+    "static": [
+        [PY, "-m", "ruff", "check", "."],
+        [PY, "-m", "ruff", "format", "--check", "."],
+        [PY, "-m", "mypy"],
+        [str(Path(PY).parent / "lint-imports")],
+        [PY, "-m", "pytest", "tests/static", "-q"],
+    ],
+    "unit": [[PY, "-m", "pytest", "tests/unit", "-q"]],
+    "smoke": [[PY, "-m", "pytest", "tests/smoke", "-q"]],
+    "sil": [[PY, "-m", "pytest", "tests/sil", "-q"]],
+}
+
+
+def main(argv: list[str]) -> int:
+    wanted = argv or list(LAYERS)
+    unknown = [name for name in wanted if name not in LAYERS]
+    if unknown:
+        print(f"gate: unknown layer(s) {unknown}; valid: {list(LAYERS)}", file=sys.stderr)
+        return 2
+    timings: list[tuple[str, float]] = []
+    for name in (layer for layer in LAYERS if layer in wanted):
+        print(f"\n=== layer {name} ===", flush=True)
+        start = time.perf_counter()
+        for cmd in LAYERS[name]:
+            print("$ " + " ".join(Path(c).name if c == PY else c for c in cmd), flush=True)
+            code = subprocess.call(cmd, cwd=ROOT)
+            if code != 0:
+                elapsed = time.perf_counter() - start
+                print(f"\n=== layer {name} FAILED after {elapsed:.1f} s (exit {code}) ===")
+                return 1
+        timings.append((name, time.perf_counter() - start))
+        print(f"=== layer {name} passed in {timings[-1][1]:.1f} s ===", flush=True)
+    print("\ngate passed: " + ", ".join(f"{n} {t:.1f} s" for n, t in timings))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv[1:]))

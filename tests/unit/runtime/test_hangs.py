@@ -1,0 +1,57 @@
+"""Hang protection: the deadlock detector and the wall-clock ceiling."""
+
+from __future__ import annotations
+
+import asyncio
+
+import anyio
+import pytest
+
+from otonav.runtime import DeadlockError, WallClockCeilingError, until, virtual_loop_factory
+
+pytestmark = pytest.mark.unit
+
+
+def test_deadlock_is_reported_instead_of_hanging() -> None:
+    async def main() -> None:
+        event = anyio.Event()
+        await anyio.sleep(3.0)
+        await event.wait()  # nobody will ever set it
+
+    with pytest.raises(DeadlockError, match=r"deadlock at sim time 3\.0"):
+        anyio.run(main, backend_options={"loop_factory": virtual_loop_factory(deadlock_grace=0.05)})
+
+
+def test_wall_ceiling_cancels_a_livelock() -> None:
+    """A predicate that never holds while an actor keeps ticking: sim time runs on
+    forever; the wall ceiling stops it and says so."""
+
+    async def busy() -> None:
+        while True:
+            await asyncio.sleep(0.001)
+
+    async def main() -> None:
+        async with anyio.create_task_group() as tg:
+            tg.start_soon(busy)
+            await until(lambda: False, within=1e12)
+
+    with pytest.raises(WallClockCeilingError, match=r"wall-clock ceiling of 0\.3 s"):
+        anyio.run(main, backend_options={"loop_factory": virtual_loop_factory(wall_ceiling=0.3)})
+
+
+def test_a_waiting_thread_is_not_a_deadlock() -> None:
+    from otonav.runtime import run_blocking
+
+    def slow() -> int:
+        import threading
+
+        threading.Event().wait(0.2)  # longer than the deadlock grace
+        return 7
+
+    async def main() -> int:
+        return await run_blocking(slow)
+
+    assert (
+        anyio.run(main, backend_options={"loop_factory": virtual_loop_factory(deadlock_grace=0.05)})
+        == 7
+    )

@@ -1,0 +1,174 @@
+"""The virtual-time loop: time jumps, timeouts at the right sim time, FIFO ties, and the
+four ways to run it (anyio.run, asyncio.Runner, pytest-asyncio, the anyio plugin)."""
+
+from __future__ import annotations
+
+import asyncio
+import hashlib
+import time
+
+import anyio
+import pytest
+
+from otonav.runtime import JumpSource, VirtualTimeLoop, run_blocking, virtual_loop_factory
+
+pytestmark = pytest.mark.unit
+
+ONE_YEAR = 365 * 24 * 3600.0
+
+
+def test_sleeps_of_an_hour_and_a_year_jump_instead_of_waiting() -> None:
+    async def main() -> tuple[float, float]:
+        await anyio.sleep(3600)
+        after_hour = anyio.current_time()
+        await anyio.sleep(ONE_YEAR)
+        return after_hour, anyio.current_time()
+
+    wall = time.perf_counter()
+    after_hour, after_year = anyio.run(
+        main, backend="asyncio", backend_options={"loop_factory": virtual_loop_factory()}
+    )
+    wall = time.perf_counter() - wall
+    assert after_hour == pytest.approx(3600.0, abs=1e-6)
+    assert after_year == pytest.approx(3600.0 + ONE_YEAR, abs=1e-3)
+    assert wall < 5.0  # a hang ceiling: the jump itself takes milliseconds
+
+
+def test_fail_after_fires_at_the_right_sim_time() -> None:
+    async def main() -> float:
+        with pytest.raises(TimeoutError):
+            with anyio.fail_after(2.5):
+                await anyio.sleep(10)
+        return anyio.current_time()
+
+    fired = anyio.run(main, backend_options={"loop_factory": virtual_loop_factory()})
+    assert fired == pytest.approx(2.5, abs=1e-6)
+
+
+def test_asyncio_timeout_under_asyncio_runner() -> None:
+    async def main() -> float:
+        loop = asyncio.get_running_loop()
+        with pytest.raises(TimeoutError):
+            async with asyncio.timeout(7.25):
+                await asyncio.sleep(100)
+        return loop.time()
+
+    with asyncio.Runner(loop_factory=virtual_loop_factory()) as runner:
+        assert runner.run(main()) == pytest.approx(7.25, abs=1e-6)
+
+
+def test_time_is_integer_ticks_of_the_source() -> None:
+    source = JumpSource(tick=0.002)
+
+    async def main() -> None:
+        for _ in range(50_000):
+            await asyncio.sleep(0.002)
+
+    with asyncio.Runner(loop_factory=virtual_loop_factory(source)) as runner:
+        runner.run(main())
+        loop = runner.get_loop()
+        assert isinstance(loop, VirtualTimeLoop)
+        # 50,000 float additions of 0.002 drift; the tick count does not.
+        assert source.ticks == 50_000
+        assert loop.time() == 50_000 * 0.002
+
+
+def test_equal_deadlines_wake_in_fifo_order() -> None:
+    order: list[int] = []
+
+    async def sleeper(i: int) -> None:
+        await anyio.sleep(1.0)
+        order.append(i)
+
+    async def main() -> None:
+        async with anyio.create_task_group() as tg:
+            for i in range(40):
+                tg.start_soon(sleeper, i)
+
+    anyio.run(main, backend_options={"loop_factory": virtual_loop_factory()})
+    assert order == list(range(40))
+
+
+def _trace_program() -> str:
+    """Many actors with equal and unequal periods; the trace hash must be identical."""
+    trace: list[tuple[float, int, int]] = []
+
+    async def ticker(i: int, period: float) -> None:
+        for k in range(30):
+            await anyio.sleep(period)
+            trace.append((round(anyio.current_time(), 9), i, k))
+
+    async def main() -> None:
+        async with anyio.create_task_group() as tg:
+            for i in range(24):
+                tg.start_soon(ticker, i, (0.01, 0.02, 0.03)[i % 3])
+
+    anyio.run(main, backend_options={"loop_factory": virtual_loop_factory(JumpSource(0.001))})
+    return hashlib.sha256(repr(trace).encode()).hexdigest()
+
+
+def test_same_program_gives_identical_event_trace() -> None:
+    assert _trace_program() == _trace_program()
+
+
+def test_run_blocking_holds_sim_time_still() -> None:
+    def blocking() -> str:
+        time.sleep(0.05)  # real blocking work in a worker thread
+        return "done"
+
+    ticks: list[float] = []
+
+    async def ticker() -> None:
+        while True:
+            await anyio.sleep(0.001)
+            ticks.append(anyio.current_time())
+
+    async def main() -> tuple[float, float, str]:
+        async with anyio.create_task_group() as tg:
+            tg.start_soon(ticker)
+            await anyio.sleep(0.01)
+            before = anyio.current_time()
+            result = await run_blocking(blocking)
+            after = anyio.current_time()
+            tg.cancel_scope.cancel()
+        return before, after, result
+
+    before, after, result = anyio.run(
+        main, backend_options={"loop_factory": virtual_loop_factory()}
+    )
+    assert result == "done"
+    assert after == before  # 50 ms of wall time in the thread, 0 s of sim time
+
+
+@pytest.mark.sim
+async def test_pytest_asyncio_hook_runs_marked_tests_on_the_virtual_loop() -> None:
+    loop = asyncio.get_running_loop()
+    assert isinstance(loop, VirtualTimeLoop)
+    start = loop.time()
+    await asyncio.sleep(86_400)
+    assert loop.time() - start == pytest.approx(86_400)
+
+
+@pytest.mark.asyncio
+async def test_unmarked_async_tests_keep_a_stock_loop() -> None:
+    assert not isinstance(asyncio.get_running_loop(), VirtualTimeLoop)
+
+
+class TestAnyioPlugin:
+    """anyio's pytest plugin, with the backend options carrying our loop factory."""
+
+    @pytest.fixture
+    def anyio_backend(self) -> tuple[str, dict[str, object]]:
+        return ("asyncio", {"loop_factory": virtual_loop_factory()})
+
+    @pytest.fixture
+    def trace(self) -> list[float]:
+        return []
+
+    @pytest.mark.anyio
+    async def test_anyio_plugin_runs_on_the_virtual_loop(self, trace: list[float]) -> None:
+        assert isinstance(asyncio.get_running_loop(), VirtualTimeLoop)
+        with anyio.move_on_after(30):
+            await anyio.sleep(1000)
+        trace.append(anyio.current_time())
+        assert trace == [pytest.approx(30.0)]
