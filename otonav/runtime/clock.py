@@ -17,7 +17,7 @@ from collections.abc import Callable
 import anyio
 
 from otonav.runtime.loop import VirtualTimeLoop
-from otonav.runtime.timesource import TimeSource
+from otonav.runtime.timesource import TimeSource, tick_rate
 
 _current: contextvars.ContextVar[Clock] = contextvars.ContextVar("otonav_clock")
 
@@ -101,7 +101,7 @@ class RealTimeClock(Clock):
         if not scale > 0:
             raise ValueError(f"real-time scale must be > 0, got {scale!r}")
         self._source = source
-        self._tick = source.tick
+        self._rate = tick_rate(source.tick)
         self.scale = scale
         self._ticks = 0
         self._wall0: float | None = None
@@ -124,11 +124,11 @@ class RealTimeClock(Clock):
     def _follow_wall(self) -> None:
         wall = self._wall()
         assert self._wall0 is not None
-        self._advance_to(math.floor((wall - self._wall0) * self.scale / self._tick + 1e-9))
+        self._advance_to(math.floor((wall - self._wall0) * self.scale * self._rate + 1e-9))
 
     def now(self) -> float:
         self._follow_wall()
-        return self._ticks * self._tick
+        return self._ticks / self._rate
 
     def to_loop_time(self, sim_time: float) -> float:
         self._wall()
@@ -139,7 +139,7 @@ class RealTimeClock(Clock):
         await anyio.sleep_until(self.to_loop_time(sim_time))
         self._follow_wall()
         # A timer may fire a hair early; the world still reaches the asked instant.
-        self._advance_to(max(self._ticks, math.ceil(sim_time / self._tick - 1e-9)))
+        self._advance_to(max(self._ticks, math.ceil(sim_time * self._rate - 1e-9)))
 
     def watch(self, check: Callable[[], bool]) -> Callable[[], None]:
         self._watchers.append(check)

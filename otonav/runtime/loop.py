@@ -25,7 +25,7 @@ from concurrent.futures import Executor
 from typing import Any, TypeVar, TypeVarTuple
 
 from otonav.runtime.errors import DeadlockError, WallClockCeilingError
-from otonav.runtime.timesource import JumpSource, TimeSource
+from otonav.runtime.timesource import JumpSource, TimeSource, tick_rate
 
 _T = TypeVar("_T")
 _Ts = TypeVarTuple("_Ts")
@@ -93,10 +93,13 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         super().__init__(selector)  # type: ignore[arg-type]
         selector.loop = self
         self._source: TimeSource = source if source is not None else JumpSource()
-        self._tick = self._source.tick
+        self._rate = tick_rate(self._source.tick)
         self._base = 0.0
         self._ticks = 0
-        self._clock_resolution = self._tick / 2
+        # The loop advances to the first tick at or after a deadline; the resolution lets
+        # a timer whose deadline is float noise above a tick fire at that tick. It must
+        # stay well above the float spacing of large times (a year in: ~4e-9 s).
+        self._clock_resolution = 0.25 / self._rate
         self._seq = 0
         self._holds = 0
         self._watchers: list[_Watcher] = []
@@ -111,7 +114,10 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
     # -- time ---------------------------------------------------------------------------
 
     def time(self) -> float:
-        return self._base + self._ticks * self._tick
+        return self._base + self._ticks / self._rate
+
+    def _time_at(self, ticks: int) -> float:
+        return self._base + ticks / self._rate
 
     @property
     def source(self) -> TimeSource:
@@ -127,8 +133,8 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         self._base = self.time()
         self._ticks = 0
         self._source = source
-        self._tick = source.tick
-        self._clock_resolution = self._tick / 2
+        self._rate = tick_rate(source.tick)
+        self._clock_resolution = 0.25 / self._rate
 
     def call_at(
         self,
@@ -208,12 +214,22 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
             return inner.select(0.05)
         if timeout is None:
             return self._wait_or_deadlock(inner)
-        steps = max(0, math.floor(timeout / self._tick - 0.5) + 1)
-        if steps:
-            self._source.advance(steps)
-            self._ticks += steps
-            self.wakes += 1
+        self._advance_to_deadline(self._scheduled[0]._when)  # type: ignore[attr-defined]
         return []
+
+    def _advance_to_deadline(self, when: float) -> None:
+        """Advance at least one tick (``when`` is ahead of now: asyncio passed a timeout
+        > 0), and on to the first tick at which asyncio will consider ``when`` due.
+
+        Always moving on matters: anyio re-arms a deadline timer that fired within the
+        clock resolution but before its deadline; staying put would livelock.
+        """
+        target = max(self._ticks + 1, math.ceil((when - self._base) * self._rate - 1.0))
+        while self._time_at(target) + self._clock_resolution <= when:
+            target += 1
+        self._source.advance(target - self._ticks)
+        self._ticks = target
+        self.wakes += 1
 
     def _wait_or_deadlock(
         self, inner: selectors.BaseSelector

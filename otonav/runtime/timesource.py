@@ -41,3 +41,15 @@ class JumpSource:
 
     def advance(self, n: int) -> None:
         self.ticks += n
+
+
+def tick_rate(tick: float) -> float:
+    """Ticks per second, snapped to an integer when ``1 / tick`` is one (0.002 s -> 500).
+
+    Time is then ``ticks / rate``: a correctly rounded division, so tick instants are
+    the same doubles as the decimal literals people write (1100 / 500 == 2.2, whereas
+    1100 * 0.002 == 2.2000000000000002).
+    """
+    rate = 1.0 / tick
+    nearest = round(rate)
+    return float(nearest) if nearest > 0 and abs(rate - nearest) < 1e-6 * rate else rate

@@ -1,0 +1,29 @@
+"""Hardware abstraction layer: the robot as otonav sees it.
+
+``otonav.hal.mujoco`` (the MuJoCo world) is not imported here, so importing the HAL's
+types, interface and fake does not load MuJoCo.
+"""
+
+from otonav.hal.fake import FakeHardware
+from otonav.hal.interface import RobotHardwareInterface
+from otonav.hal.types import (
+    BoxObstacle,
+    GroundTruth,
+    ImuSample,
+    RangeScan,
+    RobotGeometry,
+    WheelCommand,
+    WheelState,
+)
+
+__all__ = [
+    "BoxObstacle",
+    "FakeHardware",
+    "GroundTruth",
+    "ImuSample",
+    "RangeScan",
+    "RobotGeometry",
+    "RobotHardwareInterface",
+    "WheelCommand",
+    "WheelState",
+]

@@ -1,0 +1,103 @@
+"""The hardware abstraction: what the rest of otonav may know about a robot.
+
+A :class:`RobotHardwareInterface` is both the robot's I/O (wheel commands in; encoders,
+IMU, lidar out) and, in simulation, the *time source*: the virtual-time loop calls
+:meth:`RobotHardwareInterface.advance` and nothing else steps the world. Time is an
+integer count of physics ticks; ``sim_time`` is derived from it, never accumulated.
+"""
+
+from __future__ import annotations
+
+import abc
+from types import TracebackType
+from typing import Self
+
+from otonav.hal.types import (
+    BoxObstacle,
+    GroundTruth,
+    ImuSample,
+    RangeScan,
+    RobotGeometry,
+    WheelCommand,
+    WheelState,
+)
+
+__all__ = ["RobotHardwareInterface"]
+
+
+class RobotHardwareInterface(abc.ABC):
+    """A differential-drive robot with wheel encoders, an IMU and a planar lidar.
+
+    Usable as a context manager (``close()`` on exit).
+    """
+
+    @property
+    @abc.abstractmethod
+    def tick(self) -> float:
+        """Physics step, seconds. Constant for the life of the interface."""
+
+    @property
+    @abc.abstractmethod
+    def ticks(self) -> int:
+        """Number of physics steps taken since construction: the truth of time."""
+
+    @property
+    def sim_time(self) -> float:
+        """Simulated time, seconds: ``ticks * tick`` (computed, so it never drifts)."""
+        return self.ticks * self.tick
+
+    @abc.abstractmethod
+    def advance(self, n: int) -> None:
+        """Step the world ``n`` ticks (``n >= 0``) holding the current wheel command."""
+
+    @abc.abstractmethod
+    def write(self, cmd: WheelCommand) -> None:
+        """Set the wheel angular velocity setpoints (rad/s); takes effect on next advance."""
+
+    @abc.abstractmethod
+    def read_wheels(self) -> WheelState:
+        """Wheel encoders now: angles (rad) and angular velocities (rad/s)."""
+
+    @abc.abstractmethod
+    def read_imu(self) -> ImuSample:
+        """IMU now: orientation (w, x, y, z), gyro (rad/s), accelerometer (m/s^2, with g)."""
+
+    @abc.abstractmethod
+    def read_scan(self) -> RangeScan:
+        """One lidar sweep taken now, in the laser frame; ranges in metres, misses +inf."""
+
+    @abc.abstractmethod
+    def ground_truth(self) -> GroundTruth:
+        """True chassis pose and world velocity (for judging only, never for control)."""
+
+    @property
+    @abc.abstractmethod
+    def geometry(self) -> RobotGeometry:
+        """Wheel radius and separation (m) and laser mounting offset (m)."""
+
+    @abc.abstractmethod
+    def obstacles(self) -> tuple[BoxObstacle, ...]:
+        """The world's obstacle boxes (m), for ground-truth clearance. Excludes walls."""
+
+    def walls(self) -> tuple[BoxObstacle, ...]:
+        """The world's boundary walls as boxes (m). Empty if the world has none."""
+        return ()
+
+    def clearance_boxes(self) -> tuple[BoxObstacle, ...]:
+        """Everything the robot must keep clear of: obstacles and walls."""
+        return self.obstacles() + self.walls()
+
+    @abc.abstractmethod
+    def close(self) -> None:
+        """Release resources. Idempotent; the interface must not be used afterwards."""
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()

@@ -1,0 +1,153 @@
+"""Value types exchanged with a :class:`~otonav.hal.interface.RobotHardwareInterface`.
+
+Plain frozen dataclasses, SI units, no simulator imports. Angles in radians, lengths in
+metres, times in seconds. The world frame is x forward / y left / z up (ROS REP 103).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = [
+    "BoxObstacle",
+    "GroundTruth",
+    "ImuSample",
+    "RangeScan",
+    "RobotGeometry",
+    "WheelCommand",
+    "WheelState",
+]
+
+
+@dataclass(frozen=True, slots=True)
+class WheelCommand:
+    """Wheel angular velocity setpoints, rad/s. Positive drives the robot forward."""
+
+    left: float
+    right: float
+
+
+@dataclass(frozen=True, slots=True)
+class WheelState:
+    """Wheel encoders: joint angles (rad, unwrapped) and angular velocities (rad/s)."""
+
+    left_position: float
+    right_position: float
+    left_velocity: float
+    right_velocity: float
+
+
+@dataclass(frozen=True, slots=True)
+class ImuSample:
+    """One IMU reading, in the IMU site frame.
+
+    ``orientation`` is the site's world orientation as a unit quaternion (w, x, y, z).
+    ``angular_velocity`` is rad/s. ``linear_acceleration`` is m/s^2 and, like a real
+    accelerometer, includes gravity: (0, 0, +9.81) at rest on level ground.
+    """
+
+    orientation: tuple[float, float, float, float]
+    angular_velocity: tuple[float, float, float]
+    linear_acceleration: tuple[float, float, float]
+
+
+@dataclass(frozen=True, slots=True)
+class RangeScan:
+    """A planar laser scan, ROS ``sensor_msgs/LaserScan`` convention.
+
+    Angles are CCW from +x of the laser frame; beam ``i`` points at
+    ``angle_min + i * angle_increment`` and ``angle_max`` is the angle of the last beam.
+    ``ranges`` are metres, float32; an invalid return (no hit within ``range_max``, or
+    closer than ``range_min``) is ``+inf`` (REP 117).
+    """
+
+    angle_min: float
+    angle_max: float
+    angle_increment: float
+    range_min: float
+    range_max: float
+    ranges: NDArray[np.float32]
+
+    @property
+    def angles(self) -> NDArray[np.float64]:
+        """Angle of every beam, rad (laser frame)."""
+        angles = self.angle_min + self.angle_increment * np.arange(self.ranges.size)
+        return np.asarray(angles, dtype=np.float64)
+
+    def beam_index(self, angle: float) -> int:
+        """Index of the beam closest to ``angle`` (rad, laser frame).
+
+        A full-circle scan wraps around; a partial one clamps to its first/last beam.
+        """
+        n = self.ranges.size
+        if n == 0:
+            raise ValueError("empty scan has no beams")
+        if n == 1 or self.angle_increment == 0.0:
+            return 0
+        k = round((angle - self.angle_min) / self.angle_increment)
+        if abs(self.angle_increment) * n >= 2.0 * math.pi - 1e-9:
+            return k % n
+        return min(max(k, 0), n - 1)
+
+
+@dataclass(frozen=True, slots=True)
+class GroundTruth:
+    """Simulator truth for the chassis (base_link) frame.
+
+    ``x``, ``y`` in metres (world); ``yaw``, ``pitch``, ``roll`` in rad (intrinsic
+    Z-Y-X; positive pitch is nose down); ``vx_world``, ``vy_world`` in m/s (world).
+    """
+
+    x: float
+    y: float
+    yaw: float
+    pitch: float
+    roll: float
+    vx_world: float
+    vy_world: float
+
+
+@dataclass(frozen=True, slots=True)
+class RobotGeometry:
+    """What kinematics and the /tf tree need to know about the robot.
+
+    ``wheel_radius`` and ``wheel_separation`` (distance between wheel contact points)
+    in metres. base_link is the midpoint of the wheel axle, at axle height
+    (``base_height`` above the floor); the laser frame is ``laser_offset_x`` ahead of
+    and ``laser_offset_z`` above base_link, with no rotation.
+    """
+
+    wheel_radius: float
+    wheel_separation: float
+    laser_offset_x: float
+    laser_offset_z: float
+    base_height: float = 0.0
+
+
+@dataclass(frozen=True, slots=True)
+class BoxObstacle:
+    """An upright box in the world plane: centre (x, y) m, half sizes m, yaw rad."""
+
+    x: float
+    y: float
+    half_x: float
+    half_y: float
+    yaw: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not (self.half_x > 0.0 and self.half_y > 0.0):
+            raise ValueError(f"box half sizes must be positive, got {self.half_x}, {self.half_y}")
+
+    def distance_to(self, px: float, py: float) -> float:
+        """Euclidean distance, m, from the point (px, py) to the box; 0 inside."""
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        dx, dy = px - self.x, py - self.y
+        lx = c * dx + s * dy
+        ly = -s * dx + c * dy
+        ex = max(abs(lx) - self.half_x, 0.0)
+        ey = max(abs(ly) - self.half_y, 0.0)
+        return math.hypot(ex, ey)

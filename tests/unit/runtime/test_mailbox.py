@@ -1,0 +1,229 @@
+"""Typed topics and QoS: wiring errors, exact drop counts, backpressure, late joiners."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import anyio
+import pytest
+
+from otonav.runtime import (
+    LATCHED_QOS,
+    SENSOR_DATA_QOS,
+    Actor,
+    Bus,
+    Durability,
+    Input,
+    Output,
+    QoS,
+    QoSIncompatibleError,
+    Reliability,
+    System,
+    TopicTypeError,
+    virtual_loop_factory,
+)
+from otonav.runtime.mailbox import Endpoint
+
+pytestmark = pytest.mark.unit
+
+
+@dataclass(frozen=True, slots=True)
+class Ping:
+    n: int
+
+
+@dataclass(frozen=True, slots=True)
+class Pong:
+    n: int
+
+
+def _run(main: object) -> None:
+    anyio.run(main, backend_options={"loop_factory": virtual_loop_factory()})  # type: ignore[arg-type]
+
+
+BEST_EFFORT = QoS(Reliability.BEST_EFFORT)
+VOLATILE_RELIABLE = QoS(Reliability.RELIABLE)
+TRANSIENT = QoS(durability=Durability.TRANSIENT_LOCAL)
+
+
+@pytest.mark.parametrize(
+    ("offered", "requested", "fragment"),
+    [
+        (BEST_EFFORT, VOLATILE_RELIABLE, "requests reliable delivery"),
+        (VOLATILE_RELIABLE, TRANSIENT, "requests transient_local durability"),
+        (BEST_EFFORT, TRANSIENT, "requests reliable delivery"),
+    ],
+)
+@pytest.mark.parametrize("publisher_first", [True, False])
+def test_incompatible_qos_fails_at_wiring_naming_both_ends_and_the_fix(
+    offered: QoS, requested: QoS, fragment: str, publisher_first: bool
+) -> None:
+    bus = Bus()
+    pub_end, sub_end = Endpoint("lidar", "scan"), Endpoint("nav", "scan_in")
+
+    def wire() -> None:
+        if publisher_first:
+            bus.publisher("/scan", Ping, offered, endpoint=pub_end)
+            bus.subscribe("/scan", Ping, requested, endpoint=sub_end)
+        else:
+            bus.subscribe("/scan", Ping, requested, endpoint=sub_end)
+            bus.publisher("/scan", Ping, offered, endpoint=pub_end)
+
+    with pytest.raises(QoSIncompatibleError) as err:
+        wire()
+    text = str(err.value)
+    assert "'/scan'" in text
+    assert "lidar.scan" in text
+    assert "nav.scan_in" in text
+    assert fragment in text
+    assert "fix:" in text
+
+
+@pytest.mark.parametrize(
+    ("offered", "requested"),
+    [
+        (VOLATILE_RELIABLE, BEST_EFFORT),
+        (BEST_EFFORT, BEST_EFFORT),
+        (TRANSIENT, VOLATILE_RELIABLE),
+        (TRANSIENT, TRANSIENT),
+        (LATCHED_QOS, SENSOR_DATA_QOS),
+    ],
+)
+def test_compatible_qos_pairs_wire(offered: QoS, requested: QoS) -> None:
+    bus = Bus()
+    bus.publisher("/t", Ping, offered, endpoint=Endpoint("a", "out"))
+    bus.subscribe("/t", Ping, requested, endpoint=Endpoint("b", "in"))
+
+
+def test_two_port_types_on_one_topic_name_actor_port_topic_and_both_types() -> None:
+    class Talker(Actor):
+        out = Output("/chatter", Ping)
+
+    class Listener(Actor):
+        inp = Input("/chatter", Pong)
+
+    with pytest.raises(TopicTypeError) as err:
+        System([Talker(), Listener()])
+    text = str(err.value)
+    assert "listener.inp" in text
+    assert "'/chatter'" in text
+    assert "Pong" in text
+    assert "Ping" in text
+    assert "talker.out" in text
+
+
+def test_publishing_the_wrong_type_names_port_topic_and_types() -> None:
+    bus = Bus()
+    pub = bus.publisher("/chatter", Ping, endpoint=Endpoint("talker", "out"))
+
+    async def main() -> None:
+        with pytest.raises(TopicTypeError) as err:
+            await pub.publish(Pong(1))  # type: ignore[arg-type]
+        assert "talker.out" in str(err.value)
+        assert "Pong" in str(err.value)
+        assert "'/chatter'" in str(err.value)
+        assert "Ping" in str(err.value)
+
+    _run(main)
+
+
+def test_best_effort_drops_oldest_and_counts_exactly() -> None:
+    bus = Bus()
+    pub = bus.publisher("/scan", Ping, BEST_EFFORT, endpoint=Endpoint("a", "o"))
+    sub = bus.subscribe(
+        "/scan", Ping, QoS(Reliability.BEST_EFFORT, depth=3), endpoint=Endpoint("b", "i")
+    )
+
+    async def main() -> None:
+        for n in range(10):
+            await pub.publish(Ping(n))
+        got = [sub.try_recv() for _ in range(4)]
+        assert got == [Ping(7), Ping(8), Ping(9), None]
+        stats = sub.statistics()
+        assert (stats.received, stats.taken, stats.dropped, stats.queued) == (10, 3, 7, 0)
+
+    _run(main)
+
+
+def test_one_message_object_is_shared_by_all_subscribers() -> None:
+    bus = Bus()
+    pub = bus.publisher("/t", Ping, endpoint=Endpoint("a", "o"))
+    subs = [bus.subscribe("/t", Ping, endpoint=Endpoint(f"s{i}", "i")) for i in range(3)]
+
+    async def main() -> None:
+        message = Ping(1)
+        await pub.publish(message)
+        assert all(s.try_recv() is message for s in subs)
+
+    _run(main)
+
+
+def test_reliable_slow_consumer_loses_nothing_and_publisher_waits() -> None:
+    received: list[int] = []
+    publish_times: list[float] = []
+
+    class Fast(Actor):
+        out = Output("/data", Ping)
+
+        async def run(self) -> None:
+            for n in range(100):
+                await self.out.publish(Ping(n))
+                publish_times.append(self.clock.now())
+
+    class Slow(Actor):
+        inp = Input("/data", Ping, QoS(depth=4))
+
+        async def run(self) -> None:
+            while len(received) < 100:
+                received.append((await self.inp.recv()).n)
+                await self.clock.sleep(0.1)
+
+    async def main() -> None:
+        system = System([Fast(), Slow()])
+        await system.run()
+        stats = system.graph().topic("/data").subscriptions[0].statistics
+        assert stats.dropped == 0
+        assert stats.received == 100
+
+    _run(main)
+    assert received == list(range(100))
+    # Backpressure: the publisher was held back by the consumer's pace. The consumer
+    # takes message k at 0.1*k s, freeing room for message k+4; so message 99 goes out
+    # when message 95 is taken, at 9.5 s (0..4 go out at 0 s: 4 queued + 1 taken).
+    assert publish_times[:5] == [0.0] * 5
+    assert publish_times[-1] == pytest.approx(9.5, abs=1e-6)
+
+
+def test_transient_local_late_joiner_gets_the_last_n() -> None:
+    bus = Bus()
+    pub = bus.publisher(
+        "/goal",
+        Ping,
+        QoS(depth=3, durability=Durability.TRANSIENT_LOCAL),
+        endpoint=Endpoint("a", "o"),
+    )
+
+    async def main() -> None:
+        for n in range(5):
+            await pub.publish(Ping(n))
+        late = bus.subscribe("/goal", Ping, TRANSIENT, endpoint=Endpoint("late", "i"))
+        volatile = bus.subscribe("/goal", Ping, VOLATILE_RELIABLE, endpoint=Endpoint("vol", "i"))
+        assert [late.try_recv() for _ in range(4)] == [Ping(2), Ping(3), Ping(4), None]
+        assert volatile.try_recv() is None
+
+    _run(main)
+
+
+def test_take_latest_discards_older_messages() -> None:
+    bus = Bus()
+    pub = bus.publisher("/odom", Ping, endpoint=Endpoint("a", "o"))
+    sub = bus.subscribe("/odom", Ping, endpoint=Endpoint("b", "i"))
+
+    async def main() -> None:
+        for n in range(4):
+            await pub.publish(Ping(n))
+        assert sub.take_latest() == Ping(3)
+        assert sub.take_latest() is None
+        assert sub.statistics().taken == 4
+
+    _run(main)

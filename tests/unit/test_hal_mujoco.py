@@ -1,0 +1,221 @@
+"""MujocoInterface: scenes compile, time is ticks, the robot drives flat, the lidar is honest."""
+
+from __future__ import annotations
+
+import math
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from otonav.hal import BoxObstacle, WheelCommand
+from otonav.hal.mujoco import MujocoInterface, SceneError, compile_scene, scene_names
+
+pytestmark = pytest.mark.unit
+
+ASSETS = Path(str(resources.files("otonav.hal").joinpath("assets")))
+START = (0.0, 0.0)
+GOAL = (4.0, 1.5)
+SPEED = 6.0  # rad/s = 0.3 m/s on 0.05 m wheels
+SCAN_EVERY = 50  # ticks: 10 Hz at dt 0.002
+
+
+def drive_and_brake(
+    hw: MujocoInterface, *, drive_s: float = 1.0, brake_s: float = 1.0
+) -> tuple[list[float], list[int], list[float]]:
+    """Step-start at SPEED, then step-stop; scan at 10 Hz.
+
+    Returns the |pitch| (rad) at every scan, the floor hits of every scan, and the
+    nearest floor hit (m) of every scan in the forward sector |angle| < 0.26 rad.
+    """
+    pitches: list[float] = []
+    floor_hits: list[int] = []
+    forward_floor: list[float] = []
+    for seconds, speed in ((drive_s, SPEED), (brake_s, 0.0)):
+        hw.write(WheelCommand(speed, speed))
+        for _ in range(round(seconds / (SCAN_EVERY * hw.tick))):
+            hw.advance(SCAN_EVERY)
+            scan = hw.read_scan()
+            pitches.append(abs(hw.ground_truth().pitch))
+            floor_hits.append(hw.scan_floor_hits())
+            on_floor = hw.scan_floor_mask() & (np.abs(scan.angles) < 0.26)
+            forward_floor.append(float(scan.ranges[on_floor].min(initial=np.inf)))
+    return pitches, floor_hits, forward_floor
+
+
+@pytest.mark.parametrize("path", sorted(ASSETS.glob("*.xml")), ids=lambda p: p.name)
+def test_every_asset_compiles(path: Path) -> None:
+    compile_scene(path)
+
+
+def test_builtin_scene_names() -> None:
+    assert {"empty", "obstacles"} <= set(scene_names())
+    for name in scene_names():
+        compile_scene(name)
+
+
+def test_bad_mjcf_error_names_the_file(tmp_path: Path) -> None:
+    unparsable = tmp_path / "unparsable.xml"
+    unparsable.write_text("<mujoco><worldbody><geom type='bogus'/></worldbody></mujoco>")
+    with pytest.raises(SceneError, match=r"unparsable\.xml does not parse"):
+        compile_scene(unparsable)
+    uncompilable = tmp_path / "uncompilable.xml"
+    uncompilable.write_text("<mujoco><worldbody><geom type='box'/></worldbody></mujoco>")
+    with pytest.raises(SceneError, match=r"uncompilable\.xml does not compile"):
+        compile_scene(uncompilable)
+    with pytest.raises(SceneError, match="neither a built-in scene"):
+        compile_scene(tmp_path / "missing.xml")
+
+
+def test_scene_without_robot_is_rejected(tmp_path: Path) -> None:
+    bare = tmp_path / "bare.xml"
+    bare.write_text(
+        "<mujoco><worldbody><geom name='floor' type='plane' size='1 1 .1'/></worldbody></mujoco>"
+    )
+    compile_scene(bare)
+    with pytest.raises(SceneError, match=r"bare\.xml: no body named 'chassis'"):
+        MujocoInterface(bare)
+
+
+def test_advance_counts_ticks() -> None:
+    hw = MujocoInterface("empty", timestep=0.005)
+    assert hw.tick == 0.005
+    assert hw.ticks == 0
+    hw.advance(7)
+    hw.advance(0)
+    hw.advance(13)
+    assert hw.ticks == 20
+    assert hw.sim_time == 20 * 0.005
+    with pytest.raises(ValueError, match="negative"):
+        hw.advance(-1)
+    hw.close()
+    with pytest.raises(RuntimeError, match="closed"):
+        hw.advance(1)
+
+
+def test_geometry_matches_the_robot_model() -> None:
+    geo = MujocoInterface("empty").geometry
+    assert geo.wheel_radius == pytest.approx(0.05)
+    assert geo.wheel_separation == pytest.approx(0.22)
+    assert geo.laser_offset_x == pytest.approx(0.06)
+    assert geo.laser_offset_z == pytest.approx(0.09)
+    assert geo.base_height == pytest.approx(0.05)
+
+
+def test_at_rest_imu_reads_gravity_and_lidar_never_sees_the_robot() -> None:
+    hw = MujocoInterface("empty")
+    imu = hw.read_imu()
+    assert imu.linear_acceleration == pytest.approx((0.0, 0.0, 9.81), abs=0.01)
+    assert imu.angular_velocity == pytest.approx((0.0, 0.0, 0.0), abs=1e-6)
+    assert imu.orientation == pytest.approx((1.0, 0.0, 0.0, 0.0), abs=1e-3)
+    scan = hw.read_scan()
+    # Inner wall faces at +-5 m; the laser sits 0.06 m ahead of the origin.
+    assert np.all(np.isfinite(scan.ranges))
+    assert float(scan.ranges.min()) > 4.9
+    assert {hw.geom_name(int(g)) for g in hw.scan_hit_geoms()} <= {
+        "wall_east",
+        "wall_west",
+        "wall_north",
+        "wall_south",
+    }
+
+
+def test_straight_drive_moves_v_times_t_and_stays_flat() -> None:
+    hw = MujocoInterface("empty")
+    hw.write(WheelCommand(SPEED, SPEED))
+    max_pitch = 0.0
+    for _ in range(100):  # 2 s
+        hw.advance(10)
+        max_pitch = max(max_pitch, abs(hw.ground_truth().pitch))
+    gt = hw.ground_truth()
+    assert hw.sim_time == pytest.approx(2.0)
+    assert gt.x == pytest.approx(0.6, abs=0.02)
+    assert abs(gt.y) < 0.005
+    assert abs(gt.yaw) < math.radians(0.5)
+    assert gt.vx_world == pytest.approx(0.3, abs=0.01)
+    wheels = hw.read_wheels()
+    assert wheels.left_velocity == pytest.approx(SPEED, abs=0.05)
+    assert wheels.left_position * hw.geometry.wheel_radius == pytest.approx(gt.x, abs=0.01)
+    assert math.degrees(max_pitch) < 2.0
+
+
+def test_shipped_model_stays_flat_and_never_scans_the_floor() -> None:
+    hw = MujocoInterface("obstacles")
+    pitches, floor_hits, _ = drive_and_brake(hw)
+    assert math.degrees(max(pitches)) < 2.0
+    assert sum(floor_hits) == 0
+    assert abs(hw.ground_truth().vx_world) < 0.01  # it did stop
+
+
+def test_bug_variant_scans_the_floor() -> None:
+    """The seeds' bug: no caster, no torque limit, kv 10.
+
+    Without the caster the centre of mass (ahead of the axle) puts the nose on the
+    floor already at rest (about 8 deg, floor read at about 0.9 m ahead); the abrupt
+    stop pitches it much further and the floor comes within half a metre.
+    """
+    hw = MujocoInterface("obstacles", variant="no_caster_unlimited_torque")
+    hw.read_scan()
+    assert hw.scan_floor_hits() > 0
+    pitches, floor_hits, forward_floor = drive_and_brake(hw)
+    assert math.degrees(max(pitches)) > 10.0
+    assert sum(floor_hits) > 0
+    assert min(forward_floor) < 0.5
+
+
+def test_lidar_sees_an_extra_obstacle_at_the_expected_range() -> None:
+    box = BoxObstacle(1.5, 0.0, 0.1, 0.1)
+    hw = MujocoInterface("empty", extra_obstacles=[box])
+    assert box in hw.obstacles()
+    scan = hw.read_scan()
+    ahead = scan.beam_index(0.0)
+    assert scan.ranges[ahead] == pytest.approx(1.5 - 0.1 - 0.06, abs=0.005)
+    assert hw.geom_name(int(hw.scan_hit_geoms()[ahead])) == "obstacle_extra_0"
+    behind = scan.beam_index(math.pi)
+    assert scan.ranges[behind] == pytest.approx(5.0 + 0.06, abs=0.005)
+
+
+def test_lidar_range_limits_give_inf() -> None:
+    hw = MujocoInterface("empty", lidar_beams=90, lidar_range_max=3.0)
+    scan = hw.read_scan()
+    assert scan.ranges.size == 90
+    assert np.all(np.isposinf(scan.ranges))  # walls are 5 m away
+    # Anything closer than range_min (0.12 m) would be inside the robot, so raise it.
+    near = MujocoInterface(
+        "empty", lidar_range_min=0.5, extra_obstacles=[BoxObstacle(0.5, 0.0, 0.1, 0.3)]
+    )
+    scan = near.read_scan()
+    assert np.isposinf(scan.ranges[scan.beam_index(0.0)])  # 0.34 m < range_min 0.5
+    assert scan.ranges[scan.beam_index(math.pi)] == pytest.approx(5.06, abs=0.005)
+
+
+def test_reading_sensors_does_not_perturb_physics() -> None:
+    quiet, chatty = MujocoInterface("obstacles"), MujocoInterface("obstacles")
+    for hw in (quiet, chatty):
+        hw.write(WheelCommand(4.0, 6.0))
+    for _ in range(40):
+        quiet.advance(10)
+        chatty.advance(10)
+        chatty.read_scan()
+        chatty.read_imu()
+    assert quiet.ground_truth() == chatty.ground_truth()
+    assert quiet.read_wheels() == chatty.read_wheels()
+
+
+def test_obstacle_scene_layout() -> None:
+    hw = MujocoInterface("obstacles")
+    obstacles, walls = hw.obstacles(), hw.walls()
+    assert len(obstacles) >= 3
+    assert len(walls) == 4
+    gt = hw.ground_truth()
+    assert (gt.x, gt.y) == pytest.approx(START, abs=1e-3)
+    assert gt.yaw == pytest.approx(0.0, abs=1e-3)
+    samples = np.linspace(0.0, 1.0, 401)
+    path = [
+        (START[0] + t * (GOAL[0] - START[0]), START[1] + t * (GOAL[1] - START[1])) for t in samples
+    ]
+    clearance = [min(box.distance_to(x, y) for x, y in path) for box in obstacles]
+    assert min(clearance) >= 0.45, clearance
+    assert min(clearance) <= 1.5
+    assert min(w.distance_to(*GOAL) for w in walls) >= 0.9
