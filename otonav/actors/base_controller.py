@@ -1,0 +1,93 @@
+"""The base controller: /cmd_vel -> limits -> diff-drive kinematics -> /wheel_cmd."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from otonav.actors import topics
+from otonav.control import DiffDriveGeometry, limit_twist, twist_to_wheels
+from otonav.msgs import Header, Time, Twist, WheelCommand
+from otonav.runtime import Actor, Input, Output
+
+
+@dataclass(frozen=True, slots=True)
+class BaseLimits:
+    """Velocity (m/s, rad/s) and acceleration (m/s², rad/s²) limits."""
+
+    max_v: float = 0.5
+    max_omega: float = 1.5
+    max_accel: float = 1.0
+    max_alpha: float = 3.0
+
+
+class BaseController(Actor):
+    """At ``rate_hz``: take the newest /cmd_vel, clamp it to velocity and acceleration
+    limits, convert to wheel speeds, publish /wheel_cmd. With no /cmd_vel for
+    ``cmd_timeout`` s of sim time the target falls to zero (the watchdog)."""
+
+    cmd_vel = Input(topics.CMD_VEL, Twist, topics.COMMAND_QOS)
+    wheel_cmd = Output(topics.WHEEL_CMD, WheelCommand, topics.COMMAND_QOS)
+
+    def __init__(
+        self,
+        geometry: DiffDriveGeometry,
+        limits: BaseLimits = BaseLimits(),
+        *,
+        rate_hz: float = 50.0,
+        cmd_timeout: float = 0.5,
+        name: str = "base",
+    ) -> None:
+        super().__init__(name)
+        if not rate_hz > 0 or not cmd_timeout > 0:
+            raise ValueError(
+                f"base.rate_hz and base.cmd_timeout must be > 0, got {rate_hz}, {cmd_timeout}"
+            )
+        self.geometry = geometry
+        self.limits = limits
+        self.rate_hz = rate_hz
+        self.cmd_timeout = cmd_timeout
+        self.watchdog_trips = 0
+
+    async def run(self) -> None:
+        rate = self.clock.rate(self.rate_hz)
+        limits = self.limits
+        v = omega = 0.0
+        target: Twist | None = None
+        received_at = -math.inf
+        timed_out = False
+        while True:
+            await rate.sleep()
+            now = self.clock.now()
+            latest = self.cmd_vel.take_latest()
+            if latest is not None:
+                target, received_at, timed_out = latest, now, False
+            if target is not None and not timed_out and now - received_at > self.cmd_timeout:
+                self.watchdog_trips += 1
+                timed_out = True
+            want_v, want_omega = (
+                (target.linear.x, target.angular.z)
+                if target is not None and not timed_out
+                else (0.0, 0.0)
+            )
+            v, omega = limit_twist(
+                want_v,
+                want_omega,
+                prev_v=v,
+                prev_omega=omega,
+                dt=rate.period,
+                max_v=limits.max_v,
+                max_omega=limits.max_omega,
+                max_accel=limits.max_accel,
+                max_alpha=limits.max_alpha,
+            )
+            left, right = twist_to_wheels(v, omega, self.geometry)
+            await self.wheel_cmd.publish(
+                WheelCommand.model_construct(
+                    header=Header.model_construct(
+                        stamp=Time.from_seconds(now), frame_id="base_link"
+                    ),
+                    left=left,
+                    right=right,
+                )
+            )

@@ -1,0 +1,233 @@
+"""The bridge: owns the hardware (simulated or real), publishes its sensors at their
+rates, applies wheel commands. The only actor that touches the HAL."""
+
+from __future__ import annotations
+
+import anyio
+
+from otonav.actors import topics
+from otonav.control import Pose2D, integrate_odometry
+from otonav.hal import RobotHardwareInterface
+from otonav.hal import WheelCommand as HalWheelCommand
+from otonav.msgs import (
+    Clock,
+    Header,
+    Imu,
+    LaserScan,
+    Odometry,
+    Point,
+    Pose,
+    PoseWithCovariance,
+    Quaternion,
+    TFMessage,
+    Time,
+    Transform,
+    TransformStamped,
+    Twist,
+    TwistWithCovariance,
+    Vector3,
+    WheelCommand,
+)
+from otonav.runtime import Actor, Input, Output
+
+
+def _diag6(*variances: float) -> tuple[float, ...]:
+    """A row-major 6x6 covariance with ``variances`` on the diagonal."""
+    return tuple(variances[i // 6] if i % 7 == 0 else 0.0 for i in range(36))
+
+
+# (x, y, z, roll, pitch, yaw): planar robot; z, roll and pitch are not estimated.
+_POSE_COV = _diag6(1e-3, 1e-3, 1e6, 1e6, 1e6, 1e-3)
+_TWIST_COV = _diag6(1e-3, 1e6, 1e6, 1e6, 1e6, 1e-3)
+
+
+class Bridge(Actor):
+    """Publishes /clock, /odom (+ /tf odom->base_link), /imu and /scan at their rates;
+    /tf_static base_link->laser once; writes /wheel_cmd to the hardware.
+
+    Odometry: wheel encoders for distance, the gyro for heading (it does not scrub
+    in turns; notes/mujoco-model.md: ~2 cm and 0.2 deg over a circle vs 7 cm and 8 deg).
+    """
+
+    clock_out = Output(topics.CLOCK, Clock, topics.CLOCK_QOS)
+    odom = Output(topics.ODOM, Odometry, topics.SENSOR_QOS)
+    imu = Output(topics.IMU, Imu, topics.SENSOR_QOS)
+    scan = Output(topics.SCAN, LaserScan, topics.SENSOR_QOS)
+    tf = Output(topics.TF, TFMessage, topics.TF_QOS)
+    tf_static = Output(topics.TF_STATIC, TFMessage, topics.LATCHED)
+    wheel_cmd = Input(topics.WHEEL_CMD, WheelCommand, topics.COMMAND_QOS)
+
+    def __init__(
+        self,
+        hal: RobotHardwareInterface,
+        *,
+        clock_hz: float = 100.0,
+        odom_hz: float = 100.0,
+        imu_hz: float = 100.0,
+        scan_hz: float = 10.0,
+        name: str = "bridge",
+    ) -> None:
+        super().__init__(name)
+        for field, hz in (
+            ("clock_hz", clock_hz),
+            ("odom_hz", odom_hz),
+            ("imu_hz", imu_hz),
+            ("scan_hz", scan_hz),
+        ):
+            if not hz > 0:
+                raise ValueError(f"bridge.{field} must be > 0 Hz, got {hz}")
+        self.hal = hal
+        self._periods = {
+            "clock": 1.0 / clock_hz,
+            "odom": 1.0 / odom_hz,
+            "imu": 1.0 / imu_hz,
+            "scan": 1.0 / scan_hz,
+        }
+        self._pose = Pose2D(0.0, 0.0, 0.0)
+        self._last_wheels: tuple[float, float] | None = None
+        self._last_odom_time = 0.0
+
+    async def on_start(self) -> None:
+        geometry = self.hal.geometry
+        laser = TransformStamped.model_construct(
+            header=Header.model_construct(
+                stamp=Time.from_seconds(self.clock.now()), frame_id="base_link"
+            ),
+            child_frame_id="laser",
+            transform=Transform.model_construct(
+                translation=Vector3.model_construct(
+                    x=geometry.laser_offset_x, y=0.0, z=geometry.laser_offset_z
+                ),
+                rotation=Quaternion(),
+            ),
+        )
+        await self.tf_static.publish(TFMessage.model_construct(transforms=(laser,)))
+
+    async def run(self) -> None:
+        async with anyio.create_task_group() as tg:
+            tg.start_soon(self._apply_commands)
+            await self._publish_loop()
+
+    async def _apply_commands(self) -> None:
+        async for cmd in self.wheel_cmd:
+            self.hal.write(HalWheelCommand(cmd.left, cmd.right))
+
+    async def _publish_loop(self) -> None:
+        """One timer for all streams: wake at the earliest due instant, publish every
+        stream due then, in a fixed order (clock, odom, imu, scan): deterministic, and
+        one wake per instant instead of one per stream."""
+        start = self.clock.now()
+        counts = dict.fromkeys(self._periods, 0)
+        publishers = {
+            "clock": self._publish_clock,
+            "odom": self._publish_odom,
+            "imu": self._publish_imu,
+            "scan": self._publish_scan,
+        }
+        self._last_odom_time = start
+        while True:
+            due = {
+                name: start + (counts[name] + 1) * period for name, period in self._periods.items()
+            }
+            instant = min(due.values())
+            await self.clock.sleep_until(instant)
+            stamp = Time.from_seconds(instant)
+            for name, when in due.items():
+                if when <= instant + 1e-12:
+                    counts[name] += 1
+                    await publishers[name](stamp, instant)
+
+    async def _publish_clock(self, stamp: Time, _now: float) -> None:
+        await self.clock_out.publish(Clock.model_construct(clock=stamp))
+
+    async def _publish_odom(self, stamp: Time, now: float) -> None:
+        hal = self.hal
+        wheels = hal.read_wheels()
+        gyro_z = hal.read_imu().angular_velocity[2]
+        geometry = hal.geometry
+        dt = now - self._last_odom_time
+        self._last_odom_time = now
+        if self._last_wheels is None or dt <= 0:
+            self._last_wheels = (wheels.left_position, wheels.right_position)
+            v = 0.0
+        else:
+            left0, right0 = self._last_wheels
+            self._last_wheels = (wheels.left_position, wheels.right_position)
+            distance = (
+                geometry.wheel_radius
+                * ((wheels.left_position - left0) + (wheels.right_position - right0))
+                / 2
+            )
+            v = distance / dt
+            self._pose = integrate_odometry(self._pose, v, gyro_z, dt)
+        pose = self._pose
+        header = Header.model_construct(stamp=stamp, frame_id="odom")
+        orientation = Quaternion.from_yaw(pose.yaw)
+        await self.odom.publish(
+            Odometry.model_construct(
+                header=header,
+                child_frame_id="base_link",
+                pose=PoseWithCovariance.model_construct(
+                    pose=Pose.model_construct(
+                        position=Point.model_construct(x=pose.x, y=pose.y, z=0.0),
+                        orientation=orientation,
+                    ),
+                    covariance=_POSE_COV,
+                ),
+                twist=TwistWithCovariance.model_construct(
+                    twist=Twist.model_construct(
+                        linear=Vector3.model_construct(x=v, y=0.0, z=0.0),
+                        angular=Vector3.model_construct(x=0.0, y=0.0, z=gyro_z),
+                    ),
+                    covariance=_TWIST_COV,
+                ),
+            )
+        )
+        await self.tf.publish(
+            TFMessage.model_construct(
+                transforms=(
+                    TransformStamped.model_construct(
+                        header=header,
+                        child_frame_id="base_link",
+                        transform=Transform.model_construct(
+                            translation=Vector3.model_construct(x=pose.x, y=pose.y, z=0.0),
+                            rotation=orientation,
+                        ),
+                    ),
+                )
+            )
+        )
+
+    async def _publish_imu(self, stamp: Time, _now: float) -> None:
+        sample = self.hal.read_imu()
+        w, x, y, z = sample.orientation
+        gx, gy, gz = sample.angular_velocity
+        ax, ay, az = sample.linear_acceleration
+        await self.imu.publish(
+            Imu.model_construct(
+                header=Header.model_construct(stamp=stamp, frame_id="imu_link"),
+                orientation=Quaternion.model_construct(x=x, y=y, z=z, w=w),
+                orientation_covariance=(0.0,) * 9,
+                angular_velocity=Vector3.model_construct(x=gx, y=gy, z=gz),
+                angular_velocity_covariance=(0.0,) * 9,
+                linear_acceleration=Vector3.model_construct(x=ax, y=ay, z=az),
+                linear_acceleration_covariance=(0.0,) * 9,
+            )
+        )
+
+    async def _publish_scan(self, stamp: Time, _now: float) -> None:
+        scan = self.hal.read_scan()
+        await self.scan.publish(
+            LaserScan.model_construct(
+                header=Header.model_construct(stamp=stamp, frame_id="laser"),
+                angle_min=scan.angle_min,
+                angle_max=scan.angle_max,
+                angle_increment=scan.angle_increment,
+                time_increment=0.0,
+                scan_time=self._periods["scan"],
+                range_min=scan.range_min,
+                range_max=scan.range_max,
+                ranges=tuple(scan.ranges.tolist()),
+                intensities=(),
+            )
+        )

@@ -1,0 +1,118 @@
+"""The navigator: go-to-goal with an obstacle guard. /odom + /scan + /goal -> /cmd_vel."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from otonav.actors import topics
+from otonav.control import Pose2D
+from otonav.msgs import Header, LaserScan, NavState, Odometry, PoseStamped, Time, Twist, Vector3
+from otonav.nav import GoToGoalParams, GuardParams, go_to_goal, guard_blocked
+from otonav.runtime import Actor, Input, Output
+
+
+class Navigator(Actor):
+    """At ``rate_hz``: drive toward the goal (turn, then drive; P-control) and stop when
+    a valid return inside the guard's front sector is closer than its stop distance.
+
+    The goal comes from ``/goal`` (latched) or ``goal=(x, y)``; the newest wins.
+    Publishes /cmd_vel and /nav/state (idle | driving | blocked | reached).
+    """
+
+    odom = Input(topics.ODOM, Odometry, topics.SENSOR_QOS)
+    scan = Input(topics.SCAN, LaserScan, topics.SENSOR_QOS)
+    goal_in = Input(topics.GOAL, PoseStamped, topics.LATCHED)
+    cmd_vel = Output(topics.CMD_VEL, Twist, topics.COMMAND_QOS)
+    state = Output(topics.NAV_STATE, NavState, topics.COMMAND_QOS)
+
+    def __init__(
+        self,
+        params: GoToGoalParams = GoToGoalParams(),
+        guard: GuardParams = GuardParams(),
+        *,
+        rate_hz: float = 20.0,
+        goal: tuple[float, float] | None = None,
+        name: str = "nav",
+    ) -> None:
+        super().__init__(name)
+        if not rate_hz > 0:
+            raise ValueError(f"nav.rate_hz must be > 0 Hz, got {rate_hz}")
+        self.params = params
+        self.guard = guard
+        self.rate_hz = rate_hz
+        self.goal = goal
+        self._scan: LaserScan | None = None
+        self._ranges: NDArray[np.float32] = np.empty(0, np.float32)
+
+    async def run(self) -> None:
+        rate = self.clock.rate(self.rate_hz)
+        odom: Odometry | None = None
+        while True:
+            await rate.sleep()
+            odom = self.odom.take_latest() or odom
+            goal_msg = self.goal_in.take_latest()
+            if goal_msg is not None:
+                self.goal = (goal_msg.pose.position.x, goal_msg.pose.position.y)
+            scan = self.scan.take_latest()
+            if scan is not None:
+                self._scan = scan
+                self._ranges = np.asarray(scan.ranges, dtype=np.float32)
+            await self._step(odom)
+
+    async def _step(self, odom: Odometry | None) -> None:
+        stamp = Time.from_seconds(self.clock.now())
+        if odom is None or self.goal is None:
+            await self._publish(stamp, 0.0, 0.0, "idle", math.inf, 0.0, math.inf)
+            return
+        p = odom.pose.pose
+        pose = Pose2D(p.position.x, p.position.y, p.orientation.yaw())
+        command = go_to_goal(pose, self.goal[0], self.goal[1], self.params)
+        closest = math.inf
+        blocked = False
+        if self._scan is not None:
+            blocked, closest = guard_blocked(
+                self._ranges,
+                self._scan.angle_min,
+                self._scan.angle_increment,
+                self.guard,
+                range_min=self._scan.range_min,
+                range_max=self._scan.range_max,
+            )
+        if command.reached:
+            state, v, omega = "reached", 0.0, 0.0
+        elif blocked and command.v > 0:
+            state, v, omega = "blocked", 0.0, 0.0
+        else:
+            state, v, omega = "driving", command.v, command.omega
+        await self._publish(
+            stamp, v, omega, state, command.distance, command.heading_error, closest
+        )
+
+    async def _publish(
+        self,
+        stamp: Time,
+        v: float,
+        omega: float,
+        state: str,
+        distance: float,
+        heading_error: float,
+        closest: float,
+    ) -> None:
+        await self.cmd_vel.publish(
+            Twist.model_construct(
+                linear=Vector3.model_construct(x=v, y=0.0, z=0.0),
+                angular=Vector3.model_construct(x=0.0, y=0.0, z=omega),
+            )
+        )
+        await self.state.publish(
+            NavState.model_construct(
+                header=Header.model_construct(stamp=stamp, frame_id="odom"),
+                state=state,
+                distance_to_goal=distance,
+                heading_error=heading_error,
+                closest_ahead=closest,
+            )
+        )

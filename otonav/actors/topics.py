@@ -1,0 +1,28 @@
+"""The stack's topic names and QoS, in one place (like a ROS 2 interface package)."""
+
+from __future__ import annotations
+
+from otonav.runtime import LATCHED_QOS, SENSOR_DATA_QOS, QoS, Reliability
+
+CLOCK = "/clock"
+ODOM = "/odom"
+IMU = "/imu"
+SCAN = "/scan"
+TF = "/tf"
+TF_STATIC = "/tf_static"
+CMD_VEL = "/cmd_vel"
+WHEEL_CMD = "/wheel_cmd"
+GOAL = "/goal"
+NAV_STATE = "/nav/state"
+ROSOUT = "/rosout"
+
+#: Sensor streams: best-effort, keep a few (a slow reader sees the newest, never stalls physics).
+SENSOR_QOS = SENSOR_DATA_QOS
+#: /clock: best-effort, keep the last one.
+CLOCK_QOS = QoS(Reliability.BEST_EFFORT, depth=1)
+#: Commands and state: reliable.
+COMMAND_QOS = QoS(depth=10)
+#: /tf: reliable with room for a slow recorder, as in ROS 2 (depth 100).
+TF_QOS = QoS(depth=100)
+#: Goals and static transforms: latched (a late subscriber gets the last one).
+LATCHED = LATCHED_QOS

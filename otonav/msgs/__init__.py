@@ -1,0 +1,42 @@
+"""Message types, shaped like the ROS 2 messages they stand for (frozen pydantic)."""
+
+from otonav.msgs._base import Message
+from otonav.msgs.geometry import (
+    Point,
+    Pose,
+    PoseStamped,
+    PoseWithCovariance,
+    Quaternion,
+    Transform,
+    TransformStamped,
+    Twist,
+    TwistWithCovariance,
+    Vector3,
+)
+from otonav.msgs.otonav_msgs import NavState, WheelCommand
+from otonav.msgs.sensors import Imu, LaserScan, Odometry, TFMessage
+from otonav.msgs.std import Clock, Header, Log, Time
+
+__all__ = (
+    "Clock",
+    "Header",
+    "Imu",
+    "LaserScan",
+    "Log",
+    "Message",
+    "NavState",
+    "Odometry",
+    "Point",
+    "Pose",
+    "PoseStamped",
+    "PoseWithCovariance",
+    "Quaternion",
+    "TFMessage",
+    "Time",
+    "Transform",
+    "TransformStamped",
+    "Twist",
+    "TwistWithCovariance",
+    "Vector3",
+    "WheelCommand",
+)

@@ -1,0 +1,31 @@
+"""Messages with no ROS 2 equivalent (package ``otonav_msgs``)."""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+from otonav.msgs._base import Message
+from otonav.msgs.std import Header
+
+
+class WheelCommand(Message):
+    """Wheel angular velocity setpoints, rad/s (base controller -> bridge)."""
+
+    ros_type: ClassVar[str] = "otonav_msgs/msg/WheelCommand"
+    header: Header = Header()
+    left: float = 0.0
+    right: float = 0.0
+
+
+class NavState(Message):
+    """What the navigator is doing: ``idle``, ``driving``, ``blocked`` or ``reached``."""
+
+    ros_type: ClassVar[str] = "otonav_msgs/msg/NavState"
+    header: Header = Header()
+    state: str = "idle"
+    distance_to_goal: float = 0.0
+    """m, from the odometry estimate (inf with no goal)."""
+    heading_error: float = 0.0
+    """rad, wrapped to [-pi, pi]."""
+    closest_ahead: float = 0.0
+    """m, closest valid return in the guard's front sector (inf if none)."""

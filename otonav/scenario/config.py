@@ -1,0 +1,45 @@
+"""A scenario: the world it runs in, the goal, and what counts as passing."""
+
+from __future__ import annotations
+
+from pydantic import BaseModel, ConfigDict, Field, PositiveFloat
+
+from otonav.hal import BoxObstacle
+
+
+class BoxSpec(BaseModel):
+    """An extra box obstacle: centre (m), full size (m), yaw (rad)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+    x: float
+    y: float
+    size_x: PositiveFloat
+    size_y: PositiveFloat
+    yaw: float = 0.0
+
+    def to_obstacle(self) -> BoxObstacle:
+        return BoxObstacle(self.x, self.y, self.size_x / 2, self.size_y / 2, self.yaw)
+
+
+class GoalSpec(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+    x: float
+    y: float
+
+
+class ScenarioConfig(BaseModel):
+    """What to run and how to judge it. Defaults: the acceptance scenario."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+    name: str = "acceptance"
+    scene: str = "obstacles"
+    """Built-in scene name or MJCF path (overrides the stack's ``world.scene``)."""
+    obstacles: tuple[BoxSpec, ...] = ()
+    goal: GoalSpec = GoalSpec(x=4.0, y=1.5)
+    goal_tolerance: PositiveFloat = 0.15
+    """m: reached when the true position is this close to the goal."""
+    sim_budget: PositiveFloat = 20.0
+    """s of sim time to reach the goal."""
+    min_clearance: PositiveFloat = 0.3
+    """m: the robot centre must never come closer than this to an obstacle or wall."""
+    seed: int = Field(0, ge=0)

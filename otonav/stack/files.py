@@ -1,0 +1,57 @@
+"""Reading configuration files: YAML (safe loading only) validated by the pydantic models."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TypeVar
+
+import yaml
+from pydantic import BaseModel, ValidationError
+
+_M = TypeVar("_M", bound=BaseModel)
+
+
+class ConfigFileError(ValueError):
+    """A configuration file that cannot be used: one line naming the file, the key path
+    and what would be valid."""
+
+
+def describe_validation_error(source: str, error: ValidationError) -> str:
+    """One line per problem: ``file: key.path: what is wrong (got value)``."""
+    lines = []
+    for item in error.errors():
+        path = ".".join(str(part) for part in item["loc"]) or "(top level)"
+        message = item["msg"]
+        if item["type"] == "extra_forbidden":
+            message = "unknown key (check the spelling; see the README for valid keys)"
+        got = item.get("input")
+        shown = "" if item["type"] in ("extra_forbidden", "missing") else f" (got {got!r})"
+        lines.append(f"{source}: {path}: {message}{shown}")
+    return "\n".join(lines)
+
+
+def load_model(path: Path, model: type[_M]) -> _M:
+    """Load ``path`` (YAML) as ``model``; raise :class:`ConfigFileError` on any problem."""
+    try:
+        text = path.read_text()
+    except FileNotFoundError:
+        raise ConfigFileError(f"{path}: no such file") from None
+    except OSError as exc:
+        raise ConfigFileError(f"{path}: cannot read ({exc.strerror})") from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(exc, "problem", None) or str(exc)
+        raise ConfigFileError(f"{path}: invalid YAML{where}: {problem}") from None
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise ConfigFileError(
+            f"{path}: expected a mapping of keys at the top level, got {type(data).__name__}"
+        )
+    try:
+        return model.model_validate(data)
+    except ValidationError as exc:
+        raise ConfigFileError(describe_validation_error(str(path), exc)) from None
