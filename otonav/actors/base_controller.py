@@ -62,7 +62,11 @@ class BaseController(Actor):
             latest = self.cmd_vel.take_latest()
             if latest is not None:
                 target, received_at, timed_out = latest, now, False
-            if target is not None and not timed_out and now - received_at > self.cmd_timeout:
+            # received_at is the control tick that picked the command up, up to one
+            # period after it arrived: trip at >= so the stop starts within
+            # cmd_timeout + one period of the last command, never before cmd_timeout.
+            silent = now - received_at
+            if target is not None and not timed_out and silent >= self.cmd_timeout - 1e-9:
                 self.watchdog_trips += 1
                 timed_out = True
             want_v, want_omega = (

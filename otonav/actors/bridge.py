@@ -125,17 +125,22 @@ class Bridge(Actor):
             "scan": self._publish_scan,
         }
         self._last_odom_time = start
+        wheels = self.hal.read_wheels()  # odometry counts motion from the start
+        self._last_wheels = (wheels.left_position, wheels.right_position)
         while True:
             due = {
                 name: start + (counts[name] + 1) * period for name, period in self._periods.items()
             }
             instant = min(due.values())
             await self.clock.sleep_until(instant)
-            stamp = Time.from_seconds(instant)
+            # A period that is not a whole number of ticks wakes at the next tick: stamp
+            # (and integrate) with the instant the data is actually read at.
+            now = self.clock.now()
+            stamp = Time.from_seconds(now)
             for name, when in due.items():
                 if when <= instant + 1e-12:
                     counts[name] += 1
-                    await publishers[name](stamp, instant)
+                    await publishers[name](stamp, now)
 
     async def _publish_clock(self, stamp: Time, _now: float) -> None:
         await self.clock_out.publish(Clock.model_construct(clock=stamp))

@@ -18,7 +18,9 @@ class Navigator(Actor):
     """At ``rate_hz``: drive toward the goal (turn, then drive; P-control) and stop when
     a valid return inside the guard's front sector is closer than its stop distance.
 
-    The goal comes from ``/goal`` (latched) or ``goal=(x, y)``; the newest wins.
+    The goal comes from ``/goal`` (latched) or ``goal=(x, y)``; the newest wins. With no
+    scan yet, or none for ``scan_timeout`` s of sim time, it will not drive forward
+    (the guard fails safe): its state is then ``waiting``.
     Publishes /cmd_vel and /nav/state (idle | driving | blocked | reached).
     """
 
@@ -35,6 +37,7 @@ class Navigator(Actor):
         *,
         rate_hz: float = 20.0,
         goal: tuple[float, float] | None = None,
+        scan_timeout: float = 0.5,
         name: str = "nav",
     ) -> None:
         super().__init__(name)
@@ -44,7 +47,9 @@ class Navigator(Actor):
         self.guard = guard
         self.rate_hz = rate_hz
         self.goal = goal
+        self.scan_timeout = scan_timeout
         self._scan: LaserScan | None = None
+        self._scan_time = -math.inf
         self._ranges: NDArray[np.float32] = np.empty(0, np.float32)
 
     async def run(self) -> None:
@@ -59,6 +64,7 @@ class Navigator(Actor):
             scan = self.scan.take_latest()
             if scan is not None:
                 self._scan = scan
+                self._scan_time = self.clock.now()
                 self._ranges = np.asarray(scan.ranges, dtype=np.float32)
             await self._step(odom)
 
@@ -72,6 +78,8 @@ class Navigator(Actor):
         command = go_to_goal(pose, self.goal[0], self.goal[1], self.params)
         closest = math.inf
         blocked = False
+        # Fail safe: with no scan yet, or none for scan_timeout s, the way ahead is unknown.
+        blind = self._scan is None or self.clock.now() - self._scan_time > self.scan_timeout
         if self._scan is not None:
             blocked, closest = guard_blocked(
                 self._ranges,
@@ -85,6 +93,8 @@ class Navigator(Actor):
             state, v, omega = "reached", 0.0, 0.0
         elif blocked and command.v > 0:
             state, v, omega = "blocked", 0.0, 0.0
+        elif blind and command.v > 0:
+            state, v, omega = "waiting", 0.0, 0.0
         else:
             state, v, omega = "driving", command.v, command.omega
         await self._publish(
