@@ -13,7 +13,7 @@ from otonav.msgs.geometry import (
     TwistWithCovariance,
     Vector3,
 )
-from otonav.msgs.otonav_msgs import NavState, WheelCommand
+from otonav.msgs.otonav_msgs import NavState, ScenarioVerdict, WheelCommand
 from otonav.msgs.sensors import Imu, LaserScan, Odometry, TFMessage
 from otonav.msgs.std import Clock, Header, Log, Time
 
@@ -31,6 +31,7 @@ __all__ = (
     "PoseStamped",
     "PoseWithCovariance",
     "Quaternion",
+    "ScenarioVerdict",
     "TFMessage",
     "Time",
     "Transform",

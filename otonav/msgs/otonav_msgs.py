@@ -18,7 +18,8 @@ class WheelCommand(Message):
 
 
 class NavState(Message):
-    """What the navigator is doing: ``idle``, ``driving``, ``blocked`` or ``reached``."""
+    """What the navigator is doing: ``idle`` (no goal), ``waiting`` (no fresh scan),
+    ``driving``, ``blocked`` (obstacle ahead) or ``reached``."""
 
     ros_type: ClassVar[str] = "otonav_msgs/msg/NavState"
     header: Header = Header()
@@ -29,3 +30,21 @@ class NavState(Message):
     """rad, wrapped to [-pi, pi]."""
     closest_ahead: float = 0.0
     """m, closest valid return in the guard's front sector (inf if none)."""
+
+
+class ScenarioVerdict(Message):
+    """The judged outcome of a scenario (sim-time figures only, so recordings of the
+    same run are byte-identical whatever the machine's speed)."""
+
+    ros_type: ClassVar[str] = "otonav_msgs/msg/ScenarioVerdict"
+    header: Header = Header()
+    scenario: str = ""
+    passed: bool = False
+    reached: bool = False
+    reason: str = ""
+    time_to_goal: float = -1.0
+    """s of sim time; -1 when the goal was not reached."""
+    min_clearance: float = 0.0
+    final_distance: float = 0.0
+    path_length: float = 0.0
+    sim_time: float = 0.0

@@ -20,7 +20,7 @@ from collections.abc import Mapping
 from typing import Any, Generic, TypeVar, overload
 
 from otonav.runtime.clock import Clock
-from otonav.runtime.mailbox import Publisher, Subscription
+from otonav.runtime.mailbox import Bus, Publisher, Subscription
 from otonav.runtime.qos import DEFAULT_QOS, QoS
 
 M = TypeVar("M")
@@ -118,6 +118,10 @@ class Actor:
         if self._otonav_clock is None:
             raise RuntimeError(f"actor '{self.name}' has no clock until its System runs")
         return self._otonav_clock
+
+    def on_wired(self, bus: Bus) -> None:
+        """Called once, synchronously, when the System has wired every actor's ports:
+        for actors that attach to topics dynamically (a recorder)."""
 
     async def on_start(self) -> None:
         """Called once before ``run`` (and again before each restart)."""

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import asyncio
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Generic, NamedTuple, TypeVar
 
@@ -97,6 +98,10 @@ class Subscription(Generic[M]):
         if waiter is not None and not waiter.done():
             waiter.set_result(None)
         return True
+
+    def _full(self) -> bool:
+        """True when a reliable mailbox has no room (``publish_nowait`` must not block)."""
+        return self._reliable and len(self._queue) >= self._depth
 
     async def _wait_for_room(self) -> None:
         waiter = asyncio.get_running_loop().create_future()
@@ -211,7 +216,7 @@ class Publisher(Generic[M]):
         if type(message) is not self.msg_type:
             self._check_type(message)
         for subscription in self._subscriptions:
-            if subscription._reliable and len(subscription._queue) >= subscription._depth:
+            if subscription._full():
                 raise anyio.WouldBlock(f"mailbox {subscription.endpoint} of '{self.topic}' is full")
         self.published += 1
         if self._history is not None:
@@ -237,6 +242,12 @@ class Bus:
 
     def __init__(self) -> None:
         self.topics: dict[str, Topic[Any]] = {}
+        self._topic_listeners: list[Callable[[Topic[Any]], None]] = []
+
+    def add_topic_listener(self, listener: Callable[[Topic[Any]], None]) -> None:
+        """Call ``listener(topic)`` for every topic created from now on (a recorder
+        subscribing to everything, like ``ros2 bag record -a`` discovering topics)."""
+        self._topic_listeners.append(listener)
 
     def _topic(self, name: str, msg_type: type[M], endpoint: Endpoint) -> Topic[M]:
         if not name.startswith("/"):
@@ -245,6 +256,8 @@ class Bus:
         if topic is None:
             topic = Topic(name, msg_type)
             self.topics[name] = topic
+            for listener in self._topic_listeners:
+                listener(topic)
             return topic
         if topic.msg_type is not msg_type:
             ends = [str(p.endpoint) for p in topic.publishers] + [

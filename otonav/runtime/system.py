@@ -17,7 +17,7 @@ import contextlib
 import contextvars
 import logging
 import traceback
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from types import TracebackType
 from typing import Any
@@ -69,6 +69,7 @@ class _ActorState:
     restarts: int = 0
     crash_times: list[float] = field(default_factory=list)
     status: str = "created"
+    scope: anyio.CancelScope | None = None
 
 
 class System:
@@ -86,6 +87,7 @@ class System:
         self._clock = clock
         self._states: dict[str, _ActorState] = {}
         self.events: list[SystemEvent] = []
+        self._event_listeners: list[Callable[[SystemEvent], None]] = []
         self._failure: ActorCrashedError | None = None
         self._tg: TaskGroup | None = None
         self._clock_token: contextvars.Token[Clock] | None = None
@@ -102,6 +104,8 @@ class System:
         for direction in ("out", "in"):
             for state in self._states.values():
                 self._wire(state.actor, direction)
+        for state in self._states.values():
+            state.actor.on_wired(self.bus)
 
     def _wire(self, actor: Actor, direction: str) -> None:
         for port in actor.ports():
@@ -128,6 +132,10 @@ class System:
     ) -> Publisher[Any]:
         """A publisher on ``topic`` for code outside the actors; same checks as ports."""
         return self.bus.publisher(topic, msg_type, qos, endpoint=Endpoint(name, topic))
+
+    def add_event_listener(self, listener: Callable[[SystemEvent], None]) -> None:
+        """Call ``listener(event)`` for every lifecycle event (started, crashed, ...)."""
+        self._event_listeners.append(listener)
 
     @property
     def clock(self) -> Clock:
@@ -158,7 +166,10 @@ class System:
 
     def _event(self, actor: str, kind: str, detail: str = "") -> None:
         now = self._clock.now() if self._clock is not None else 0.0
-        self.events.append(SystemEvent(now, actor, kind, detail))
+        event = SystemEvent(now, actor, kind, detail)
+        self.events.append(event)
+        for listener in self._event_listeners:
+            listener(event)
         log.log(
             logging.ERROR if kind == "crashed" else logging.INFO,
             "[%.3f] %s %s %s",
@@ -168,9 +179,19 @@ class System:
             detail,
         )
 
+    def _give_clocks(self) -> None:
+        # Every actor has its clock before any starts: on_start hooks publish, and a
+        # recorder stamps what it receives with its clock.
+        for state in self._states.values():
+            state.actor._otonav_clock = self.clock
+
     async def _supervise(self, state: _ActorState) -> None:
+        state.scope = anyio.CancelScope()
+        with state.scope:
+            await self._supervise_in_scope(state)
+
+    async def _supervise_in_scope(self, state: _ActorState) -> None:
         actor = state.actor
-        actor._otonav_clock = self.clock
         started = False
         try:
             while True:
@@ -196,8 +217,7 @@ class System:
                     if self._failure is None:
                         self._failure = ActorCrashedError(actor.name, now, text)
                         self._failure.__cause__ = exc
-                    assert self._tg is not None
-                    self._tg.cancel_scope.cancel()
+                    self.stop()
                     return
         finally:
             if started or state.status == "crashed":
@@ -227,6 +247,7 @@ class System:
 
     async def __aenter__(self) -> System:
         self._clock_token = set_current_clock(self.clock)
+        self._give_clocks()
         self._tg = anyio.create_task_group()
         await self._tg.__aenter__()
         for state in self._states.values():
@@ -240,7 +261,7 @@ class System:
         tb: TracebackType | None,
     ) -> bool:
         assert self._tg is not None
-        self._tg.cancel_scope.cancel()
+        self.stop()
         try:
             suppressed = await self._tg.__aexit__(exc_type, exc, tb)
         finally:
@@ -252,13 +273,24 @@ class System:
         return bool(suppressed)
 
     def stop(self) -> None:
-        """Stop every actor (each ``on_stop`` runs); ``run()`` then returns."""
-        if self._tg is not None:
-            self._tg.cancel_scope.cancel()
+        """Stop every actor (each ``on_stop`` runs); ``run()`` then returns.
+
+        Actors are cancelled one by one in reverse start order, like a launch file
+        shutting down, and only then the task group: anyio cancels a group's tasks in
+        set order (memory addresses), which made two identical runs log their stops
+        in different orders.
+        """
+        if self._tg is None:
+            return
+        for state in reversed(self._states.values()):
+            if state.scope is not None:
+                state.scope.cancel()
+        self._tg.cancel_scope.cancel()
 
     async def run(self) -> None:
         """Run until every actor's ``run`` returned, :meth:`stop` is called, or a crash."""
         token = set_current_clock(self.clock)
+        self._give_clocks()
         self._tg = anyio.create_task_group()
         try:
             async with self._tg:

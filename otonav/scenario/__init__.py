@@ -2,7 +2,7 @@
 
 from otonav.scenario.config import BoxSpec, GoalSpec, ScenarioConfig
 from otonav.scenario.judge import Judge
-from otonav.scenario.run import Verdict, run_scenario, run_stack_scenario
+from otonav.scenario.run import Verdict, drive_to_goal, run_scenario
 
 __all__ = (
     "BoxSpec",
@@ -10,6 +10,6 @@ __all__ = (
     "Judge",
     "ScenarioConfig",
     "Verdict",
+    "drive_to_goal",
     "run_scenario",
-    "run_stack_scenario",
 )

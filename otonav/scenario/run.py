@@ -1,20 +1,32 @@
-"""Run a scenario on a virtual-time loop driven by the physics world, and judge it."""
+"""Run a scenario on a virtual-time loop driven by the physics world, judge it, and
+leave its artifacts: the recording (always finished, whatever ends the run), the
+trajectory plot."""
 
 from __future__ import annotations
 
 import asyncio
 import contextlib
+import json
 import math
+import signal
+import threading
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
 
 from otonav.actors import topics
+from otonav.actors.recorder import Recorder
 from otonav.hal import RobotHardwareInterface
-from otonav.msgs import Header, Point, Pose, PoseStamped, Time
-from otonav.runtime import LATCHED_QOS, SimTimeoutError, System, until, virtual_loop_factory
+from otonav.msgs import Header, Point, Pose, PoseStamped, ScenarioVerdict, Time
+from otonav.record.writer import RecordingWriter
+from otonav.runtime import LATCHED_QOS, Actor, SimTimeoutError, System, until, virtual_loop_factory
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
+from otonav.scenario.plot import plot_trajectory
 from otonav.stack import StackConfig, build_actors, build_world
+from otonav.stack.rosout import attach_rosout
+
+VERDICT_TOPIC = "/scenario/verdict"
 
 
 @dataclass(frozen=True, slots=True)
@@ -32,18 +44,32 @@ class Verdict:
     sim_time_s: float
     wall_time_s: float
     rtf: float
+    recording: str | None = None
+    plot: str | None = None
 
     def as_dict(self) -> dict[str, object]:
         return asdict(self)
 
 
-async def run_stack_scenario(
-    scenario: ScenarioConfig, stack: StackConfig, hal: RobotHardwareInterface
-) -> tuple[Judge, System]:
-    """Bring the stack up on ``hal``, publish the goal, wait (in sim time) until the
-    robot reaches it or the budget runs out. Returns the judge and the stopped system."""
-    judge = Judge(hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance)
-    system = System([*build_actors(stack, hal), judge])
+def effective_stack(scenario: ScenarioConfig, stack: StackConfig) -> StackConfig:
+    """The stack config with the scenario's scene."""
+    world = stack.world.model_copy(update={"scene": scenario.scene})
+    return stack.model_copy(update={"world": world})
+
+
+async def drive_to_goal(
+    scenario: ScenarioConfig,
+    stack: StackConfig,
+    hal: RobotHardwareInterface,
+    judge: Judge,
+    *,
+    before: tuple[Actor, ...] = (),
+) -> System:
+    """Bring the stack up on ``hal`` (after the ``before`` actors, e.g. a recorder),
+    publish the goal on /goal, and wait in sim time until the judge says the robot is
+    there or the budget is spent. Returns the stopped system."""
+    system = System([*before, *build_actors(stack, hal), judge])
+    attach_rosout(system)
     async with system:
         goal = system.publisher(topics.GOAL, PoseStamped, LATCHED_QOS, name="scenario")
         await goal.publish(
@@ -52,6 +78,7 @@ async def run_stack_scenario(
                 pose=Pose(position=Point(x=scenario.goal.x, y=scenario.goal.y)),
             )
         )
+        # Running out of budget is a verdict (judged below), not an error.
         with contextlib.suppress(SimTimeoutError):
             await until(
                 lambda: judge.reached,
@@ -59,31 +86,129 @@ async def run_stack_scenario(
                 observe=lambda: f"{judge.distance:.3f} m from the goal",
                 what=f"reaching the goal within {scenario.goal_tolerance} m",
             )
-    return judge, system
+    return system
+
+
+async def _main(
+    scenario: ScenarioConfig,
+    stack: StackConfig,
+    hal: RobotHardwareInterface,
+    judge: Judge,
+    before: tuple[Actor, ...],
+) -> None:
+    # SIGTERM ends the run like Ctrl-C does (asyncio.Runner handles SIGINT): by
+    # cancellation, so every finally runs and the recording is finished.
+    loop = asyncio.get_running_loop()
+    task = asyncio.current_task()
+    in_main_thread = threading.current_thread() is threading.main_thread()
+    if in_main_thread and task is not None:
+        loop.add_signal_handler(signal.SIGTERM, task.cancel)
+    try:
+        await drive_to_goal(scenario, stack, hal, judge, before=before)
+    finally:
+        if in_main_thread:
+            loop.remove_signal_handler(signal.SIGTERM)
 
 
 def run_scenario(
     scenario: ScenarioConfig = ScenarioConfig(),
     stack: StackConfig = StackConfig(),
     *,
+    out_dir: Path | None = None,
+    record: bool = True,
+    plot: bool = True,
     wall_ceiling: float | None = 300.0,
+    extra_actors: tuple[Actor, ...] = (),
 ) -> Verdict:
-    """Run ``scenario`` headless in virtual time and judge it."""
-    stack = stack.model_copy(
-        update={"world": stack.world.model_copy(update={"scene": scenario.scene})}
-    )
+    """Run ``scenario`` headless in virtual time and judge it. With ``out_dir``, leave
+    ``recording.mcap`` (unless ``record=False``) and ``trajectory.png`` there. The
+    recording is finished on every exit path (an exception, Ctrl-C, SIGTERM).
+    ``extra_actors`` join the system (monitors, fault injectors)."""
+    stack = effective_stack(scenario, stack)
     hal = build_world(stack, extra_obstacles=[b.to_obstacle() for b in scenario.obstacles])
+    judge = Judge(hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance)
+    writer = RecordingWriter(out_dir / "recording.mcap") if out_dir and record else None
+    recorder = Recorder(writer) if writer else None
     wall_start = time.perf_counter()
+    sim_time = 0.0
+    ended = "completed"
     try:
-        with asyncio.Runner(
-            loop_factory=virtual_loop_factory(hal, wall_ceiling=wall_ceiling)
-        ) as runner:
-            judge, _system = runner.run(run_stack_scenario(scenario, stack, hal))
-            sim_time = runner.get_loop().time()
+        factory = virtual_loop_factory(hal, wall_ceiling=wall_ceiling)
+        with asyncio.Runner(loop_factory=factory) as runner:
+            try:
+                before = ((recorder,) if recorder else ()) + tuple(extra_actors)
+                runner.run(_main(scenario, stack, hal, judge, before))
+            finally:
+                sim_time = runner.get_loop().time()
+    except BaseException as exc:
+        ended = f"{type(exc).__name__} at sim time {sim_time:.3f} s: {exc}".strip().rstrip(":")
+        raise
     finally:
+        verdict = judge_verdict(scenario, judge, sim_time, time.perf_counter() - wall_start)
+        if ended != "completed":
+            verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
+        if writer is not None:
+            _close_recording(writer, recorder, scenario, stack, verdict)
+            verdict = replace(verdict, recording=str(writer.path))
         hal.close()
-    wall = time.perf_counter() - wall_start
-    return judge_verdict(scenario, judge, sim_time, wall)
+        if out_dir is not None and plot:
+            png = plot_trajectory(
+                out_dir / "trajectory.png",
+                judge.trajectory,
+                judge.boxes,
+                (scenario.goal.x, scenario.goal.y),
+                scenario.goal_tolerance,
+                judge.min_clearance_at,
+                f"{scenario.name}: {'PASSED' if verdict.passed else 'FAILED'}",
+            )
+            verdict = replace(verdict, plot=str(png))
+    return verdict
+
+
+def _close_recording(
+    writer: RecordingWriter,
+    recorder: Recorder | None,
+    scenario: ScenarioConfig,
+    stack: StackConfig,
+    verdict: Verdict,
+) -> None:
+    """Append the verdict (a message and a metadata record) and finish the file."""
+    try:
+        if recorder is not None and recorder._funnel is not None:
+            recorder.drain()
+        writer.write(
+            VERDICT_TOPIC,
+            ScenarioVerdict(
+                header=Header(stamp=Time.from_seconds(verdict.sim_time_s)),
+                scenario=verdict.scenario,
+                passed=verdict.passed,
+                reached=verdict.reached,
+                reason=verdict.reason,
+                time_to_goal=verdict.time_to_goal_s if verdict.time_to_goal_s is not None else -1.0,
+                min_clearance=verdict.min_clearance_m,
+                final_distance=verdict.final_distance_m,
+                path_length=verdict.path_length_m,
+                sim_time=verdict.sim_time_s,
+            ),
+            verdict.sim_time_s,
+        )
+        figures = {
+            k: v
+            for k, v in verdict.as_dict().items()
+            if k not in ("wall_time_s", "rtf", "recording", "plot")
+        }
+        writer.add_metadata(
+            "otonav",
+            {
+                "scenario": scenario.name,
+                "seed": str(scenario.seed),
+                "scenario_config": scenario.model_dump_json(),
+                "stack_config": stack.model_dump_json(),
+                "verdict": json.dumps(figures, sort_keys=True, default=str),
+            },
+        )
+    finally:
+        writer.finish()
 
 
 def judge_verdict(scenario: ScenarioConfig, judge: Judge, sim_time: float, wall: float) -> Verdict:

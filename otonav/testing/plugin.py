@@ -1,23 +1,43 @@
-"""The otonav pytest plugin.
+"""The otonav pytest plugin (entry point ``otonav``).
 
-``@pytest.mark.sim`` on an async test (pytest-asyncio) runs it, and its async fixtures of
-the same loop scope, on a fresh :class:`~otonav.runtime.VirtualTimeLoop`: ``anyio.sleep``,
-``asyncio.timeout`` and ``until(...)`` are sim time. Options of the marker:
-``wall_ceiling`` (seconds; default 60) and ``deadlock_grace`` (seconds; default 0.5).
-Tests without the marker keep pytest-asyncio's ordinary loop.
+- ``@pytest.mark.sim`` runs an async test (and its async fixtures of the same loop
+  scope) on a fresh :class:`~otonav.runtime.VirtualTimeLoop`: ``anyio.sleep``,
+  ``asyncio.timeout`` and ``until(...)`` are sim time. Marker options: ``wall_ceiling``
+  (s, default 60) and ``deadlock_grace`` (s, default 0.5). Unmarked tests keep
+  pytest-asyncio's ordinary loop.
+- ``otonav_artifacts``: a directory for this test's artifacts (recordings, plots). When
+  the test fails they are kept under ``--otonav-artifacts`` (default
+  ``out/test-artifacts``), a trajectory plot is drawn for each recording, and the
+  failure report names the paths. When it passes they are deleted.
 """
 
 from __future__ import annotations
 
 import asyncio
 import inspect
-from collections.abc import Callable, Mapping
+import re
+import shutil
+from collections.abc import Callable, Generator, Mapping
+from pathlib import Path
 
 import pytest
 
 from otonav.runtime.loop import virtual_loop_factory
 
 DEFAULT_WALL_CEILING = 60.0
+DEFAULT_ARTIFACTS = "out/test-artifacts"
+_DIR_KEY = pytest.StashKey[Path]()
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    group = parser.getgroup("otonav")
+    group.addoption(
+        "--otonav-artifacts",
+        default=None,
+        metavar="DIR",
+        help=f"where failing scenario tests keep their recordings (default {DEFAULT_ARTIFACTS})",
+    )
+    parser.addini("otonav_artifacts", "default for --otonav-artifacts", default=DEFAULT_ARTIFACTS)
 
 
 def pytest_configure(config: pytest.Config) -> None:
@@ -50,3 +70,49 @@ def pytest_asyncio_loop_factories(
             deadlock_grace=marker.kwargs.get("deadlock_grace", 0.5),
         )
     }
+
+
+def _artifacts_root(config: pytest.Config) -> Path:
+    option = config.getoption("--otonav-artifacts")
+    root = Path(option if option else str(config.getini("otonav_artifacts")))
+    return root if root.is_absolute() else Path(config.rootpath) / root
+
+
+@pytest.fixture
+def otonav_artifacts(request: pytest.FixtureRequest) -> Path:
+    """This test's artifact directory (kept only if the test fails)."""
+    name = re.sub(r"[^A-Za-z0-9_.-]+", "_", request.node.nodeid).strip("_")
+    path = _artifacts_root(request.config) / name
+    if path.exists():
+        shutil.rmtree(path)
+    path.mkdir(parents=True)
+    request.node.stash[_DIR_KEY] = path
+    return path
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(
+    item: pytest.Item, call: pytest.CallInfo[None]
+) -> Generator[None, pytest.TestReport, None]:
+    outcome = yield
+    report: pytest.TestReport = outcome.get_result()
+    path = item.stash.get(_DIR_KEY, None)
+    if path is None or report.when != "call":
+        return
+    if report.failed:
+        lines = []
+        for recording in sorted(path.rglob("*.mcap")):
+            lines.append(f"recording: {recording}")
+            png = recording.parent / "trajectory.png"
+            if not png.exists():
+                try:
+                    from otonav.scenario.replay import plot_recording
+
+                    png = plot_recording(recording, png)
+                except Exception as exc:  # the report must still name the recording
+                    lines.append(f"(no trajectory plot: {exc})")
+                    continue
+            lines.append(f"trajectory: {png}")
+        report.sections.append(("otonav artifacts", "\n".join(lines) or f"(none in {path})"))
+    else:
+        shutil.rmtree(path, ignore_errors=True)

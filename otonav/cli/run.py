@@ -1,0 +1,106 @@
+"""``otonav run``: run a scenario headless in virtual time, print the verdict."""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from rich.console import Console
+from rich.table import Table
+
+from otonav.scenario import ScenarioConfig, Verdict, run_scenario
+from otonav.scenario.builtin import BUILTIN
+from otonav.stack import StackConfig
+from otonav.stack.files import ConfigFileError, load_model
+from otonav.stack.overrides import apply_overrides
+
+DEFAULT_OUT = Path("out")
+
+
+def add_parser(commands: Any) -> None:
+    p = commands.add_parser("run", help="run a scenario (default: acceptance) headless")
+    p.add_argument("--scenario", default="acceptance", help="built-in name or YAML path")
+    p.add_argument("--config", type=Path, help="stack config YAML (default: built-in)")
+    p.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY.PATH=VALUE",
+        help="override a stack config key, e.g. --set nav.kp_lin=0 (repeatable)",
+    )
+    p.add_argument("--seed", type=int, help="override the scenario's seed")
+    p.add_argument(
+        "--out", type=Path, default=DEFAULT_OUT, help="artifact directory (default: out)"
+    )
+    p.add_argument("--no-record", action="store_true", help="do not write recording.mcap")
+    p.set_defaults(handler=main)
+
+
+def load_scenario(spec: str) -> ScenarioConfig:
+    if spec in BUILTIN:
+        return BUILTIN[spec]
+    path = Path(spec)
+    if path.suffix in (".yaml", ".yml") or path.exists():
+        return load_model(path, ScenarioConfig)
+    raise ConfigFileError(
+        f"--scenario {spec!r}: not a built-in scenario ({', '.join(BUILTIN)}) nor a YAML file"
+    )
+
+
+def load_stack(config: Path | None, overrides: list[str]) -> StackConfig:
+    stack = load_model(config, StackConfig) if config is not None else StackConfig()
+    return apply_overrides(stack, overrides) if overrides else stack
+
+
+def summary_dict(verdict: Verdict) -> dict[str, Any]:
+    return verdict.as_dict()
+
+
+def print_verdict(verdict: Verdict, console: Console) -> None:
+    table = Table(
+        title=f"scenario {verdict.scenario}: " + ("PASSED" if verdict.passed else "FAILED")
+    )
+    table.add_column("figure")
+    table.add_column("value", justify="right")
+    ttg = f"{verdict.time_to_goal_s:.2f} s" if verdict.time_to_goal_s is not None else "-"
+    for key, value in (
+        ("reached", "yes" if verdict.reached else "no"),
+        ("time to goal", ttg),
+        ("min clearance", f"{verdict.min_clearance_m:.3f} m"),
+        ("final distance", f"{verdict.final_distance_m:.3f} m"),
+        ("path length", f"{verdict.path_length_m:.2f} m"),
+        ("sim time", f"{verdict.sim_time_s:.2f} s"),
+        ("wall time", f"{verdict.wall_time_s:.3f} s"),
+        ("real-time factor", f"{verdict.rtf:.0f}x"),
+    ):
+        table.add_row(key, value)
+    console.print(table)
+    console.print(f"why: {verdict.reason}")
+    for label, path in (("recording", verdict.recording), ("plot", verdict.plot)):
+        if path:
+            console.print(f"{label}: {path}")
+
+
+def main(args: argparse.Namespace) -> int:
+    scenario = load_scenario(args.scenario)
+    if args.seed is not None:
+        scenario = scenario.model_copy(update={"seed": args.seed})
+    stack = load_stack(args.config, args.overrides)
+    out: Path = args.out
+    try:
+        verdict = run_scenario(scenario, stack, out_dir=out, record=not args.no_record)
+    except asyncio.CancelledError:
+        print("otonav: terminated; the recording was finished and is readable", file=sys.stderr)
+        return 143
+    out.mkdir(parents=True, exist_ok=True)
+    summary = out / "summary.json"
+    summary.write_text(json.dumps(summary_dict(verdict), indent=2, default=str) + "\n")
+    console = Console(highlight=False)
+    print_verdict(verdict, console)
+    console.print(f"summary: {summary}")
+    return 0 if verdict.passed else 1

@@ -1,0 +1,1 @@
+"""Recording: MCAP (ROS 2 CDR) writing, reading, info and salvage."""

@@ -1,0 +1,180 @@
+"""Reading recordings back: a summary (like ``ros2 bag info``), decoded messages of a
+topic in a time range, and the cut-off case (no footer: the process was killed)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from mcap.exceptions import McapError
+from mcap.reader import NonSeekingReader, make_reader
+from mcap_ros2.decoder import DecoderFactory
+
+MAGIC = b"\x89MCAP0\r\n"
+
+
+class RecordingError(ValueError):
+    """A file that is not a readable recording: one line naming it and why."""
+
+
+@dataclass(slots=True)
+class TopicSummary:
+    topic: str
+    type: str
+    count: int
+    first_ns: int | None = None
+    last_ns: int | None = None
+
+    @property
+    def rate_hz(self) -> float:
+        if self.count < 2 or self.first_ns is None or self.last_ns is None:
+            return 0.0
+        span = (self.last_ns - self.first_ns) / 1e9
+        return (self.count - 1) / span if span > 0 else 0.0
+
+
+@dataclass(slots=True)
+class RecordingSummary:
+    path: Path
+    size_bytes: int
+    profile: str
+    library: str
+    start_ns: int
+    end_ns: int
+    topics: list[TopicSummary]
+    metadata: dict[str, dict[str, str]] = field(default_factory=dict)
+    truncated: bool = False
+    """True when the file has no footer/index (cut off); figures come from its complete chunks."""
+
+    @property
+    def duration_s(self) -> float:
+        return max(0, self.end_ns - self.start_ns) / 1e9
+
+    @property
+    def message_count(self) -> int:
+        return sum(t.count for t in self.topics)
+
+
+def _check_file(path: Path) -> None:
+    if not path.exists():
+        raise RecordingError(f"{path}: no such file")
+    if path.is_dir():
+        raise RecordingError(f"{path}: is a directory, not an MCAP file")
+    with path.open("rb") as f:
+        head = f.read(len(MAGIC))
+    if head != MAGIC:
+        raise RecordingError(f"{path}: not an MCAP file (it does not start with the MCAP magic)")
+
+
+def summarize(path: str | Path) -> RecordingSummary:
+    """Topics, types, counts, rates and duration; falls back to a streaming scan of the
+    complete chunks when the file was cut off (``truncated=True``)."""
+    path = Path(path)
+    _check_file(path)
+    size = path.stat().st_size
+    with path.open("rb") as f:
+        try:
+            reader = make_reader(f)
+            header = reader.get_header()
+            summary = reader.get_summary()
+            if summary is None or summary.statistics is None:
+                raise McapError("no summary section")
+            stats = summary.statistics
+            topics = [
+                TopicSummary(
+                    ch.topic,
+                    summary.schemas[ch.schema_id].name if ch.schema_id in summary.schemas else "?",
+                    stats.channel_message_counts.get(ch.id, 0),
+                )
+                for ch in summary.channels.values()
+            ]
+            by_topic = {t.topic: t for t in topics}
+            # First/last time per topic for the rate: from the chunk message indexes.
+            for _schema, channel, message in reader.iter_messages(log_time_order=False):
+                t = by_topic[channel.topic]
+                if t.first_ns is None or message.log_time < t.first_ns:
+                    t.first_ns = message.log_time
+                if t.last_ns is None or message.log_time > t.last_ns:
+                    t.last_ns = message.log_time
+            metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
+            return RecordingSummary(
+                path,
+                size,
+                header.profile,
+                header.library,
+                stats.message_start_time,
+                stats.message_end_time,
+                sorted(topics, key=lambda t: t.topic),
+                metadata,
+            )
+        except (McapError, EOFError, ValueError, KeyError, AssertionError):
+            pass
+    return _scan_truncated(path, size)
+
+
+def _scan_truncated(path: Path, size: int) -> RecordingSummary:
+    topics: dict[str, TopicSummary] = {}
+    profile = library = ""
+    start = end = 0
+    with path.open("rb") as f:
+        try:
+            header = NonSeekingReader(f).get_header()
+            profile, library = header.profile, header.library
+        except (McapError, EOFError, ValueError, KeyError, AssertionError):
+            pass
+    with path.open("rb") as f:
+        reader = NonSeekingReader(f)
+        try:
+            for schema, channel, message in reader.iter_messages(log_time_order=False):
+                t = topics.get(channel.topic)
+                if t is None:
+                    t = topics[channel.topic] = TopicSummary(
+                        channel.topic, schema.name if schema else "?", 0
+                    )
+                t.count += 1
+                t.first_ns = (
+                    message.log_time if t.first_ns is None else min(t.first_ns, message.log_time)
+                )
+                t.last_ns = (
+                    message.log_time if t.last_ns is None else max(t.last_ns, message.log_time)
+                )
+        except (McapError, EOFError, ValueError, KeyError, AssertionError):
+            pass  # the cut: everything before it has been counted
+    firsts = [t.first_ns for t in topics.values() if t.first_ns is not None]
+    lasts = [t.last_ns for t in topics.values() if t.last_ns is not None]
+    if firsts:
+        start, end = min(firsts), max(lasts)
+    return RecordingSummary(
+        path,
+        size,
+        profile,
+        library,
+        start,
+        end,
+        sorted(topics.values(), key=lambda t: t.topic),
+        {},
+        truncated=True,
+    )
+
+
+def read_messages(
+    path: str | Path,
+    topics: Sequence[str] | None = None,
+    *,
+    start: float | None = None,
+    end: float | None = None,
+) -> Iterator[tuple[str, float, Any]]:
+    """Yield ``(topic, sim_time_s, decoded_message)`` in log-time order, for ``topics``
+    (all when None) with ``start <= t < end`` (seconds of sim time)."""
+    path = Path(path)
+    _check_file(path)
+    with path.open("rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        for _schema, channel, message, decoded in reader.iter_decoded_messages(
+            topics=list(topics) if topics is not None else None,
+            starting_at=None if start is None else round(start * 1e9),
+            ending_before=None if end is None else round(end * 1e9),
+        ):
+            yield channel.topic, message.log_time / 1e9, decoded

@@ -1,0 +1,110 @@
+"""Writing one MCAP file: profile ``ros2``, ``ros2msg`` schemas, CDR payloads, sim-time
+stamps. Crash-safe by construction (notes/recording.md):
+
+- chunks of 64 KiB (a 1 MiB chunk held the longest ``add_message`` pause at 8.4 ms vs
+  0.9 ms, and a kill loses at most one chunk);
+- the file is flushed whenever a chunk (or the header) has been written, so each
+  finished chunk is in the OS at once (with a 1 MiB buffered file a SIGKILL left an
+  empty file: even the header was held). An unbuffered file is not an option: mcap's
+  writer produced a file with no valid footer on one (measured here);
+- ``finish()`` (footer + index) runs on every exit path: the owner calls it in ``finally``
+  and the CLI turns SIGINT/SIGTERM into cancellation. What a SIGKILL leaves, ``salvage``
+  rewrites as an indexed file.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from types import TracebackType
+from typing import IO
+
+from mcap.writer import CompressionType, Writer
+
+from otonav.msgs import Message
+from otonav.record.cdr import encode
+from otonav.record.schemas import schema_for
+
+CHUNK_SIZE = 64 * 1024
+
+
+def _library() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return f"otonav {version('otonav')}"
+    except PackageNotFoundError:  # running from a source tree without installing
+        return "otonav"
+
+
+class RecordingWriter:
+    """Append messages of any otonav type on any topic; channels appear on first use."""
+
+    def __init__(self, path: str | Path, *, chunk_size: int = CHUNK_SIZE) -> None:
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._file: IO[bytes] = open(self.path, "wb")  # noqa: SIM115 - closed in finish()
+        self._writer = Writer(self._file, chunk_size=chunk_size, compression=CompressionType.ZSTD)
+        self._writer.start(profile="ros2", library=_library())
+        self._file.flush()
+        self._flushed_at = self._file.tell()
+        self._schemas: dict[type[Message], int] = {}
+        self._channels: dict[str, int] = {}
+        self._sequence: dict[int, int] = {}
+        self.messages = 0
+        self.finished = False
+
+    def _channel(self, topic: str, kind: type[Message]) -> int:
+        schema_id = self._schemas.get(kind)
+        if schema_id is None:
+            name, definition = schema_for(kind)
+            schema_id = self._writer.register_schema(name, "ros2msg", definition.encode())
+            self._schemas[kind] = schema_id
+        channel_id = self._writer.register_channel(topic, "cdr", schema_id)
+        self._channels[topic] = channel_id
+        self._sequence[channel_id] = 0
+        return channel_id
+
+    def write(self, topic: str, message: Message, sim_time: float) -> None:
+        """Record ``message`` on ``topic`` at ``sim_time`` seconds (log and publish time)."""
+        channel_id = self._channels.get(topic)
+        if channel_id is None:
+            channel_id = self._channel(topic, type(message))
+        stamp = round(sim_time * 1e9)
+        self._sequence[channel_id] += 1
+        self._writer.add_message(
+            channel_id,
+            log_time=stamp,
+            data=encode(message),
+            publish_time=stamp,
+            sequence=self._sequence[channel_id],
+        )
+        self.messages += 1
+        # Messages accumulate in memory until a chunk is full; the file grows only when
+        # a chunk was written, and then it goes to the OS at once.
+        if self._file.tell() != self._flushed_at:
+            self._file.flush()
+            self._flushed_at = self._file.tell()
+
+    def add_metadata(self, name: str, data: dict[str, str]) -> None:
+        self._writer.add_metadata(name, data)
+
+    def finish(self) -> None:
+        """Write the footer and index and close the file; safe to call twice."""
+        if self.finished:
+            return
+        self.finished = True
+        try:
+            self._writer.finish()  # type: ignore[no-untyped-call]
+        finally:
+            self._file.close()
+
+    def __enter__(self) -> RecordingWriter:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.finish()

@@ -1,0 +1,38 @@
+"""/rosout: the system's lifecycle events (started, crashed, restarted, stopped) as
+``rcl_interfaces/msg/Log`` lines, so a recording carries them next to the data."""
+
+from __future__ import annotations
+
+import contextlib
+
+import anyio
+
+from otonav.actors import topics
+from otonav.msgs import Log, Time
+from otonav.runtime import QoS, System, SystemEvent
+
+#: As in ROS 2: reliable, keep the last 1000.
+ROSOUT_QOS = QoS(depth=1000)
+
+_LEVELS = {"crashed": Log.ERROR, "restarted": Log.WARN}
+
+
+def attach_rosout(system: System) -> None:
+    """Publish every event of ``system`` on /rosout (dropped, not blocking, when full)."""
+    publisher = system.publisher(topics.ROSOUT, Log, ROSOUT_QOS, name="rosout")
+
+    def publish(event: SystemEvent) -> None:
+        text = event.kind if not event.detail else f"{event.kind}: {event.detail}"
+        message = Log.model_construct(
+            stamp=Time.from_seconds(event.sim_time),
+            level=_LEVELS.get(event.kind, Log.INFO),
+            name=event.actor,
+            msg=text,
+            file="",
+            function="",
+            line=0,
+        )
+        with contextlib.suppress(anyio.WouldBlock):
+            publisher.publish_nowait(message)
+
+    system.add_event_listener(publish)

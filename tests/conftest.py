@@ -1,0 +1,3 @@
+"""Test-suite configuration: pytester for testing the otonav pytest plugin itself."""
+
+pytest_plugins = ["pytester"]
