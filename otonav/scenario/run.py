@@ -11,6 +11,7 @@ import math
 import signal
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
@@ -95,11 +96,14 @@ async def _main(
     hal: RobotHardwareInterface,
     judge: Judge,
     before: tuple[Actor, ...],
+    on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None,
 ) -> None:
     # SIGTERM ends the run like Ctrl-C does (asyncio.Runner handles SIGINT): by
     # cancellation, so every finally runs and the recording is finished.
     loop = asyncio.get_running_loop()
     task = asyncio.current_task()
+    if on_start is not None and task is not None:
+        on_start(loop, task)  # type: ignore[arg-type]
     in_main_thread = threading.current_thread() is threading.main_thread()
     if in_main_thread and task is not None:
         loop.add_signal_handler(signal.SIGTERM, task.cancel)
@@ -119,11 +123,14 @@ def run_scenario(
     plot: bool = True,
     wall_ceiling: float | None = 300.0,
     extra_actors: tuple[Actor, ...] = (),
+    on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
 ) -> Verdict:
     """Run ``scenario`` headless in virtual time and judge it. With ``out_dir``, leave
     ``recording.mcap`` (unless ``record=False``) and ``trajectory.png`` there. The
     recording is finished on every exit path (an exception, Ctrl-C, SIGTERM).
-    ``extra_actors`` join the system (monitors, fault injectors)."""
+    ``extra_actors`` join the system (monitors, fault injectors). ``on_start(loop,
+    task)`` is called on the run's loop as it starts: a host running this in a worker
+    thread cancels the run with ``loop.call_soon_threadsafe(task.cancel)``."""
     stack = effective_stack(scenario, stack)
     hal = build_world(stack, extra_obstacles=[b.to_obstacle() for b in scenario.obstacles])
     judge = Judge(hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance)
@@ -137,7 +144,7 @@ def run_scenario(
         with asyncio.Runner(loop_factory=factory) as runner:
             try:
                 before = ((recorder,) if recorder else ()) + tuple(extra_actors)
-                runner.run(_main(scenario, stack, hal, judge, before))
+                runner.run(_main(scenario, stack, hal, judge, before, on_start))
             finally:
                 sim_time = runner.get_loop().time()
     except BaseException as exc:
