@@ -103,7 +103,7 @@ async def _main(
     loop = asyncio.get_running_loop()
     task = asyncio.current_task()
     if on_start is not None and task is not None:
-        on_start(loop, task)  # type: ignore[arg-type]
+        on_start(loop, task)
     in_main_thread = threading.current_thread() is threading.main_thread()
     if in_main_thread and task is not None:
         loop.add_signal_handler(signal.SIGTERM, task.cancel)
