@@ -10,7 +10,7 @@ import argparse
 import sys
 from collections.abc import Sequence
 
-from otonav.cli import info, run
+from otonav.cli import info, inspect, run
 from otonav.hal.mujoco import SceneError
 from otonav.record.reader import RecordingError
 from otonav.stack.files import ConfigFileError
@@ -30,6 +30,7 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", parser_class=_Parser)
     run.add_parser(commands)
     info.add_parsers(commands)
+    inspect.add_parsers(commands)
     return parser
 
 

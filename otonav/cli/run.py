@@ -12,6 +12,7 @@ from typing import Any
 from rich.console import Console
 from rich.table import Table
 
+from otonav.cli.progress import ProgressLine
 from otonav.scenario import ScenarioConfig, Verdict, run_scenario
 from otonav.scenario.builtin import BUILTIN
 from otonav.stack import StackConfig
@@ -92,8 +93,17 @@ def main(args: argparse.Namespace) -> int:
         scenario = scenario.model_copy(update={"seed": args.seed})
     stack = load_stack(args.config, args.overrides)
     out: Path = args.out
+    source = args.scenario if args.scenario not in BUILTIN else f"scenario '{args.scenario}'"
+    extra = (ProgressLine(),) if sys.stderr.isatty() else ()
     try:
-        verdict = run_scenario(scenario, stack, out_dir=out, record=not args.no_record)
+        verdict = run_scenario(
+            scenario,
+            stack,
+            out_dir=out,
+            record=not args.no_record,
+            extra_actors=extra,
+            source=source,
+        )
     except asyncio.CancelledError:
         print("otonav: terminated; the recording was finished and is readable", file=sys.stderr)
         return 143

@@ -68,6 +68,11 @@ _OBSTACLE_HEIGHT: Final = 0.5  # m, height of boxes added through extra_obstacle
 _SETTLE_TIME: Final = 0.25  # s of physics run at construction, before tick 0
 
 
+def _one_line(exc: BaseException) -> str:
+    """MuJoCo's messages span lines (``Element 'geom', line 1``): one line for users."""
+    return " ".join(str(exc).split())
+
+
 class SceneError(ValueError):
     """An MJCF scene that cannot be found, parsed, compiled or used as an otonav world."""
 
@@ -126,7 +131,7 @@ def _load_spec(scene: str | os.PathLike[str]) -> tuple[Any, str]:
         try:
             spec = mujoco.MjSpec.from_file(str(path))
         except ValueError as exc:
-            raise SceneError(f"MJCF file {label} does not parse: {exc}") from exc
+            raise SceneError(f"MJCF file {label} does not parse: {_one_line(exc)}") from exc
     return spec, label
 
 
@@ -134,7 +139,7 @@ def _compile(spec: Any, label: str) -> Any:
     try:
         return spec.compile()
     except ValueError as exc:
-        raise SceneError(f"MJCF file {label} does not compile: {exc}") from exc
+        raise SceneError(f"MJCF file {label} does not compile: {_one_line(exc)}") from exc
 
 
 def compile_scene(path_or_name: str | os.PathLike[str]) -> None:

@@ -24,6 +24,7 @@ from otonav.runtime import LATCHED_QOS, Actor, SimTimeoutError, System, until, v
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
 from otonav.scenario.plot import plot_trajectory
+from otonav.scenario.validate import check_goal
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.rosout import attach_rosout
 
@@ -124,15 +125,22 @@ def run_scenario(
     wall_ceiling: float | None = 300.0,
     extra_actors: tuple[Actor, ...] = (),
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
+    source: str = "scenario",
 ) -> Verdict:
     """Run ``scenario`` headless in virtual time and judge it. With ``out_dir``, leave
     ``recording.mcap`` (unless ``record=False``) and ``trajectory.png`` there. The
     recording is finished on every exit path (an exception, Ctrl-C, SIGTERM).
     ``extra_actors`` join the system (monitors, fault injectors). ``on_start(loop,
     task)`` is called on the run's loop as it starts: a host running this in a worker
-    thread cancels the run with ``loop.call_soon_threadsafe(task.cancel)``."""
+    thread cancels the run with ``loop.call_soon_threadsafe(task.cancel)``. A goal
+    outside the arena or on an obstacle raises ``ConfigFileError`` naming ``source``."""
     stack = effective_stack(scenario, stack)
     hal = build_world(stack, extra_obstacles=[b.to_obstacle() for b in scenario.obstacles])
+    try:
+        check_goal(scenario, hal.obstacles(), hal.walls(), source=source)
+    except BaseException:
+        hal.close()
+        raise
     judge = Judge(hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance)
     writer = RecordingWriter(out_dir / "recording.mcap") if out_dir and record else None
     recorder = Recorder(writer) if writer else None

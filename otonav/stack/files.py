@@ -17,17 +17,17 @@ class ConfigFileError(ValueError):
 
 
 def describe_validation_error(source: str, error: ValidationError) -> str:
-    """One line per problem: ``file: key.path: what is wrong (got value)``."""
-    lines = []
+    """One line: ``file: key.path: what is wrong (got value); other.key: ...``."""
+    problems = []
     for item in error.errors():
         path = ".".join(str(part) for part in item["loc"]) or "(top level)"
         message = item["msg"]
         if item["type"] == "extra_forbidden":
-            message = "unknown key (check the spelling; see the README for valid keys)"
+            message = "unknown key (check the spelling; the README lists the valid keys)"
         got = item.get("input")
         shown = "" if item["type"] in ("extra_forbidden", "missing") else f" (got {got!r})"
-        lines.append(f"{source}: {path}: {message}{shown}")
-    return "\n".join(lines)
+        problems.append(f"{path}: {message}{shown}")
+    return f"{source}: " + "; ".join(problems)
 
 
 def load_model(path: Path, model: type[_M]) -> _M:

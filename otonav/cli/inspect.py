@@ -1,0 +1,76 @@
+"""``otonav graph``, ``otonav scenarios`` and ``otonav plot``."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from rich.console import Console
+from rich.table import Table
+
+from otonav.cli.run import load_stack
+from otonav.runtime import System
+from otonav.scenario.builtin import BUILTIN, describe
+from otonav.scenario.replay import plot_recording
+from otonav.stack import build_actors, build_world
+from otonav.stack.rosout import attach_rosout
+
+
+def add_parsers(commands: Any) -> None:
+    g = commands.add_parser("graph", help="actors, topics, types and QoS of the configured stack")
+    g.add_argument("--config", type=Path, help="stack config YAML (default: built-in)")
+    g.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
+    g.set_defaults(handler=graph_main)
+    s = commands.add_parser("scenarios", help="list the built-in scenarios")
+    s.set_defaults(handler=scenarios_main)
+    p = commands.add_parser("plot", help="draw the path recorded in an MCAP file as a PNG")
+    p.add_argument("file", type=Path)
+    p.add_argument("--out", type=Path, help="PNG path (default: next to the file)")
+    p.set_defaults(handler=plot_main)
+
+
+def graph_main(args: argparse.Namespace) -> int:
+    stack = load_stack(args.config, args.overrides)
+    hal = build_world(stack)
+    try:
+        system = System(build_actors(stack, hal))
+        attach_rosout(system)
+        graph = system.graph()
+    finally:
+        hal.close()
+    console = Console(highlight=False, width=140)
+    actors = Table(title="actors")
+    for column in ("actor", "kind", "subscribes", "publishes"):
+        actors.add_column(column)
+    for a in graph.actors:
+        actors.add_row(a.name, a.kind, "\n".join(a.inputs), "\n".join(a.outputs))
+    console.print(actors)
+    topics = Table(title="topics (a recording adds the recorder on every topic)")
+    for column in ("topic", "type", "publishers (QoS)", "subscribers (QoS)"):
+        topics.add_column(column)
+    for t in graph.topics:
+        topics.add_row(
+            t.name,
+            t.type.rsplit(".", 1)[-1],
+            "\n".join(f"{p.actor} ({p.qos})" for p in t.publishers),
+            "\n".join(f"{s.actor} ({s.qos})" for s in t.subscriptions),
+        )
+    console.print(topics)
+    return 0
+
+
+def scenarios_main(_args: argparse.Namespace) -> int:
+    table = Table(title="built-in scenarios (run one: otonav run --scenario NAME)")
+    table.add_column("name")
+    table.add_column("what")
+    for name in BUILTIN:
+        table.add_row(name, describe(name))
+    Console(highlight=False).print(table)
+    return 0
+
+
+def plot_main(args: argparse.Namespace) -> int:
+    png = plot_recording(args.file, args.out)
+    print(f"plot: {png}")
+    return 0

@@ -1,0 +1,58 @@
+"""Checks of a scenario against its world: a goal the robot can never reach is a
+configuration error (exit 2), not a failed run."""
+
+from __future__ import annotations
+
+import math
+
+from otonav.hal import BoxObstacle
+from otonav.scenario.config import ScenarioConfig
+from otonav.stack.files import ConfigFileError
+
+
+def arena_bounds(walls: tuple[BoxObstacle, ...]) -> tuple[float, float, float, float] | None:
+    """The inner rectangle (x_min, x_max, y_min, y_max) enclosed by axis-aligned walls
+    around the origin; None when the scene has no walls on every side."""
+    x_min, x_max, y_min, y_max = -math.inf, math.inf, -math.inf, math.inf
+    for wall in walls:
+        if wall.half_x <= wall.half_y:  # a wall along y, at some x
+            if wall.x < 0:
+                x_min = max(x_min, wall.x + wall.half_x)
+            else:
+                x_max = min(x_max, wall.x - wall.half_x)
+        elif wall.y < 0:
+            y_min = max(y_min, wall.y + wall.half_y)
+        else:
+            y_max = min(y_max, wall.y - wall.half_y)
+    bounds = (x_min, x_max, y_min, y_max)
+    return bounds if all(math.isfinite(b) for b in bounds) else None
+
+
+def check_goal(
+    scenario: ScenarioConfig,
+    obstacles: tuple[BoxObstacle, ...],
+    walls: tuple[BoxObstacle, ...],
+    *,
+    source: str = "scenario",
+) -> None:
+    """Raise :class:`ConfigFileError` when the goal is outside the arena or closer to an
+    obstacle than the clearance the scenario demands."""
+    gx, gy = scenario.goal.x, scenario.goal.y
+    bounds = arena_bounds(walls)
+    if bounds is not None:
+        x_min, x_max, y_min, y_max = bounds
+        if not (x_min < gx < x_max and y_min < gy < y_max):
+            raise ConfigFileError(
+                f"{source}: goal: ({gx:g}, {gy:g}) is outside the arena of scene "
+                f"'{scenario.scene}' (valid: x in ({x_min:g}, {x_max:g}), "
+                f"y in ({y_min:g}, {y_max:g}))"
+            )
+    for box in obstacles:
+        gap = box.distance_to(gx, gy)
+        if gap < scenario.min_clearance:
+            where = "inside" if gap == 0 else f"{gap:.2f} m from"
+            raise ConfigFileError(
+                f"{source}: goal: ({gx:g}, {gy:g}) is {where} the obstacle at "
+                f"({box.x:g}, {box.y:g}); a goal needs at least min_clearance = "
+                f"{scenario.min_clearance:g} m from every obstacle"
+            )
