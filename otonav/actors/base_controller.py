@@ -87,10 +87,8 @@ class BaseController(Actor):
             )
             left, right = twist_to_wheels(v, omega, self.geometry)
             await self.wheel_cmd.publish(
-                WheelCommand.model_construct(
-                    header=Header.model_construct(
-                        stamp=Time.from_seconds(now), frame_id="base_link"
-                    ),
+                WheelCommand.fast(
+                    header=Header.fast(stamp=Time.from_seconds(now), frame_id="base_link"),
                     left=left,
                     right=right,
                 )

@@ -7,7 +7,7 @@ import anyio
 
 from otonav.actors import topics
 from otonav.control import Pose2D, integrate_odometry
-from otonav.hal import RobotHardwareInterface
+from otonav.hal import ImuSample, RobotHardwareInterface
 from otonav.hal import WheelCommand as HalWheelCommand
 from otonav.msgs import (
     Clock,
@@ -86,22 +86,22 @@ class Bridge(Actor):
         self._pose = Pose2D(0.0, 0.0, 0.0)
         self._last_wheels: tuple[float, float] | None = None
         self._last_odom_time = 0.0
+        self._imu_sample: ImuSample | None = None
+        self._imu_time = -1.0
 
     async def on_start(self) -> None:
         geometry = self.hal.geometry
-        laser = TransformStamped.model_construct(
-            header=Header.model_construct(
-                stamp=Time.from_seconds(self.clock.now()), frame_id="base_link"
-            ),
+        laser = TransformStamped.fast(
+            header=Header.fast(stamp=Time.from_seconds(self.clock.now()), frame_id="base_link"),
             child_frame_id="laser",
-            transform=Transform.model_construct(
-                translation=Vector3.model_construct(
+            transform=Transform.fast(
+                translation=Vector3.fast(
                     x=geometry.laser_offset_x, y=0.0, z=geometry.laser_offset_z
                 ),
                 rotation=Quaternion(),
             ),
         )
-        await self.tf_static.publish(TFMessage.model_construct(transforms=(laser,)))
+        await self.tf_static.publish(TFMessage.fast(transforms=(laser,)))
 
     async def run(self) -> None:
         async with anyio.create_task_group() as tg:
@@ -143,12 +143,12 @@ class Bridge(Actor):
                     await publishers[name](stamp, now)
 
     async def _publish_clock(self, stamp: Time, _now: float) -> None:
-        await self.clock_out.publish(Clock.model_construct(clock=stamp))
+        await self.clock_out.publish(Clock.fast(clock=stamp))
 
     async def _publish_odom(self, stamp: Time, now: float) -> None:
         hal = self.hal
         wheels = hal.read_wheels()
-        gyro_z = hal.read_imu().angular_velocity[2]
+        gyro_z = self._imu_at(now).angular_velocity[2]
         geometry = hal.geometry
         dt = now - self._last_odom_time
         self._last_odom_time = now
@@ -166,36 +166,36 @@ class Bridge(Actor):
             v = distance / dt
             self._pose = integrate_odometry(self._pose, v, gyro_z, dt)
         pose = self._pose
-        header = Header.model_construct(stamp=stamp, frame_id="odom")
+        header = Header.fast(stamp=stamp, frame_id="odom")
         orientation = Quaternion.from_yaw(pose.yaw)
         await self.odom.publish(
-            Odometry.model_construct(
+            Odometry.fast(
                 header=header,
                 child_frame_id="base_link",
-                pose=PoseWithCovariance.model_construct(
-                    pose=Pose.model_construct(
-                        position=Point.model_construct(x=pose.x, y=pose.y, z=0.0),
+                pose=PoseWithCovariance.fast(
+                    pose=Pose.fast(
+                        position=Point.fast(x=pose.x, y=pose.y, z=0.0),
                         orientation=orientation,
                     ),
                     covariance=_POSE_COV,
                 ),
-                twist=TwistWithCovariance.model_construct(
-                    twist=Twist.model_construct(
-                        linear=Vector3.model_construct(x=v, y=0.0, z=0.0),
-                        angular=Vector3.model_construct(x=0.0, y=0.0, z=gyro_z),
+                twist=TwistWithCovariance.fast(
+                    twist=Twist.fast(
+                        linear=Vector3.fast(x=v, y=0.0, z=0.0),
+                        angular=Vector3.fast(x=0.0, y=0.0, z=gyro_z),
                     ),
                     covariance=_TWIST_COV,
                 ),
             )
         )
         await self.tf.publish(
-            TFMessage.model_construct(
+            TFMessage.fast(
                 transforms=(
-                    TransformStamped.model_construct(
+                    TransformStamped.fast(
                         header=header,
                         child_frame_id="base_link",
-                        transform=Transform.model_construct(
-                            translation=Vector3.model_construct(x=pose.x, y=pose.y, z=0.0),
+                        transform=Transform.fast(
+                            translation=Vector3.fast(x=pose.x, y=pose.y, z=0.0),
                             rotation=orientation,
                         ),
                     ),
@@ -203,19 +203,26 @@ class Bridge(Actor):
             )
         )
 
-    async def _publish_imu(self, stamp: Time, _now: float) -> None:
-        sample = self.hal.read_imu()
+    def _imu_at(self, now: float) -> ImuSample:
+        """One IMU read per instant, shared by odometry and /imu (it was read twice)."""
+        if self._imu_time != now or self._imu_sample is None:
+            self._imu_sample = self.hal.read_imu()
+            self._imu_time = now
+        return self._imu_sample
+
+    async def _publish_imu(self, stamp: Time, now: float) -> None:
+        sample = self._imu_at(now)
         w, x, y, z = sample.orientation
         gx, gy, gz = sample.angular_velocity
         ax, ay, az = sample.linear_acceleration
         await self.imu.publish(
-            Imu.model_construct(
-                header=Header.model_construct(stamp=stamp, frame_id="imu_link"),
-                orientation=Quaternion.model_construct(x=x, y=y, z=z, w=w),
+            Imu.fast(
+                header=Header.fast(stamp=stamp, frame_id="imu_link"),
+                orientation=Quaternion.fast(x=x, y=y, z=z, w=w),
                 orientation_covariance=(0.0,) * 9,
-                angular_velocity=Vector3.model_construct(x=gx, y=gy, z=gz),
+                angular_velocity=Vector3.fast(x=gx, y=gy, z=gz),
                 angular_velocity_covariance=(0.0,) * 9,
-                linear_acceleration=Vector3.model_construct(x=ax, y=ay, z=az),
+                linear_acceleration=Vector3.fast(x=ax, y=ay, z=az),
                 linear_acceleration_covariance=(0.0,) * 9,
             )
         )
@@ -223,8 +230,8 @@ class Bridge(Actor):
     async def _publish_scan(self, stamp: Time, _now: float) -> None:
         scan = self.hal.read_scan()
         await self.scan.publish(
-            LaserScan.model_construct(
-                header=Header.model_construct(stamp=stamp, frame_id="laser"),
+            LaserScan.fast(
+                header=Header.fast(stamp=stamp, frame_id="laser"),
                 angle_min=scan.angle_min,
                 angle_max=scan.angle_max,
                 angle_increment=scan.angle_increment,

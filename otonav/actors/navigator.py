@@ -112,14 +112,14 @@ class Navigator(Actor):
         closest: float,
     ) -> None:
         await self.cmd_vel.publish(
-            Twist.model_construct(
-                linear=Vector3.model_construct(x=v, y=0.0, z=0.0),
-                angular=Vector3.model_construct(x=0.0, y=0.0, z=omega),
+            Twist.fast(
+                linear=Vector3.fast(x=v, y=0.0, z=0.0),
+                angular=Vector3.fast(x=0.0, y=0.0, z=omega),
             )
         )
         await self.state.publish(
-            NavState.model_construct(
-                header=Header.model_construct(stamp=stamp, frame_id="odom"),
+            NavState.fast(
+                header=Header.fast(stamp=stamp, frame_id="odom"),
                 state=state,
                 distance_to_goal=distance,
                 heading_error=heading_error,

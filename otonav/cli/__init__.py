@@ -10,7 +10,7 @@ import argparse
 import sys
 from collections.abc import Sequence
 
-from otonav.cli import info, inspect, run
+from otonav.cli import bench, info, inspect, run
 from otonav.hal.mujoco import SceneError
 from otonav.record.reader import RecordingError
 from otonav.stack.files import ConfigFileError
@@ -31,6 +31,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_parser(commands)
     info.add_parsers(commands)
     inspect.add_parsers(commands)
+    bench.add_parser(commands)
     return parser
 
 

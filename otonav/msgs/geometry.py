@@ -34,7 +34,7 @@ class Quaternion(Message):
 
     @classmethod
     def from_yaw(cls, yaw: float) -> Quaternion:
-        return cls.model_construct(x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2))
+        return cls.fast(x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2))
 
     def yaw(self) -> float:
         return math.atan2(2 * (self.w * self.z + self.x * self.y), 1 - 2 * (self.y**2 + self.z**2))

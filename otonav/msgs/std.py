@@ -19,7 +19,7 @@ class Time(Message):
     @classmethod
     def from_seconds(cls, seconds: float) -> Time:
         total = round(seconds * 1e9)
-        return cls.model_construct(sec=total // 1_000_000_000, nanosec=total % 1_000_000_000)
+        return cls.fast(sec=total // 1_000_000_000, nanosec=total % 1_000_000_000)
 
     def to_seconds(self) -> float:
         return self.sec + self.nanosec * 1e-9

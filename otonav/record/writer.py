@@ -18,10 +18,11 @@ from pathlib import Path
 from types import TracebackType
 from typing import IO
 
-from mcap.writer import CompressionType, Writer
+from mcap.writer import CompressionType
 
 from otonav.msgs import Message
 from otonav.record.cdr import encode
+from otonav.record.fastwriter import FastWriter
 from otonav.record.schemas import schema_for
 
 CHUNK_SIZE = 64 * 1024
@@ -43,7 +44,9 @@ class RecordingWriter:
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._file: IO[bytes] = open(self.path, "wb")  # noqa: SIM115 - closed in finish()
-        self._writer = Writer(self._file, chunk_size=chunk_size, compression=CompressionType.ZSTD)
+        self._writer = FastWriter(
+            self._file, chunk_size=chunk_size, compression=CompressionType.ZSTD
+        )
         self._writer.start(profile="ros2", library=_library())
         self._file.flush()
         self._flushed_at = self._file.tell()

@@ -88,6 +88,26 @@ class VirtualClock(Clock):
     def watch(self, check: Callable[[], bool]) -> Callable[[], None]:
         return self._loop.add_idle_watcher(check)
 
+    async def sleep_until(self, sim_time: float) -> None:
+        # A timer at exactly ``sim_time``: no float drift from ``now + delay``, and none
+        # of anyio.sleep_until's backend lookup (10k calls were 1.2 % of a profiled run).
+        # Cancellation (anyio cancel scopes included) cancels the future as usual.
+        loop = self._loop
+        if sim_time <= loop.time():
+            await asyncio.sleep(0)
+            return
+        future: asyncio.Future[None] = loop.create_future()
+        handle = loop.call_at(sim_time, _wake, future)
+        try:
+            await future
+        finally:
+            handle.cancel()
+
+
+def _wake(future: asyncio.Future[None]) -> None:
+    if not future.done():
+        future.set_result(None)
+
 
 class RealTimeClock(Clock):
     """Sim time on any loop, paced to the wall clock times ``scale``.

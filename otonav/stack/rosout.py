@@ -23,7 +23,7 @@ def attach_rosout(system: System) -> None:
 
     def publish(event: SystemEvent) -> None:
         text = event.kind if not event.detail else f"{event.kind}: {event.detail}"
-        message = Log.model_construct(
+        message = Log.fast(
             stamp=Time.from_seconds(event.sim_time),
             level=_LEVELS.get(event.kind, Log.INFO),
             name=event.actor,

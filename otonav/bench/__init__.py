@@ -1,0 +1,1 @@
+"""``otonav bench``: the stack against bare physics, measured in one session."""

@@ -1,0 +1,150 @@
+"""``otonav bench``: (a) bare loop, (b) stack, (c) stack + recorder; medians, ratios,
+peak RSS, where the time goes, and how cost scales with beams and /scan subscribers."""
+
+from __future__ import annotations
+
+import json
+import statistics
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from otonav.bench.harness import Case, Sample, run_in_children
+
+LABELS = {
+    "bare": "(a) bare loop",
+    "stack": "(b) stack, no recorder",
+    "recorded": "(c) stack + recorder",
+}
+
+
+@dataclass(frozen=True, slots=True)
+class Row:
+    label: str
+    duration_s: float
+    reps: int
+    wall_median_s: float
+    wall_min_s: float
+    wall_max_s: float
+    rtf: float
+    us_per_10ms_sim: float
+    peak_rss_mb: float
+
+
+def _row(label: str, samples: list[Sample]) -> Row:
+    walls = [s.wall_s for s in samples]
+    median = statistics.median(walls)
+    sim = samples[0].sim_s
+    return Row(
+        label,
+        sim,
+        len(samples),
+        median,
+        min(walls),
+        max(walls),
+        sim / median,
+        median / (sim / 0.01) * 1e6,
+        max(s.peak_rss_mb for s in samples),
+    )
+
+
+def run_bench(duration: float, reps: int, *, scaling: bool, profile: bool) -> dict[str, object]:
+    kinds = ("bare", "stack", "recorded")
+    # Interleave a, b, c, a, b, c, ... so slow phases of this shared machine hit all three.
+    cases = [Case(kind, duration) for _ in range(reps) for kind in kinds]
+    samples = run_in_children(cases)
+    rows = {
+        k: _row(LABELS[k], [s for c, s in zip(cases, samples, strict=True) if c.kind == k])
+        for k in kinds
+    }
+    base = rows["bare"].wall_median_s
+    result: dict[str, object] = {
+        "duration_s": duration,
+        "reps": reps,
+        "rows": [asdict(r) for r in rows.values()],
+        "ratio_b_over_a": rows["stack"].wall_median_s / base,
+        "ratio_c_over_a": rows["recorded"].wall_median_s / base,
+    }
+    if profile:
+        import multiprocessing
+
+        from otonav.bench.profile import profile_case
+
+        with multiprocessing.get_context("spawn").Pool(1) as pool:
+            result["stages_recorded"] = pool.apply(profile_case, (Case("recorded", duration),))
+    if scaling:
+        scale_reps = max(1, min(reps, 3))
+        beam_cases = [
+            Case("recorded", duration, beams=b) for _ in range(scale_reps) for b in (36, 360, 1440)
+        ]
+        sub_cases = [
+            Case("recorded", duration, scan_subscribers=n)
+            for _ in range(scale_reps)
+            for n in (1, 4, 16)
+        ]
+        beam_samples = run_in_children(beam_cases)
+        sub_samples = run_in_children(sub_cases)
+        result["scaling_beams"] = {
+            str(b): asdict(
+                _row(
+                    f"{b} beams",
+                    [s for c, s in zip(beam_cases, beam_samples, strict=True) if c.beams == b],
+                )
+            )
+            for b in (36, 360, 1440)
+        }
+        result["scaling_scan_subscribers"] = {
+            str(n): asdict(
+                _row(
+                    f"{n} /scan subscribers",
+                    [
+                        s
+                        for c, s in zip(sub_cases, sub_samples, strict=True)
+                        if c.scan_subscribers == n
+                    ],
+                )
+            )
+            for n in (1, 4, 16)
+        }
+    return result
+
+
+def format_report(result: dict[str, object]) -> str:
+    lines = [
+        f"otonav bench: acceptance world, {result['duration_s']:g} s of sim time, "
+        f"median of {result['reps']} runs each (interleaved, one process per run)",
+        f"{'configuration':<26}{'wall (s)':>10}{'min':>8}{'max':>8}{'RTF':>8}"
+        f"{'us/10ms':>10}{'RSS MB':>9}",
+    ]
+    for r in result["rows"]:  # type: ignore[attr-defined]
+        lines.append(
+            f"{r['label']:<26}{r['wall_median_s']:>10.3f}{r['wall_min_s']:>8.3f}{r['wall_max_s']:>8.3f}"
+            f"{r['rtf']:>7.0f}x{r['us_per_10ms_sim']:>10.0f}{r['peak_rss_mb']:>9.0f}"
+        )
+    lines.append(
+        f"ratios: (b)/(a) = {result['ratio_b_over_a']:.2f}   "
+        f"(c)/(a) = {result['ratio_c_over_a']:.2f}"
+    )
+    stages = result.get("stages_recorded")
+    if isinstance(stages, dict):
+        total = sum(stages.values()) or 1.0
+        lines.append("where the time goes in (c) (one cProfile run, own time per stage):")
+        for stage, seconds in stages.items():
+            lines.append(f"  {stage:<34}{100 * seconds / total:>5.1f} %")
+    for key, title in (
+        ("scaling_beams", "lidar beams"),
+        ("scaling_scan_subscribers", "/scan subscribers"),
+    ):
+        table = result.get(key)
+        if isinstance(table, dict):
+            lines.append(f"scaling with {title} (stack + recorder):")
+            for name, r in table.items():
+                lines.append(
+                    f"  {name:>6}: RTF {r['rtf']:>5.0f}x  {r['us_per_10ms_sim']:>6.0f} us/10ms"
+                    f"  wall {r['wall_median_s']:.3f} s"
+                )
+    return "\n".join(lines)
+
+
+def write_json(result: dict[str, object], path: Path) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(result, indent=2) + "\n")

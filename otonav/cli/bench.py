@@ -1,0 +1,30 @@
+"""``otonav bench``: measure the stack against bare physics (see otonav.bench)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from otonav.bench.report import format_report, run_bench, write_json
+
+
+def add_parser(commands: Any) -> None:
+    p = commands.add_parser("bench", help="stack vs bare physics: wall time, RTF, ratios, RSS")
+    p.add_argument("--duration", type=float, default=30.0, help="sim seconds per run (default 30)")
+    p.add_argument("--reps", type=int, default=5, help="runs per configuration (default 5)")
+    p.add_argument("--json", type=Path, default=Path("out/bench.json"), help="write figures here")
+    p.add_argument("--no-scaling", action="store_true", help="skip the beams / subscribers tables")
+    p.add_argument("--quick", action="store_true", help="2 s, 1 run, no scaling: checks it runs")
+    p.set_defaults(handler=main)
+
+
+def main(args: argparse.Namespace) -> int:
+    duration, reps, scaling = args.duration, args.reps, not args.no_scaling
+    if args.quick:
+        duration, reps, scaling = 2.0, 1, False
+    result = run_bench(duration, reps, scaling=scaling, profile=not args.quick)
+    print(format_report(result))
+    write_json(result, args.json)
+    print(f"figures: {args.json}")
+    return 0
