@@ -35,9 +35,16 @@ class FastWriter(Writer):
         publish_time: int,
         sequence: int = 0,
     ) -> None:
+        self.add_message_and_check(channel_id, log_time, data, publish_time, sequence)
+
+    def add_message_and_check(
+        self, channel_id: int, log_time: int, data: bytes, publish_time: int, sequence: int
+    ) -> bool:
+        """:meth:`add_message`; True when that finished a chunk (it went to the stream)."""
         if not SUPPORTED:
+            before = self._chunks_written()
             super().add_message(channel_id, log_time, data, publish_time, sequence)
-            return
+            return self._chunks_written() != before
         stats: Any = self._Writer__statistics  # type: ignore[attr-defined]
         if stats.message_count == 0 or log_time < stats.message_start_time:
             stats.message_start_time = log_time
@@ -69,4 +76,10 @@ class FastWriter(Writer):
             )
         )
         records.write(data)
-        self._Writer__maybe_finalize_chunk()  # type: ignore[attr-defined]
+        if records.count > self._Writer__chunk_size:  # type: ignore[attr-defined]
+            self._Writer__finalize_chunk()  # type: ignore[attr-defined]
+            return True
+        return False
+
+    def _chunks_written(self) -> int:
+        return int(self._Writer__statistics.chunk_count)  # type: ignore[attr-defined]

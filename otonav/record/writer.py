@@ -49,7 +49,6 @@ class RecordingWriter:
         )
         self._writer.start(profile="ros2", library=_library())
         self._file.flush()
-        self._flushed_at = self._file.tell()
         self._schemas: dict[type[Message], int] = {}
         self._channels: dict[str, int] = {}
         self._sequence: dict[int, int] = {}
@@ -74,19 +73,14 @@ class RecordingWriter:
             channel_id = self._channel(topic, type(message))
         stamp = round(sim_time * 1e9)
         self._sequence[channel_id] += 1
-        self._writer.add_message(
-            channel_id,
-            log_time=stamp,
-            data=encode(message),
-            publish_time=stamp,
-            sequence=self._sequence[channel_id],
-        )
-        self.messages += 1
-        # Messages accumulate in memory until a chunk is full; the file grows only when
-        # a chunk was written, and then it goes to the OS at once.
-        if self._file.tell() != self._flushed_at:
+        # Messages accumulate in memory until a chunk is full; when one was written,
+        # it goes to the OS at once. (Asking the file its position after every message
+        # instead cost an lseek syscall per message.)
+        if self._writer.add_message_and_check(
+            channel_id, stamp, encode(message), stamp, self._sequence[channel_id]
+        ):
             self._file.flush()
-            self._flushed_at = self._file.tell()
+        self.messages += 1
 
     def add_metadata(self, name: str, data: dict[str, str]) -> None:
         self._writer.add_metadata(name, data)

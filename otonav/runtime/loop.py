@@ -200,7 +200,13 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         if self._wall_ceiling is not None:
             self._check_wall_ceiling()
         if timeout == 0:
-            return inner.select(0)
+            # Callbacks are ready. Poll for I/O only if something besides the loop's
+            # self-pipe is registered: call_soon_threadsafe appends to the ready queue
+            # itself, the pipe only wakes a blocked select (and is drained whenever the
+            # loop does wait). Saves an epoll syscall on ~3 of 4 loop iterations.
+            if len(inner.get_map()) > 1:
+                return inner.select(0)
+            return []
         # Nothing is ready: the system has settled at this instant.
         if self._watchers:
             self._run_watchers()
