@@ -17,7 +17,9 @@ run: $(STAMP)
 	$(PY) -m otonav
 
 ## set up and run the whole gate: static, unit, smoke, SIL (stops at the first red layer)
+## (the GUI smoke test needs Debian's xvfb and x11-apps: installed here when missing)
 test: $(STAMP)
+	@sh scripts/ensure_xvfb.sh
 	$(PY) scripts/gate.py
 
 ## layer 0 only

@@ -12,6 +12,7 @@ from collections.abc import Sequence
 
 from otonav.cli import bench, info, inspect, run
 from otonav.hal.mujoco import SceneError
+from otonav.hal.viewer import NoDisplayError
 from otonav.record.reader import RecordingError
 from otonav.stack.files import ConfigFileError
 
@@ -43,7 +44,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         code: int = args.handler(args)
         return code
-    except (ConfigFileError, RecordingError, SceneError) as exc:
+    except (ConfigFileError, RecordingError, SceneError, NoDisplayError) as exc:
         print(f"otonav: error: {exc}", file=sys.stderr)
         return USAGE_ERROR
     except KeyboardInterrupt:

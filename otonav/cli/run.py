@@ -15,6 +15,7 @@ from rich.table import Table
 from otonav.cli.progress import ProgressLine
 from otonav.scenario import ScenarioConfig, Verdict, run_scenario
 from otonav.scenario.builtin import BUILTIN
+from otonav.scenario.realtime import run_scenario_realtime
 from otonav.stack import StackConfig
 from otonav.stack.files import ConfigFileError, load_model
 from otonav.stack.overrides import apply_overrides
@@ -39,6 +40,16 @@ def add_parser(commands: Any) -> None:
         "--out", type=Path, default=DEFAULT_OUT, help="artifact directory (default: out)"
     )
     p.add_argument("--no-record", action="store_true", help="do not write recording.mcap")
+    p.add_argument(
+        "--realtime", action="store_true", help="pace sim time to the wall clock (same actors)"
+    )
+    p.add_argument(
+        "--scale",
+        type=float,
+        default=1.0,
+        help="with --realtime/--gui: sim seconds per wall second",
+    )
+    p.add_argument("--gui", action="store_true", help="show the run in MuJoCo's viewer (real time)")
     p.set_defaults(handler=main)
 
 
@@ -96,14 +107,26 @@ def main(args: argparse.Namespace) -> int:
     source = args.scenario if args.scenario not in BUILTIN else f"scenario '{args.scenario}'"
     extra = (ProgressLine(),) if sys.stderr.isatty() else ()
     try:
-        verdict = run_scenario(
-            scenario,
-            stack,
-            out_dir=out,
-            record=not args.no_record,
-            extra_actors=extra,
-            source=source,
-        )
+        if args.gui or args.realtime:
+            if not args.scale > 0:
+                raise ConfigFileError(f"--scale {args.scale}: must be > 0 (sim s per wall s)")
+            verdict = run_scenario_realtime(
+                scenario,
+                stack,
+                out_dir=out,
+                record=not args.no_record,
+                scale=args.scale,
+                gui=args.gui,
+            )
+        else:
+            verdict = run_scenario(
+                scenario,
+                stack,
+                out_dir=out,
+                record=not args.no_record,
+                extra_actors=extra,
+                source=source,
+            )
     except asyncio.CancelledError:
         print("otonav: terminated; the recording was finished and is readable", file=sys.stderr)
         return 143

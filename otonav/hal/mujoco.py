@@ -17,6 +17,12 @@ counter (``data.time`` accumulates float error and is not used). Readings taken 
 ``mj_forward`` (it does not change the trajectory: reading never perturbs physics).
 Construction runs 0.25 s of physics with zero command so that at tick 0 the robot rests
 settled on its wheels and caster.
+
+Viewer: :meth:`MujocoInterface.open_viewer` opens MuJoCo's passive viewer on the live
+world (after :func:`otonav.hal.viewer.check_display`, so a missing display is a
+:class:`~otonav.hal.viewer.NoDisplayError`, not MuJoCo's hard exit). The viewer only
+draws: call :meth:`ViewerHandle.sync` after the world advanced, and
+:meth:`ViewerHandle.close` before the process exits.
 """
 
 from __future__ import annotations
@@ -24,6 +30,8 @@ from __future__ import annotations
 import math
 import os
 import tempfile
+import threading
+import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from importlib import resources
@@ -45,12 +53,15 @@ from otonav.hal.types import (
     WheelCommand,
     WheelState,
 )
+from otonav.hal.viewer import NoDisplayError, check_display
 
 __all__ = [
     "BUG_VARIANT_KV",
     "MujocoInterface",
+    "NoDisplayError",
     "SceneError",
     "Variant",
+    "ViewerHandle",
     "compile_scene",
     "scene_names",
     "scene_path",
@@ -181,6 +192,64 @@ def _apply_bug_variant(spec: Any, label: str) -> None:
         act.forcelimited = mujoco.mjtLimited.mjLIMITED_FALSE
         act.gainprm[0] = BUG_VARIANT_KV
         act.biasprm[2] = -BUG_VARIANT_KV
+
+
+_VIEWER_THREAD: Final = "_launch_internal"  # target of launch_passive's thread
+
+
+class ViewerHandle:
+    """MuJoCo's passive viewer on a :class:`MujocoInterface`'s live world.
+
+    Single-threaded use from the thread that steps the world: :meth:`sync` after the
+    world advanced (at most ~60 Hz wall: each sync copies the state for drawing),
+    :meth:`is_running` to notice the user closed the window, :meth:`close` when done
+    (also as a context manager). ``start_time_s`` is how long the window took to open.
+    """
+
+    def __init__(
+        self,
+        world: MujocoInterface,
+        handle: Any,
+        threads: Sequence[threading.Thread],
+        start_time_s: float,
+    ) -> None:
+        self._world = world
+        self._handle = handle
+        self._threads = tuple(threads)
+        self.start_time_s = start_time_s
+        self._closed = False
+
+    def is_running(self) -> bool:
+        """False once the window was closed (by the user or :meth:`close`)."""
+        return not self._closed and bool(self._handle.is_running())
+
+    def sync(self) -> None:
+        """Show the world's current state (a no-op once the window is closed)."""
+        if not self.is_running():
+            return
+        self._world._sync()  # poses of the last step, as reading does (no physics change)
+        self._handle.sync()
+
+    def close(self, timeout: float = 5.0) -> None:
+        """Close the window and wait until the viewer's thread has finished tearing
+        down, so the process can exit right after (exiting with the viewer still
+        closing crashed or hung). Idempotent."""
+        if self._closed:
+            return
+        self._closed = True
+        self._handle.close()
+        deadline = time.monotonic() + timeout
+        for thread in self._threads:
+            thread.join(max(0.0, deadline - time.monotonic()))
+        alive = [t.name for t in self._threads if t.is_alive()]
+        if alive:
+            raise RuntimeError(f"MuJoCo viewer did not shut down within {timeout:g} s ({alive})")
+
+    def __enter__(self) -> ViewerHandle:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
 
 class MujocoInterface(RobotHardwareInterface):
@@ -368,6 +437,27 @@ class MujocoInterface(RobotHardwareInterface):
     def mj_data(self) -> object:
         """The live ``mujoco.MjData`` (for a viewer inside ``otonav.hal`` only)."""
         return self._data
+
+    def open_viewer(self) -> ViewerHandle:
+        """Open MuJoCo's passive viewer (no side panels) on this world.
+
+        Raises :class:`NoDisplayError` (one line: what is missing, and the fix) when
+        there is no display GLFW can open, instead of MuJoCo's hard exit.
+        """
+        self._check_open()
+        check_display()
+        import mujoco.viewer  # loads GLFW: only when a viewer is wanted
+
+        self._sync()
+        started = time.perf_counter()
+        before = set(threading.enumerate())
+        handle = mujoco.viewer.launch_passive(
+            self._model, self._data, show_left_ui=False, show_right_ui=False
+        )
+        elapsed = time.perf_counter() - started
+        new = [t for t in threading.enumerate() if t not in before]
+        threads = [t for t in new if _VIEWER_THREAD in t.name] or new
+        return ViewerHandle(self, handle, threads, elapsed)
 
     # -- time -----------------------------------------------------------------------------
 

@@ -264,6 +264,12 @@ class System:
         self.stop()
         try:
             suppressed = await self._tg.__aexit__(exc_type, exc, tb)
+        except BaseExceptionGroup as group:
+            # anyio wraps the body's own exception in a group: give the caller the
+            # exception it raised (a test sees its SimTimeoutError, not a group).
+            if exc is not None and group.exceptions == (exc,):
+                raise exc from None
+            raise
         finally:
             self._tg = None
             _reset_clock(self._clock_token)

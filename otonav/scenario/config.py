@@ -10,7 +10,8 @@ from otonav.hal import BoxObstacle
 class BoxSpec(BaseModel):
     """An extra box obstacle: centre (m), full size (m), yaw (rad)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # strict: "yes" is not 1.0 (files are validated in JSON mode, where lists are tuples)
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
     x: float
     y: float
     size_x: PositiveFloat
@@ -22,7 +23,7 @@ class BoxSpec(BaseModel):
 
 
 class GoalSpec(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
     x: float
     y: float
 
@@ -30,7 +31,7 @@ class GoalSpec(BaseModel):
 class ScenarioConfig(BaseModel):
     """What to run and how to judge it. Defaults: the acceptance scenario."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
     name: str = "acceptance"
     scene: str = "obstacles"
     """Built-in scene name or MJCF path (overrides the stack's ``world.scene``)."""

@@ -20,7 +20,15 @@ from otonav.actors.recorder import Recorder
 from otonav.hal import RobotHardwareInterface
 from otonav.msgs import Header, Point, Pose, PoseStamped, ScenarioVerdict, Time
 from otonav.record.writer import RecordingWriter
-from otonav.runtime import LATCHED_QOS, Actor, SimTimeoutError, System, until, virtual_loop_factory
+from otonav.runtime import (
+    LATCHED_QOS,
+    Actor,
+    Clock,
+    SimTimeoutError,
+    System,
+    until,
+    virtual_loop_factory,
+)
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
 from otonav.scenario.plot import plot_trajectory
@@ -66,11 +74,13 @@ async def drive_to_goal(
     judge: Judge,
     *,
     before: tuple[Actor, ...] = (),
+    clock: Clock | None = None,
 ) -> System:
     """Bring the stack up on ``hal`` (after the ``before`` actors, e.g. a recorder),
     publish the goal on /goal, and wait in sim time until the judge says the robot is
-    there or the budget is spent. Returns the stopped system."""
-    system = System([*before, *build_actors(stack, hal), judge])
+    there or the budget is spent. Returns the stopped system. ``clock``: a
+    :class:`RealTimeClock` for real-time mode (default: the virtual loop's time)."""
+    system = System([*before, *build_actors(stack, hal), judge], clock=clock)
     attach_rosout(system)
     async with system:
         goal = system.publisher(topics.GOAL, PoseStamped, LATCHED_QOS, name="scenario")

@@ -7,7 +7,8 @@ from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, m
 
 
 class _Section(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    # strict: "yes" is not 1.0 and "3" is not 3 (a number in YAML is still a number).
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
 
 
 class WorldConfig(_Section):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import TypeVar
 
@@ -52,6 +53,8 @@ def load_model(path: Path, model: type[_M]) -> _M:
             f"{path}: expected a mapping of keys at the top level, got {type(data).__name__}"
         )
     try:
-        return model.model_validate(data)
+        # JSON mode: with strict models, YAML lists become tuples and mappings models,
+        # while "yes" or "3" stay refused where a number is expected.
+        return model.model_validate_json(json.dumps(data))
     except ValidationError as exc:
         raise ConfigFileError(describe_validation_error(str(path), exc)) from None

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from collections.abc import Sequence
 from typing import Any, TypeVar
 
@@ -43,6 +44,6 @@ def apply_overrides(model: _M, assignments: Sequence[str], *, source: str = "--s
             )
         node[parts[-1]] = value
     try:
-        return type(model).model_validate(data)
+        return type(model).model_validate_json(json.dumps(data))
     except ValidationError as exc:
         raise ConfigFileError(describe_validation_error(source, exc)) from None

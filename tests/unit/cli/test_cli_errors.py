@@ -77,6 +77,8 @@ def test_set_override_errors(capsys: pytest.CaptureFixture[str]) -> None:
     _fails(capsys, ["run", "--set", "nav.kp_lin=fast"], "--set", "nav.kp_lin", "valid number")
     _fails(capsys, ["run", "--set", "nav.kpl=1"], "nav.kpl", "unknown key", "kp_lin")
     _fails(capsys, ["run", "--set", "kp_lin"], "expected key.path=value")
+    # Strict numbers: YAML's "yes" is a boolean, not a gain of 1.0.
+    _fails(capsys, ["run", "--set", "nav.kp_lin=yes"], "nav.kp_lin", "valid number")
 
 
 def test_goal_inside_an_obstacle(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
@@ -117,3 +119,17 @@ def test_unknown_command_is_a_usage_error(capsys: pytest.CaptureFixture[str]) ->
         main(["fly"])
     assert exit_info.value.code == 2
     assert "invalid choice: 'fly'" in capsys.readouterr().err
+
+
+def test_gui_without_a_display_is_one_line_and_exit_2(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    _fails(capsys, ["run", "--gui", "--out", str(tmp_path)], "no display", "xvfb-run")
+
+
+def test_realtime_scale_must_be_positive(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    _fails(capsys, ["run", "--realtime", "--scale", "0", "--out", str(tmp_path)], "--scale")

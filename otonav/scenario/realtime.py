@@ -1,0 +1,176 @@
+"""Run a scenario paced to the wall clock (optionally scaled), optionally in MuJoCo's
+viewer: the same world, actors, judge, recording and verdict as
+:func:`~otonav.scenario.run.run_scenario`, on a stock asyncio loop with a
+:class:`~otonav.runtime.RealTimeClock` instead of the virtual-time loop."""
+
+from __future__ import annotations
+
+import asyncio
+import signal
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import replace
+from pathlib import Path
+
+import anyio
+
+from otonav.actors.recorder import Recorder
+from otonav.hal import RobotHardwareInterface
+from otonav.hal.mujoco import MujocoInterface, ViewerHandle
+from otonav.hal.viewer import check_display
+from otonav.record.writer import RecordingWriter
+from otonav.runtime import Actor, RealTimeClock
+from otonav.runtime.timesource import tick_rate
+from otonav.scenario.config import ScenarioConfig
+from otonav.scenario.judge import Judge
+from otonav.scenario.plot import plot_trajectory
+from otonav.scenario.run import (
+    Verdict,
+    _close_recording,
+    drive_to_goal,
+    effective_stack,
+    judge_verdict,
+)
+from otonav.scenario.validate import check_goal
+from otonav.stack import StackConfig, build_world
+
+__all__ = ["VIEWER_HZ", "run_scenario_realtime"]
+
+VIEWER_HZ = 60.0
+"""Wall-clock rate at which the viewer is shown the world."""
+
+
+async def _show(
+    viewer: ViewerHandle, clock: RealTimeClock, closed_at: list[float], stop: anyio.CancelScope
+) -> None:
+    """Sync the viewer at ``VIEWER_HZ`` wall; if the user closes it, stop the run."""
+    rate = clock.rate(VIEWER_HZ / clock.scale)  # the clock's time is sim time
+    while viewer.is_running():
+        viewer.sync()
+        await rate.sleep()  # wakes with the world stepped to the wall clock
+    closed_at.append(clock.now())
+    stop.cancel()
+
+
+async def _main(
+    scenario: ScenarioConfig,
+    stack: StackConfig,
+    hal: RobotHardwareInterface,
+    judge: Judge,
+    before: tuple[Actor, ...],
+    scale: float,
+    viewer: ViewerHandle | None,
+    closed_at: list[float],
+    on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None,
+) -> None:
+    # As run._main: SIGTERM cancels the run like Ctrl-C, so every finally runs.
+    loop = asyncio.get_running_loop()
+    task = asyncio.current_task()
+    in_main_thread = threading.current_thread() is threading.main_thread()
+    if in_main_thread and task is not None:
+        loop.add_signal_handler(signal.SIGTERM, task.cancel)
+    try:
+        clock = RealTimeClock(hal, scale=scale)
+        if on_start is not None and task is not None:
+            on_start(loop, task)
+        async with anyio.create_task_group() as tg:
+            if viewer is not None:
+                tg.start_soon(_show, viewer, clock, closed_at, tg.cancel_scope)
+            await drive_to_goal(scenario, stack, hal, judge, before=before, clock=clock)
+            tg.cancel_scope.cancel()
+    finally:
+        if in_main_thread:
+            loop.remove_signal_handler(signal.SIGTERM)
+
+
+def run_scenario_realtime(
+    scenario: ScenarioConfig = ScenarioConfig(),
+    stack: StackConfig = StackConfig(),
+    *,
+    out_dir: Path | None = None,
+    record: bool = True,
+    plot: bool = True,
+    scale: float = 1.0,
+    gui: bool = False,
+    on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
+) -> Verdict:
+    """Run ``scenario`` with sim time following the wall clock times ``scale`` and judge
+    it, like :func:`~otonav.scenario.run.run_scenario` (same artifacts in ``out_dir``,
+    recording finished on every exit path).
+
+    ``gui=True`` shows the run in MuJoCo's viewer: the display is checked before
+    anything is built (:class:`~otonav.hal.viewer.NoDisplayError`, one line, when there
+    is none), the window opens before the clock starts, is synced at ~60 Hz wall and
+    closed at the end. Closing the window stops the run: the verdict fails and says so.
+    ``on_start(loop, task)`` is called on the run's loop once the window (if any) is up.
+    """
+    if not scale > 0:
+        raise ValueError(f"real-time scale must be > 0, got {scale!r}")
+    if gui:
+        check_display()
+    stack = effective_stack(scenario, stack)
+    hal = build_world(stack, extra_obstacles=[b.to_obstacle() for b in scenario.obstacles])
+    viewer: ViewerHandle | None = None
+    try:
+        check_goal(scenario, hal.obstacles(), hal.walls())
+        if gui:
+            if not isinstance(hal, MujocoInterface):
+                raise TypeError(f"gui=True needs the MuJoCo world, got {type(hal).__name__}")
+            viewer = hal.open_viewer()
+        judge = Judge(hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance)
+        writer = RecordingWriter(out_dir / "recording.mcap") if out_dir and record else None
+    except BaseException:
+        if viewer is not None:
+            viewer.close()
+        hal.close()
+        raise
+    recorder = Recorder(writer) if writer else None
+    closed_at: list[float] = []
+    wall_start = time.perf_counter()
+    ended = "completed"
+    try:
+        before = (recorder,) if recorder else ()
+        with asyncio.Runner() as runner:
+            runner.run(
+                _main(scenario, stack, hal, judge, before, scale, viewer, closed_at, on_start)
+            )
+    except BaseException as exc:
+        sim = hal.ticks / tick_rate(hal.tick)
+        ended = f"{type(exc).__name__} at sim time {sim:.3f} s: {exc}".strip().rstrip(":")
+        raise
+    finally:
+        wall = time.perf_counter() - wall_start
+        sim_time = hal.ticks / tick_rate(hal.tick)
+        try:
+            verdict = judge_verdict(scenario, judge, sim_time, wall)
+            if ended != "completed":
+                verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
+            elif closed_at and not judge.reached:
+                verdict = replace(
+                    verdict,
+                    passed=False,
+                    reason=(
+                        f"stopped: the viewer window was closed at sim time {closed_at[0]:.3f} s "
+                        f"({judge.distance:.3f} m from the goal)"
+                    ),
+                )
+            if writer is not None:
+                _close_recording(writer, recorder, scenario, stack, verdict)
+                verdict = replace(verdict, recording=str(writer.path))
+        finally:
+            if viewer is not None:
+                viewer.close()
+            hal.close()
+        if out_dir is not None and plot:
+            png = plot_trajectory(
+                out_dir / "trajectory.png",
+                judge.trajectory,
+                judge.boxes,
+                (scenario.goal.x, scenario.goal.y),
+                scenario.goal_tolerance,
+                judge.min_clearance_at,
+                f"{scenario.name}: {'PASSED' if verdict.passed else 'FAILED'}",
+            )
+            verdict = replace(verdict, plot=str(png))
+    return verdict

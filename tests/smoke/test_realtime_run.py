@@ -1,0 +1,36 @@
+"""Layer 2: a scenario run paced to the wall clock reaches the goal, paced (not racing)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from otonav.scenario.builtin import BUILTIN
+from otonav.scenario.realtime import run_scenario_realtime
+
+pytestmark = pytest.mark.smoke
+
+SCALE = 10.0  # the "empty" scenario takes ~8.5 s of sim time: ~0.85 s of wall time
+
+
+def test_realtime_run_reaches_the_goal_paced_to_the_scaled_wall_clock(tmp_path: Path) -> None:
+    verdict = run_scenario_realtime(BUILTIN["empty"], out_dir=tmp_path, scale=SCALE)
+
+    assert verdict.passed, verdict.reason
+    assert verdict.reached
+    assert verdict.final_distance_m <= BUILTIN["empty"].goal_tolerance
+    ratio = verdict.sim_time_s / verdict.wall_time_s
+    assert 0.5 * SCALE <= ratio <= 1.2 * SCALE, (
+        f"sim {verdict.sim_time_s:.3f} s in wall {verdict.wall_time_s:.3f} s: "
+        f"ratio {ratio:.2f}, expected about the scale {SCALE:g}"
+    )
+    assert verdict.recording is not None
+    assert Path(verdict.recording).stat().st_size > 0
+    assert verdict.plot is not None
+    assert Path(verdict.plot).is_file()
+
+
+def test_realtime_run_rejects_a_non_positive_scale() -> None:
+    with pytest.raises(ValueError, match="scale must be > 0"):
+        run_scenario_realtime(BUILTIN["empty"], scale=0.0, record=False, plot=False)
