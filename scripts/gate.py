@@ -26,7 +26,7 @@ LAYERS: dict[str, list[list[str]]] = {
         [PY, "-m", "pytest", "tests/static", "-q"],
     ],
     "unit": [[PY, "-m", "pytest", "tests/unit", "-q"]],
-    "smoke": [[PY, "-m", "pytest", "tests/smoke", "-q"]],
+    "smoke": [[PY, "-m", "pytest", "tests/smoke", "tests/embed", "-q"]],
     "sil": [[PY, "-m", "pytest", "tests/sil", "-q"]],
 }
 

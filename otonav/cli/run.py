@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from pydantic import ValidationError
 from rich.console import Console
 from rich.table import Table
 
@@ -17,7 +18,7 @@ from otonav.scenario import ScenarioConfig, Verdict, run_scenario
 from otonav.scenario.builtin import BUILTIN
 from otonav.scenario.realtime import run_scenario_realtime
 from otonav.stack import StackConfig
-from otonav.stack.files import ConfigFileError, load_model
+from otonav.stack.files import ConfigFileError, describe_validation_error, load_model
 from otonav.stack.overrides import apply_overrides
 
 DEFAULT_OUT = Path("out")
@@ -100,12 +101,15 @@ def print_verdict(verdict: Verdict, console: Console) -> None:
 
 def main(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
-    if args.seed is not None:
-        scenario = scenario.model_copy(update={"seed": args.seed})
+    if args.seed is not None:  # validated like the file (model_copy would not check it)
+        try:
+            scenario = ScenarioConfig.model_validate({**scenario.model_dump(), "seed": args.seed})
+        except ValidationError as exc:
+            raise ConfigFileError(describe_validation_error("--seed", exc)) from None
     stack = load_stack(args.config, args.overrides)
     out: Path = args.out
     source = args.scenario if args.scenario not in BUILTIN else f"scenario '{args.scenario}'"
-    extra = (ProgressLine(),) if sys.stderr.isatty() else ()
+    progress = ProgressLine() if sys.stderr.isatty() else None
     try:
         if args.gui or args.realtime:
             if not args.scale > 0:
@@ -124,12 +128,15 @@ def main(args: argparse.Namespace) -> int:
                 stack,
                 out_dir=out,
                 record=not args.no_record,
-                extra_actors=extra,
+                progress=progress,
                 source=source,
             )
     except asyncio.CancelledError:
         print("otonav: terminated; the recording was finished and is readable", file=sys.stderr)
         return 143
+    finally:
+        if progress is not None:
+            progress.clear()
     out.mkdir(parents=True, exist_ok=True)
     summary = out / "summary.json"
     summary.write_text(json.dumps(summary_dict(verdict), indent=2, default=str) + "\n")

@@ -206,7 +206,8 @@ class Publisher(Generic[M]):
         self.published += 1
         if self._history is not None:
             self._history.append(message)
-        for subscription in self._subscriptions:
+        # A snapshot: a subscriber may leave (Bus.unsubscribe) while this waits for room.
+        for subscription in tuple(self._subscriptions):
             while not subscription._offer(message):
                 await subscription._wait_for_room()
 
@@ -281,6 +282,18 @@ class Bus:
         publisher = Publisher(topic, qos, endpoint)
         topic.publishers.append(publisher)
         return publisher
+
+    def unsubscribe(self, subscription: Subscription[Any]) -> None:
+        """Remove a mailbox from its topic; publishers waiting on it for room are freed.
+        Idempotent."""
+        topic = self.topics.get(subscription.topic)
+        if topic is not None and subscription in topic.subscriptions:
+            topic.subscriptions.remove(subscription)
+        while subscription._space_waiters:
+            waiter = subscription._space_waiters.popleft()
+            if not waiter.done():
+                waiter.set_result(None)
+        subscription._depth = 1 << 62  # a publisher mid-delivery finds room and moves on
 
     def subscribe(
         self, name: str, msg_type: type[M], qos: QoS = DEFAULT_QOS, *, endpoint: Endpoint

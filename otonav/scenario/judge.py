@@ -3,15 +3,22 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
+from otonav.actors import topics
 from otonav.hal import BoxObstacle, RobotHardwareInterface
-from otonav.runtime import Actor
+from otonav.msgs import NavState
+from otonav.runtime import Actor, Input, QoS, Reliability
 
 
 class Judge(Actor):
     """Samples the true pose at ``rate_hz``: distance to goal, clearance to every
     obstacle and wall (robot centre to box surface), path length, first time within
-    tolerance of the goal."""
+    tolerance of the goal. It also keeps the navigator's latest state, and calls
+    ``progress(judge, sim_time)`` after each sample (a UI's hook; it must not act on
+    the robot)."""
+
+    nav_state_in = Input(topics.NAV_STATE, NavState, QoS(Reliability.BEST_EFFORT, depth=1))
 
     def __init__(
         self,
@@ -20,9 +27,12 @@ class Judge(Actor):
         tolerance: float,
         *,
         rate_hz: float = 100.0,
+        progress: Callable[[Judge, float], None] | None = None,
         name: str = "judge",
     ) -> None:
         super().__init__(name)
+        self.progress = progress
+        self.nav_state = "starting"
         self.hal = hal
         self.goal = goal
         self.tolerance = tolerance
@@ -65,4 +75,10 @@ class Judge(Actor):
         rate = self.clock.rate(self.rate_hz)
         while True:
             await rate.sleep()
-            self.sample(self.clock.now())
+            now = self.clock.now()
+            self.sample(now)
+            if self.progress is not None:
+                state = self.nav_state_in.take_latest()
+                if state is not None:
+                    self.nav_state = state.state
+                self.progress(self, now)

@@ -136,11 +136,13 @@ def run_scenario(
     extra_actors: tuple[Actor, ...] = (),
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
     source: str = "scenario",
+    progress: Callable[[Judge, float], None] | None = None,
 ) -> Verdict:
     """Run ``scenario`` headless in virtual time and judge it. With ``out_dir``, leave
     ``recording.mcap`` (unless ``record=False``) and ``trajectory.png`` there. The
     recording is finished on every exit path (an exception, Ctrl-C, SIGTERM).
-    ``extra_actors`` join the system (monitors, fault injectors). ``on_start(loop,
+    ``extra_actors`` join the system (monitors, fault injectors). ``progress(judge,
+    sim_time)`` is called after every judge sample (the CLI's progress line). ``on_start(loop,
     task)`` is called on the run's loop as it starts: a host running this in a worker
     thread cancels the run with ``loop.call_soon_threadsafe(task.cancel)``. A goal
     outside the arena or on an obstacle raises ``ConfigFileError`` naming ``source``."""
@@ -151,7 +153,9 @@ def run_scenario(
     except BaseException:
         hal.close()
         raise
-    judge = Judge(hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance)
+    judge = Judge(
+        hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance, progress=progress
+    )
     writer = RecordingWriter(out_dir / "recording.mcap") if out_dir and record else None
     recorder = Recorder(writer) if writer else None
     wall_start = time.perf_counter()

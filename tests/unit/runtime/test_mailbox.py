@@ -227,3 +227,23 @@ def test_take_latest_discards_older_messages() -> None:
         assert sub.statistics().taken == 4
 
     _run(main)
+
+
+def test_unsubscribe_mid_backpressure_frees_the_publisher_and_skips_no_one() -> None:
+    bus = Bus()
+    pub = bus.publisher("/t", Ping, endpoint=Endpoint("a", "o"))
+    stuck = bus.subscribe("/t", Ping, QoS(depth=1), endpoint=Endpoint("stuck", "i"))
+    after = bus.subscribe("/t", Ping, QoS(depth=10), endpoint=Endpoint("after", "i"))
+
+    async def main() -> None:
+        await pub.publish(Ping(0))
+        async with anyio.create_task_group() as tg:
+            tg.start_soon(pub.publish, Ping(1))  # blocks: 'stuck' is full
+            await anyio.sleep(0.1)
+            assert after.statistics().received == 1  # Ping(1) not delivered past 'stuck' yet
+            bus.unsubscribe(stuck)
+        # The publisher moved on and delivered to the next subscriber.
+        assert [after.try_recv(), after.try_recv()] == [Ping(0), Ping(1)]
+        assert bus.topics["/t"].subscriptions == [after]
+
+    _run(main)

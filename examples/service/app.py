@@ -1,0 +1,512 @@
+"""otonav inside a web service: a small Starlette app served by uvicorn.
+
+- a live robot (real-time mode, on the service's own loop) opened at startup: its pose
+  streams as server-sent events, goals are posted to it;
+- simulations on request: each run is a scenario on its own virtual-time loop in a
+  worker thread (a few at once), with its verdict, recording and plot.
+
+    python examples/service/app.py [--port 8000] [--out out/service]
+
+Endpoints::
+
+    GET    /health                liveness (answers while simulations run)
+    POST   /runs                  {"scenario": "acceptance" | {...inline...},
+                                   "set": ["nav.kp_lin=0.5"], "seed": 3} -> 202 {"id": ...}
+    GET    /runs                  every run and its status
+    GET    /runs/{id}?wait=10     status, sim time so far, verdict (wait: for the end, s)
+    DELETE /runs/{id}             cancel; its recording is finished and indexed
+    GET    /live/pose?hz=10       text/event-stream of {"t", "x", "y", "yaw"} (odometry)
+    POST   /live/goal             {"x": 4.0, "y": 1.5} -> 202
+    GET    /live/graph            actors, topics, QoS and statistics of the live stack
+
+Bad input gets a 4xx whose ``error`` is the one-line message the CLI prints after
+``otonav: error:``. The server binds to 127.0.0.1 unless told otherwise.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import json
+import logging
+import math
+import socket
+import sys
+import uuid
+from collections.abc import AsyncIterator, Awaitable, Callable
+from contextlib import AsyncExitStack, asynccontextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import anyio
+import anyio.to_thread
+import uvicorn
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from starlette.applications import Starlette
+from starlette.requests import Request
+from starlette.responses import JSONResponse, Response, StreamingResponse
+from starlette.routing import Route
+
+from otonav.actors import topics
+from otonav.cli.run import load_scenario, load_stack
+from otonav.embed import LiveStack, check_run, open_live_stack, run_scenario_async
+from otonav.hal.mujoco import SceneError, scene_names
+from otonav.msgs import Odometry
+from otonav.runtime import QoS, Reliability
+from otonav.scenario import GoalSpec, ScenarioConfig, Verdict
+from otonav.scenario.builtin import BUILTIN
+from otonav.scenario.validate import check_goal
+from otonav.stack import StackConfig
+from otonav.stack.files import ConfigFileError, describe_validation_error
+
+log = logging.getLogger("otonav.service")
+
+#: Latest pose only: a slow client skips poses, it never holds the robot back.
+POSE_QOS = QoS(Reliability.BEST_EFFORT, depth=1)
+MAX_WAIT_S = 60.0
+
+
+class BadRequest(Exception):
+    """A 4xx with a one-line message."""
+
+    def __init__(self, message: str, status: int = 400) -> None:
+        super().__init__(message)
+        self.status = status
+
+
+# -- requests ----------------------------------------------------------------------------
+
+
+class RunRequest(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+    scenario: str | dict[str, Any] = "acceptance"
+    """A built-in scenario name, or a scenario inline (the keys of a scenario YAML)."""
+    set: list[str] = Field(default_factory=list)
+    """Stack config overrides, as ``--set`` takes them: ``nav.kp_lin=0.5``."""
+    seed: int | None = None
+
+
+class GoalRequest(BaseModel):
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    x: float
+    y: float
+
+
+def _parse(model: type[BaseModel], body: object, source: str) -> Any:
+    try:
+        return model.model_validate(body)
+    except ValidationError as exc:
+        raise BadRequest(describe_validation_error(source, exc)) from None
+
+
+async def _json_body(request: Request) -> object:
+    raw = await request.body()
+    if not raw:
+        return {}
+    try:
+        return json.loads(raw)
+    except json.JSONDecodeError as exc:
+        raise BadRequest(f"request body: invalid JSON: {exc}") from None
+
+
+def _names_a_file(name: str, suffixes: tuple[str, ...]) -> bool:
+    return "/" in name or "\\" in name or name.endswith(suffixes) or Path(name).exists()
+
+
+def resolve_scenario(spec: str | dict[str, Any], seed: int | None) -> tuple[ScenarioConfig, str]:
+    """The scenario and the name errors use for it (as ``otonav run --scenario`` does).
+    The service runs built-in or inline scenarios in built-in scenes: it reads no file a
+    client names (a scenario YAML, an MJCF scene)."""
+    if isinstance(spec, dict):
+        source = "scenario"
+        try:
+            scenario = ScenarioConfig.model_validate(spec)
+        except ValidationError as exc:
+            raise ConfigFileError(describe_validation_error(source, exc)) from None
+        if _names_a_file(scenario.scene, (".xml",)):
+            raise ConfigFileError(
+                f"{source}: scene: {scenario.scene!r}: the service runs built-in scenes "
+                f"({', '.join(scene_names())}) and reads no files"
+            )
+    elif spec in BUILTIN:
+        scenario, source = BUILTIN[spec], f"scenario '{spec}'"
+    elif _names_a_file(spec, (".yaml", ".yml")):
+        raise ConfigFileError(
+            f"--scenario {spec!r}: the service runs built-in scenarios "
+            f"({', '.join(BUILTIN)}) or inline ones, and reads no files"
+        )
+    else:
+        scenario = load_scenario(spec)  # raises the CLI's "not a built-in scenario" error
+        source = spec
+    if seed is not None:
+        data = scenario.model_dump()
+        data["seed"] = seed
+        try:
+            scenario = ScenarioConfig.model_validate(data)
+        except ValidationError as exc:
+            raise ConfigFileError(describe_validation_error("--seed", exc)) from None
+    return scenario, source
+
+
+# -- runs --------------------------------------------------------------------------------
+
+
+@dataclass(slots=True)
+class Run:
+    id: str
+    scenario: str
+    out_dir: Path
+    status: str = "queued"  # queued | running | passed | failed | cancelled | error
+    verdict: Verdict | None = None
+    error: str | None = None
+    sim_loop: asyncio.AbstractEventLoop | None = None  # while it runs (its world hangs on it)
+    sim_time: float | None = None  # where it ended
+    task: asyncio.Task[None] | None = None
+    done: asyncio.Event = field(default_factory=asyncio.Event)
+
+    def as_dict(self) -> dict[str, Any]:
+        recording = self.out_dir / "recording.mcap"
+        sim_time = self.sim_time
+        if self.sim_loop is not None:
+            sim_time = self.sim_loop.time()  # the run's loop time is its sim time
+        return {
+            "id": self.id,
+            "scenario": self.scenario,
+            "status": self.status,
+            "sim_time_s": sim_time,
+            "verdict": self.verdict.as_dict() if self.verdict else None,
+            "error": self.error,
+            "recording": str(recording) if recording.exists() else None,
+        }
+
+
+class Runs:
+    """Simulation runs: each an asyncio task awaiting ``run_scenario_async``."""
+
+    def __init__(self, out_root: Path, max_runs: int) -> None:
+        self.out_root = out_root
+        self.max_runs = max_runs
+        self.limiter: anyio.CapacityLimiter | None = None
+        self.runs: dict[str, Run] = {}
+
+    def start(self, scenario: ScenarioConfig, stack: StackConfig, source: str) -> Run:
+        assert self.limiter is not None, "runs start once the app has started"
+        run_id = uuid.uuid4().hex[:12]
+        run = Run(run_id, scenario.name, self.out_root / run_id)
+        self.runs[run_id] = run
+        run.task = asyncio.get_running_loop().create_task(
+            self._execute(run, scenario, stack, source), name=f"run:{run_id}"
+        )
+        return run
+
+    async def _execute(
+        self, run: Run, scenario: ScenarioConfig, stack: StackConfig, source: str
+    ) -> None:
+        host = asyncio.get_running_loop()
+
+        def started(loop: asyncio.AbstractEventLoop, _task: asyncio.Task[None]) -> None:
+            run.sim_loop = loop  # called in the worker thread
+            host.call_soon_threadsafe(_mark_running, run)
+
+        try:
+            verdict = await run_scenario_async(
+                scenario,
+                stack,
+                out_dir=run.out_dir,
+                limiter=self.limiter,
+                on_start=started,
+                source=source,
+            )
+        except asyncio.CancelledError:
+            run.status = "cancelled"  # this task is the run: its cancellation ends here
+        except (ConfigFileError, SceneError) as exc:
+            run.status, run.error = "error", str(exc)
+        except Exception as exc:
+            log.exception("run %s failed", run.id)
+            run.status, run.error = "error", f"{type(exc).__name__}: {exc}"
+        else:
+            run.verdict = verdict
+            run.status = "passed" if verdict.passed else "failed"
+        finally:
+            if run.sim_loop is not None:
+                run.sim_time = run.verdict.sim_time_s if run.verdict else run.sim_loop.time()
+                run.sim_loop = None
+            run.done.set()
+
+    async def cancel(self, run: Run) -> None:
+        if run.task is not None and not run.task.done():
+            run.task.cancel()
+        await run.done.wait()
+
+    async def shutdown(self) -> None:
+        for run in self.runs.values():
+            if run.task is not None and not run.task.done():
+                run.task.cancel()
+        for run in self.runs.values():
+            await run.done.wait()
+
+
+def _mark_running(run: Run) -> None:
+    if run.status == "queued":
+        run.status = "running"
+
+
+# -- the app -----------------------------------------------------------------------------
+
+
+def _finite(value: Any) -> Any:
+    """JSON has no inf/nan: None stands for them."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    return value
+
+
+def _json(data: Any, status: int = 200) -> JSONResponse:
+    return JSONResponse(_finite(data), status_code=status)
+
+
+Handler = Callable[[Request], Awaitable[Response]]
+
+
+def _errors_as_4xx(handler: Handler) -> Handler:
+    async def wrapped(request: Request) -> Response:
+        try:
+            return await handler(request)
+        except BadRequest as exc:
+            return _json({"error": str(exc)}, exc.status)
+        except (ConfigFileError, SceneError) as exc:
+            return _json({"error": str(exc)}, 400)
+
+    return wrapped
+
+
+class Service:
+    def __init__(
+        self,
+        *,
+        out_root: Path,
+        stack: StackConfig = StackConfig(),
+        live: bool = True,
+        live_scale: float = 1.0,
+        live_record: Path | None = None,
+        max_runs: int = 2,
+    ) -> None:
+        self.stack = stack
+        self.live_enabled = live
+        self.live_scale = live_scale
+        self.live_record = live_record
+        self.runs = Runs(out_root, max_runs)
+        self.live: LiveStack | None = None
+
+    @asynccontextmanager
+    async def lifespan(self, _app: Starlette) -> AsyncIterator[None]:
+        self.runs.limiter = anyio.CapacityLimiter(self.runs.max_runs)
+        async with AsyncExitStack() as stack:
+            if self.live_enabled:
+                self.live = await stack.enter_async_context(
+                    open_live_stack(self.stack, scale=self.live_scale, record_to=self.live_record)
+                )
+            try:
+                yield
+            finally:
+                await self.runs.shutdown()
+                self.live = None
+
+    def app(self) -> Starlette:
+        routes = [
+            Route("/health", self.health, methods=["GET"]),
+            Route("/runs", _errors_as_4xx(self.post_run), methods=["POST"]),
+            Route("/runs", self.list_runs, methods=["GET"]),
+            Route("/runs/{run_id}", _errors_as_4xx(self.get_run), methods=["GET"]),
+            Route("/runs/{run_id}", _errors_as_4xx(self.delete_run), methods=["DELETE"]),
+            Route("/live/pose", _errors_as_4xx(self.live_pose), methods=["GET"]),
+            Route("/live/goal", _errors_as_4xx(self.live_goal), methods=["POST"]),
+            Route("/live/graph", _errors_as_4xx(self.live_graph), methods=["GET"]),
+        ]
+        return Starlette(routes=routes, lifespan=self.lifespan)
+
+    # -- handlers
+
+    async def health(self, _request: Request) -> Response:
+        live = self.live
+        active = sum(1 for r in self.runs.runs.values() if not r.done.is_set())
+        return _json(
+            {
+                "status": "ok",
+                "live": "running" if live is not None and live.running else "stopped",
+                "runs_active": active,
+            }
+        )
+
+    async def post_run(self, request: Request) -> Response:
+        body: RunRequest = _parse(RunRequest, await _json_body(request), "request")
+        scenario, source = resolve_scenario(body.scenario, body.seed)
+        stack = load_stack(None, body.set)
+        # What the CLI would reject before running (scene, goal): a 400 now, not a
+        # failed run later. Building the world takes milliseconds: off the loop.
+        await anyio.to_thread.run_sync(lambda: check_run(scenario, stack, source=source))
+        run = self.runs.start(scenario, stack, source)
+        return _json(run.as_dict(), 202)
+
+    async def list_runs(self, _request: Request) -> Response:
+        return _json([r.as_dict() for r in self.runs.runs.values()])
+
+    def _run(self, request: Request) -> Run:
+        run_id = request.path_params["run_id"]
+        run = self.runs.runs.get(run_id)
+        if run is None:
+            raise BadRequest(f"no run {run_id!r}", 404)
+        return run
+
+    async def get_run(self, request: Request) -> Response:
+        run = self._run(request)
+        wait = request.query_params.get("wait")
+        if wait is not None:
+            try:
+                seconds = float(wait)
+            except ValueError:
+                raise BadRequest(f"wait={wait!r}: expected seconds, e.g. wait=10") from None
+            with anyio.move_on_after(min(max(seconds, 0.0), MAX_WAIT_S)):
+                await run.done.wait()
+        return _json(run.as_dict())
+
+    async def delete_run(self, request: Request) -> Response:
+        run = self._run(request)
+        await self.runs.cancel(run)
+        return _json(run.as_dict())
+
+    def _live(self) -> LiveStack:
+        live = self.live
+        if live is None or not live.running:
+            reason = f": {live.failure}" if live is not None and live.failure else ""
+            raise BadRequest(f"the live robot is not running{reason}", 503)
+        return live
+
+    async def live_pose(self, request: Request) -> Response:
+        live = self._live()
+        raw = request.query_params.get("hz", "10")
+        try:
+            hz = float(raw)
+        except ValueError:
+            hz = math.nan
+        if not 0 < hz <= 100:
+            raise BadRequest(f"hz={raw!r}: expected a rate in (0, 100]")
+        return StreamingResponse(
+            _poses(live, 1.0 / hz),
+            media_type="text/event-stream",
+            headers={"Cache-Control": "no-cache"},
+        )
+
+    async def live_goal(self, request: Request) -> Response:
+        live = self._live()
+        goal: GoalRequest = _parse(GoalRequest, await _json_body(request), "goal")
+        check_goal(
+            ScenarioConfig(scene=self.stack.world.scene, goal=GoalSpec(x=goal.x, y=goal.y)),
+            live.hal.obstacles(),
+            live.hal.walls(),
+            source="goal",
+        )
+        await live.publish_goal(goal.x, goal.y)
+        return _json({"goal": {"x": goal.x, "y": goal.y}, "sim_time_s": live.now()}, 202)
+
+    async def live_graph(self, _request: Request) -> Response:
+        live = self._live()
+        graph = live.graph()
+        return _json(
+            {
+                "sim_time_s": live.now(),
+                "slip_s": live.slip_s,
+                "actors": [
+                    {"name": a.name, "kind": a.kind, "status": a.status, "restarts": a.restarts}
+                    for a in graph.actors
+                ],
+                "topics": [
+                    {
+                        "name": t.name,
+                        "type": t.type,
+                        "publishers": [
+                            {"actor": p.actor, "qos": p.qos, "published": p.published}
+                            for p in t.publishers
+                        ],
+                        "subscriptions": [
+                            {"actor": s.actor, "qos": s.qos, **s.statistics._asdict()}
+                            for s in t.subscriptions
+                        ],
+                    }
+                    for t in graph.topics
+                ],
+            }
+        )
+
+
+async def _poses(live: LiveStack, period: float) -> AsyncIterator[str]:
+    """Odometry as SSE events, at most one per ``period`` s of sim time. Ends when the
+    client goes away (the stream is cancelled) or the live stack closes."""
+    last = -math.inf
+    async with live.subscribe(topics.ODOM, Odometry, POSE_QOS) as odom:
+        async for message in odom:
+            t = message.header.stamp.to_seconds()
+            if t - last < period - 1e-9:
+                continue
+            last = t
+            pose = message.pose.pose
+            data = {"t": t, "x": pose.position.x, "y": pose.position.y}
+            data["yaw"] = pose.orientation.yaw()
+            yield f"event: pose\ndata: {json.dumps(data)}\n\n"
+
+
+def create_app(**options: Any) -> Starlette:
+    """The app; ``options`` are :class:`Service`'s (``out_root`` is required)."""
+    return Service(**options).app()
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="otonav-service", description=__doc__.split("\n")[0])
+    parser.add_argument("--host", default="127.0.0.1", help="bind address (default loopback)")
+    parser.add_argument("--port", type=int, default=8000, help="0: any free port")
+    parser.add_argument("--out", type=Path, default=Path("out/service"), help="artifacts")
+    parser.add_argument("--config", type=Path, help="stack config YAML (live robot and runs)")
+    parser.add_argument("--set", dest="overrides", action="append", default=[])
+    parser.add_argument("--no-live", action="store_true", help="no live robot")
+    parser.add_argument("--live-scale", type=float, default=1.0, help="sim s per wall s")
+    parser.add_argument("--no-live-record", action="store_true")
+    parser.add_argument("--max-runs", type=int, default=2, help="simulations at once")
+    args = parser.parse_args(argv)
+    try:
+        stack = load_stack(args.config, args.overrides)
+    except ConfigFileError as exc:
+        print(f"otonav: error: {exc}", file=sys.stderr)
+        return 2
+    out: Path = args.out
+    service = Service(
+        out_root=out / "runs",
+        stack=stack,
+        live=not args.no_live,
+        live_scale=args.live_scale,
+        live_record=None if args.no_live_record else out / "live.mcap",
+        max_runs=args.max_runs,
+    )
+    # Bind first, so the address is known (port 0) before the server starts accepting.
+    # proto=IPPROTO_TCP matters: asyncio sets TCP_NODELAY only on sockets that say they
+    # are TCP; without it Nagle + delayed ACKs add ~40 ms to every response.
+    family = socket.AF_INET6 if ":" in args.host else socket.AF_INET
+    sock = socket.socket(family, socket.SOCK_STREAM, socket.IPPROTO_TCP)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    sock.bind((args.host, args.port))
+    sock.listen(128)
+    host, port = sock.getsockname()[:2]
+    print(f"otonav service listening on http://{host}:{port}", flush=True)
+    config = uvicorn.Config(
+        service.app(), log_level="warning", lifespan="on", timeout_graceful_shutdown=2
+    )
+    uvicorn.Server(config).run(sockets=[sock])
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,311 @@
+"""The example service (examples/service/app.py), started for real on 127.0.0.1 with an
+ephemeral port and driven over HTTP: a responsive host loop while simulations run, a
+live pose stream, cancellation leaving an indexed recording, bad input as 4xx with the
+CLI's message, and the same verdict and recording bytes from every way of running."""
+
+from __future__ import annotations
+
+import asyncio
+import itertools
+import json
+import math
+import selectors
+import signal
+import statistics
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import httpx
+import pytest
+
+from otonav.cli import main as cli_main
+from otonav.embed import run_scenario_async
+from otonav.record.reader import summarize
+from otonav.scenario import run_scenario
+from otonav.scenario.builtin import BUILTIN
+
+pytestmark = pytest.mark.smoke
+
+REPO = Path(__file__).resolve().parents[2]
+APP = REPO / "examples" / "service" / "app.py"
+START_CEILING_S = 30.0
+HEALTH_BUDGET_S = 0.050
+# Reaches no goal (the navigator stops 8 cm short of a 1 mm tolerance): it runs until
+# cancelled or its sim budget (minutes of sim time) is spent.
+ENDLESS: dict[str, Any] = {
+    "name": "endless",
+    "scene": "empty",
+    "goal": {"x": 3.0, "y": -1.0},
+    "goal_tolerance": 0.001,
+    "sim_budget": 600.0,
+}
+VOLATILE = {"wall_time_s", "rtf", "recording", "plot"}
+
+
+@dataclass(frozen=True, slots=True)
+class Server:
+    url: str
+    out: Path
+    process: subprocess.Popen[str]
+
+
+def _first_line(process: subprocess.Popen[str], within: float) -> str:
+    assert process.stdout is not None
+    with selectors.DefaultSelector() as selector:
+        selector.register(process.stdout, selectors.EVENT_READ)
+        if not selector.select(within):
+            raise AssertionError(f"the service printed no address within {within} s")
+    return process.stdout.readline()
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
+    out = tmp_path_factory.mktemp("service")
+    stderr = (out / "stderr.log").open("w")
+    process = subprocess.Popen(
+        [sys.executable, str(APP), "--port", "0", "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=stderr,
+        text=True,
+        cwd=out,
+    )
+    try:
+        line = _first_line(process, START_CEILING_S)
+        assert "listening on http://127.0.0.1:" in line, line
+        url = line.split()[-1]
+        # The socket listens before uvicorn starts: this waits for startup, no polling.
+        health = httpx.get(f"{url}/health", timeout=START_CEILING_S)
+        assert health.json()["live"] == "running"
+        yield Server(url, out, process)
+    finally:
+        process.terminate()  # SIGTERM: uvicorn shuts down, the lifespan closes the stack
+        try:
+            code = process.wait(timeout=20)
+        finally:
+            if process.poll() is None:
+                process.kill()
+            stderr.close()
+            if process.stdout is not None:
+                process.stdout.close()
+    log = (out / "stderr.log").read_text()
+    # After its graceful shutdown uvicorn re-raises the signal it caught: -SIGTERM.
+    assert code in (0, -signal.SIGTERM), log
+    assert "Traceback" not in log, log
+    live = summarize(out / "live.mcap")
+    assert live.truncated is False
+    assert live.message_count > 0
+
+
+@pytest.fixture
+def client(server: Server) -> Iterator[httpx.Client]:
+    with httpx.Client(base_url=server.url, timeout=10.0) as http:
+        yield http
+
+
+def _start(client: httpx.Client, body: dict[str, Any]) -> str:
+    response = client.post("/runs", json=body)
+    assert response.status_code == 202, response.text
+    run_id: str = response.json()["id"]
+    return run_id
+
+
+def _wait_status(client: httpx.Client, run_id: str, until: Any, within: float) -> dict[str, Any]:
+    """Ask until ``until(run)``; each ask waits up to 50 ms server-side for the run's end."""
+    deadline = time.monotonic() + within
+    while True:
+        run: dict[str, Any] = client.get(f"/runs/{run_id}", params={"wait": 0.05}).json()
+        if until(run):
+            return run
+        assert time.monotonic() < deadline, f"run never satisfied the condition: {run}"
+
+
+def test_health_answers_within_50ms_while_simulations_run(client: httpx.Client) -> None:
+    runs = [_start(client, {"scenario": ENDLESS}) for _ in range(2)]
+    for run_id in runs:
+        _wait_status(client, run_id, lambda r: r["status"] == "running", within=10)
+    first = [client.get(f"/runs/{r}").json()["sim_time_s"] for r in runs]
+    latencies = []
+    with httpx.Client(base_url=client.base_url, timeout=5.0) as probe:
+        for _ in range(25):
+            start = time.perf_counter()
+            response = probe.get("/health")
+            latencies.append(time.perf_counter() - start)
+            assert response.status_code == 200
+            assert response.json()["runs_active"] == 2
+    # Both simulations were running through every probe (and made progress).
+    after = [client.get(f"/runs/{r}").json() for r in runs]
+    assert all(r["status"] == "running" for r in after)
+    assert all(a["sim_time_s"] > f for a, f in zip(after, first, strict=True))
+    for run_id in runs:
+        assert client.delete(f"/runs/{run_id}").json()["status"] == "cancelled"
+    latencies.sort()
+    p90 = latencies[int(0.9 * (len(latencies) - 1))]
+    print(
+        f"\n/health during 2 simulations + the live robot: median "
+        f"{statistics.median(latencies) * 1e3:.1f} ms, p90 {p90 * 1e3:.1f} ms, "
+        f"max {latencies[-1] * 1e3:.1f} ms over {len(latencies)} probes"
+    )
+    assert p90 < HEALTH_BUDGET_S
+
+
+def test_cancelled_run_leaves_an_indexed_recording(client: httpx.Client) -> None:
+    run_id = _start(client, {"scenario": ENDLESS})
+    _wait_status(client, run_id, lambda r: (r["sim_time_s"] or 0) >= 2.0, within=20)
+    response = client.delete(f"/runs/{run_id}")
+    assert response.status_code == 200
+    run = response.json()
+    assert run["status"] == "cancelled"
+    assert run["recording"] is not None
+    summary = summarize(run["recording"])
+    assert summary.truncated is False
+    assert summary.end_ns / 1e9 >= 2.0
+    verdict = json.loads(summary.metadata["otonav"]["verdict"])
+    assert verdict["passed"] is False
+    assert "run ended early (CancelledError" in verdict["reason"]
+    # Cancelling again, or asking, says the same.
+    assert client.delete(f"/runs/{run_id}").json()["status"] == "cancelled"
+
+
+def _events(response: httpx.Response) -> Iterator[dict[str, float]]:
+    for line in response.iter_lines():
+        if line.startswith("data: "):
+            yield json.loads(line.removeprefix("data: "))
+
+
+def _host_subscribers(client: httpx.Client, topic: str) -> int:
+    graph = client.get("/live/graph").json()
+    (entry,) = [t for t in graph["topics"] if t["name"] == topic]
+    return sum(1 for s in entry["subscriptions"] if s["actor"] == "host")
+
+
+def test_live_pose_stream_moves_after_a_goal(client: httpx.Client) -> None:
+    with client.stream("GET", "/live/pose", params={"hz": 20}, timeout=5.0) as response:
+        assert response.status_code == 200
+        assert response.headers["content-type"].startswith("text/event-stream")
+        events = _events(response)
+        before = [next(events) for _ in range(5)]
+        times = [e["t"] for e in before]
+        assert all(b - a >= 0.05 - 1e-6 for a, b in itertools.pairwise(times))
+        assert _host_subscribers(client, "/odom") == 1
+        start = before[-1]
+        posted = client.post("/live/goal", json={"x": 1.0, "y": 0.2})
+        assert posted.status_code == 202, posted.text
+        deadline = time.monotonic() + 15.0
+        for event in events:
+            if math.hypot(event["x"] - start["x"], event["y"] - start["y"]) > 0.2:
+                break
+            assert time.monotonic() < deadline, f"the robot did not move: {event}"
+    # The stream's mailbox left the topic with the client (no leak per connection).
+    deadline = time.monotonic() + 5.0
+    while _host_subscribers(client, "/odom"):
+        assert time.monotonic() < deadline, "the closed stream still subscribes to /odom"
+
+
+def _cli_error(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
+    assert cli_main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("otonav: error: "), err
+    return err.removeprefix("otonav: error: ")
+
+
+def test_bad_input_gets_4xx_with_the_cli_message(
+    client: httpx.Client, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    out = str(tmp_path / "cli")
+    mars = tmp_path / "mars.yaml"
+    mars.write_text("scene: mars\n")
+    same_as_cli = [
+        ({"scenario": "nope"}, ["run", "--scenario", "nope"]),
+        ({"set": ["nav.kp_lin=-1"]}, ["run", "--set", "nav.kp_lin=-1"]),
+        ({"set": ["nav.bogus=1"]}, ["run", "--set", "nav.bogus=1"]),
+        ({"set": ["rates.odom_hz=fast"]}, ["run", "--set", "rates.odom_hz=fast"]),
+        ({"set": ["nav"]}, ["run", "--set", "nav"]),
+        ({"scenario": {"scene": "mars"}}, ["run", "--scenario", str(mars)]),
+    ]
+    for body, argv in same_as_cli:
+        response = client.post("/runs", json=body)
+        assert response.status_code == 400, (body, response.text)
+        assert response.json()["error"] == _cli_error([*argv, "--out", out], capsys), body
+
+    outside = tmp_path / "outside.yaml"
+    outside.write_text("goal: {x: 40, y: 0}\n")
+    cli = _cli_error(["run", "--scenario", str(outside), "--out", out], capsys)
+    response = client.post("/runs", json={"scenario": {"goal": {"x": 40, "y": 0}}})
+    assert response.status_code == 400
+    # The same message; the CLI names the file where the service says "scenario".
+    assert cli.removeprefix(f"{outside}: ") == response.json()["error"].removeprefix("scenario: ")
+
+    cases: list[tuple[str, str, dict[str, Any], int, str]] = [
+        ("POST", "/runs", {"content": b"{nope"}, 400, "request body: invalid JSON"),
+        ("POST", "/runs", {"json": {"bogus": 1}}, 400, "request: bogus: unknown key"),
+        ("POST", "/runs", {"json": {"scenario": {"goal_tolerance": -1}}}, 400, "scenario: "),
+        ("POST", "/runs", {"json": {"scenario": "../etc/passwd"}}, 400, "reads no files"),
+        ("POST", "/runs", {"json": {"scenario": {"scene": "/etc/passwd"}}}, 400, "no files"),
+        ("POST", "/runs", {"json": {"seed": -3}}, 400, "--seed: seed:"),
+        ("GET", "/runs/nope", {}, 404, "no run 'nope'"),
+        ("DELETE", "/runs/nope", {}, 404, "no run 'nope'"),
+        ("GET", "/live/pose", {"params": {"hz": "0"}}, 400, "hz='0'"),
+        ("POST", "/live/goal", {"json": {"x": "far", "y": 0}}, 400, "goal: x:"),
+        ("POST", "/live/goal", {"json": {"x": 40, "y": 0}}, 400, "goal: goal: (40, 0)"),
+    ]
+    for method, path, kwargs, status, text in cases:
+        response = client.request(method, path, **kwargs)
+        assert response.status_code == status, (path, kwargs, response.text)
+        error = response.json()["error"]
+        assert text in error, (path, kwargs, error)
+        assert "\n" not in error
+    health = client.get("/health").json()
+    assert health == {"status": "ok", "live": "running", "runs_active": 0}
+
+
+def _figures(verdict: dict[str, Any]) -> dict[str, Any]:
+    return {k: v for k, v in verdict.items() if k not in VOLATILE}
+
+
+def test_same_verdict_and_recording_from_cli_pytest_embedding_and_service(
+    client: httpx.Client, tmp_path: Path
+) -> None:
+    scenario = BUILTIN["empty"]
+    cli = subprocess.Popen(
+        [sys.executable, "-m", "otonav", "run", "--scenario", "empty", "--out", "cli"],
+        cwd=tmp_path,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        service_id = _start(client, {"scenario": "empty"})
+        direct = run_scenario(scenario, out_dir=tmp_path / "direct")
+        embedded = asyncio.run(run_scenario_async(scenario, out_dir=tmp_path / "embedded"))
+        served = client.get(f"/runs/{service_id}", params={"wait": 30}, timeout=40).json()
+        _, err = cli.communicate(timeout=60)
+    finally:
+        if cli.poll() is None:
+            cli.kill()
+    assert cli.returncode == 0, err
+    assert served["status"] == "passed", served
+
+    verdicts = {
+        "cli": json.loads((tmp_path / "cli" / "summary.json").read_text()),
+        "direct": direct.as_dict(),
+        "embedded": embedded.as_dict(),
+        "service": served["verdict"],
+    }
+    recordings = {
+        "cli": tmp_path / "cli" / "recording.mcap",
+        "direct": Path(str(direct.recording)),
+        "embedded": Path(str(embedded.recording)),
+        "service": Path(served["recording"]),
+    }
+    assert verdicts["direct"]["passed"] is True
+    reference = _figures(verdicts["direct"])
+    for name, verdict in verdicts.items():
+        assert _figures(verdict) == reference, name
+    data = recordings["direct"].read_bytes()
+    for name, path in recordings.items():
+        assert path.read_bytes() == data, f"{name}: {path} differs from {recordings['direct']}"
