@@ -12,16 +12,27 @@ from otonav.runtime.funnel import Funnel
 class Recorder(Actor):
     """Taps every topic as it appears (like ``ros2 bag record -a``) through one funnel,
     so the file keeps the global publish order and each message's sim instant. On stop
-    it drains what is left; the file's owner finishes it."""
+    it drains what is left; the file's owner finishes it.
+
+    It writes every ``period`` s of sim time what was published since (the funnel
+    stamps each message when it is published, so the file is the same bytes whatever the
+    period). Waking once per 10 ms instant instead cost ~10 us per wake: 13 % of the
+    recorder's cost in a 30 s run. A SIGKILL can lose up to ``period`` s more than the
+    last chunk; every other exit drains the funnel first.
+    """
 
     def __init__(
         self,
         writer: RecordingWriter,
         *,
         topics: Collection[str] | None = None,
+        period: float = 0.1,
         name: str = "recorder",
     ) -> None:
         super().__init__(name)
+        if not period > 0:
+            raise ValueError(f"recorder period must be > 0 s, got {period}")
+        self.period = period
         self.writer = writer
         self._wanted = frozenset(topics) if topics is not None else None
         self._funnel: Funnel | None = None
@@ -50,14 +61,10 @@ class Recorder(Actor):
         return self._funnel
 
     async def run(self) -> None:
-        funnel, write = self.funnel, self.writer.write
+        rate = self.clock.rate(1.0 / self.period)
         while True:
-            first = await funnel.recv()
-            write(first.topic, first.message, first.time)
-            # Everything published at this instant is queued: write it without
-            # going back to the loop for each message.
-            while (more := funnel.try_recv()) is not None:
-                write(more.topic, more.message, more.time)
+            await rate.sleep()
+            self.drain()
 
     def drain(self) -> None:
         """Write everything still queued (on stop, and before a verdict is appended)."""
