@@ -71,7 +71,7 @@ def generic(messages: list[Message], topic: str, path: Path) -> float:
         schema = writer.register_msgdef(name, text)
         for i, message in enumerate(messages):
             writer.write_message(topic, schema, message.model_dump(), log_time=i * 10_000_000)
-        writer.finish()
+        writer.finish()  # type: ignore[no-untyped-call]
     return len(messages) / (time.perf_counter() - start)
 
 
@@ -86,7 +86,7 @@ def main() -> None:
     ]
     with tempfile.TemporaryDirectory() as tmp:
         for label, topic, messages in cases:
-            rates = {"otonav": [], "mcap_ros2 generic": []}
+            rates: dict[str, list[float]] = {"otonav": [], "mcap_ros2 generic": []}
             for rep in range(args.reps):
                 rates["otonav"].append(ours(messages, topic, Path(tmp) / f"o{rep}.mcap"))
                 rates["mcap_ros2 generic"].append(
@@ -94,7 +94,8 @@ def main() -> None:
                 )
             mine, theirs = (statistics.median(r) for r in rates.values())
             print(
-                f"{label:<20} otonav {mine:>9,.0f} msg/s   mcap_ros2 generic {theirs:>8,.0f} msg/s   ratio {mine / theirs:.1f}x"
+                f"{label:<20} otonav {mine:>9,.0f} msg/s   "
+                f"mcap_ros2 generic {theirs:>8,.0f} msg/s   ratio {mine / theirs:.1f}x"
             )
 
 
