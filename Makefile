@@ -26,8 +26,10 @@ test: $(STAMP)
 lint: $(STAMP)
 	$(PY) scripts/gate.py static
 
+## the stack against bare physics (README "Performance"); the other benchmarks/ scripts
+## print the runtime, recording and acceptance figures
 bench: $(STAMP)
-	$(PY) benchmarks/runtime_bench.py
+	$(PY) -m otonav bench
 
 clean:
 	rm -rf $(VENV) .mypy_cache .ruff_cache .pytest_cache .hypothesis

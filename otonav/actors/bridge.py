@@ -65,6 +65,7 @@ class Bridge(Actor):
         odom_hz: float = 100.0,
         imu_hz: float = 100.0,
         scan_hz: float = 10.0,
+        initial_pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
         name: str = "bridge",
     ) -> None:
         super().__init__(name)
@@ -83,7 +84,7 @@ class Bridge(Actor):
             "imu": 1.0 / imu_hz,
             "scan": 1.0 / scan_hz,
         }
-        self._pose = Pose2D(0.0, 0.0, 0.0)
+        self._pose = Pose2D(*initial_pose)
         self._last_wheels: tuple[float, float] | None = None
         self._last_odom_time = 0.0
         self._imu_sample: ImuSample | None = None

@@ -260,7 +260,8 @@ class MujocoInterface(RobotHardwareInterface):
     [``lidar_range_min``, ``lidar_range_max``] m, otherwise +inf. ``timestep`` (s)
     overrides the scene's. ``extra_obstacles`` become 0.5 m tall static boxes named
     ``obstacle_extra_<i>``. ``variant="no_caster_unlimited_torque"`` reproduces the
-    pitch bug (for regression tests only).
+    pitch bug (for regression tests only). ``start`` is the robot's pose (x, y, yaw)
+    in the world plane before it settles.
     """
 
     def __init__(
@@ -273,6 +274,7 @@ class MujocoInterface(RobotHardwareInterface):
         timestep: float | None = None,
         extra_obstacles: Sequence[BoxObstacle] = (),
         variant: Variant = "shipped",
+        start: tuple[float, float, float] = (0.0, 0.0, 0.0),
     ) -> None:
         if lidar_beams < 1:
             raise ValueError(f"lidar_beams must be >= 1, got {lidar_beams}")
@@ -366,6 +368,12 @@ class MujocoInterface(RobotHardwareInterface):
         self._ray_dist = np.full(lidar_beams, -1.0)
         self._nbeams = lidar_beams
 
+        # Place the robot at its start pose (x, y, yaw) in the world plane.
+        x0, y0, yaw0 = start
+        p = self._base_qpos
+        self._data.qpos[p] = x0
+        self._data.qpos[p + 1] = y0
+        self._data.qpos[p + 3 : p + 7] = (math.cos(yaw0 / 2), 0.0, 0.0, math.sin(yaw0 / 2))
         # Let the robot settle onto its wheels and caster (contacts start at zero force)
         # so tick 0 is a robot at rest: the IMU reads +g, not free fall.
         mujoco.mj_step(m, self._data, nstep=max(1, round(_SETTLE_TIME / self.tick)))

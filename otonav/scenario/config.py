@@ -28,6 +28,18 @@ class GoalSpec(BaseModel):
     y: float
 
 
+class StartSpec(BaseModel):
+    """The robot's start pose in the world: position (m), heading (rad, CCW from +x)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
+    x: float = 0.0
+    y: float = 0.0
+    yaw: float = 0.0
+
+    def as_tuple(self) -> tuple[float, float, float]:
+        return (self.x, self.y, self.yaw)
+
+
 class ScenarioConfig(BaseModel):
     """What to run and how to judge it. Defaults: the acceptance scenario."""
 
@@ -36,6 +48,8 @@ class ScenarioConfig(BaseModel):
     scene: str = "obstacles"
     """Built-in scene name or MJCF path (overrides the stack's ``world.scene``)."""
     obstacles: tuple[BoxSpec, ...] = ()
+    start: StartSpec = StartSpec()
+    """Where the robot starts; odometry starts there too (odom = world frame)."""
     goal: GoalSpec = GoalSpec(x=4.0, y=1.5)
     goal_tolerance: PositiveFloat = 0.15
     """m: reached when the true position is this close to the goal."""

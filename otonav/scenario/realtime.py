@@ -110,7 +110,11 @@ def run_scenario_realtime(
     if gui:
         check_display()
     stack = effective_stack(scenario, stack)
-    hal = build_world(stack, extra_obstacles=[b.to_obstacle() for b in scenario.obstacles])
+    hal = build_world(
+        stack,
+        extra_obstacles=[b.to_obstacle() for b in scenario.obstacles],
+        start=scenario.start.as_tuple(),
+    )
     viewer: ViewerHandle | None = None
     try:
         check_goal(scenario, hal.obstacles(), hal.walls())

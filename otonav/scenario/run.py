@@ -80,7 +80,8 @@ async def drive_to_goal(
     publish the goal on /goal, and wait in sim time until the judge says the robot is
     there or the budget is spent. Returns the stopped system. ``clock``: a
     :class:`RealTimeClock` for real-time mode (default: the virtual loop's time)."""
-    system = System([*before, *build_actors(stack, hal), judge], clock=clock)
+    actors = build_actors(stack, hal, initial_pose=scenario.start.as_tuple())
+    system = System([*before, *actors, judge], clock=clock)
     attach_rosout(system)
     async with system:
         goal = system.publisher(topics.GOAL, PoseStamped, LATCHED_QOS, name="scenario")
@@ -147,7 +148,11 @@ def run_scenario(
     thread cancels the run with ``loop.call_soon_threadsafe(task.cancel)``. A goal
     outside the arena or on an obstacle raises ``ConfigFileError`` naming ``source``."""
     stack = effective_stack(scenario, stack)
-    hal = build_world(stack, extra_obstacles=[b.to_obstacle() for b in scenario.obstacles])
+    hal = build_world(
+        stack,
+        extra_obstacles=[b.to_obstacle() for b in scenario.obstacles],
+        start=scenario.start.as_tuple(),
+    )
     try:
         check_goal(scenario, hal.obstacles(), hal.walls(), source=source)
     except BaseException:

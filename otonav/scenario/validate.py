@@ -35,24 +35,28 @@ def check_goal(
     *,
     source: str = "scenario",
 ) -> None:
-    """Raise :class:`ConfigFileError` when the goal is outside the arena or closer to an
-    obstacle than the clearance the scenario demands."""
-    gx, gy = scenario.goal.x, scenario.goal.y
+    """Raise :class:`ConfigFileError` when the goal or the start is outside the arena or
+    closer to an obstacle than the clearance the scenario demands."""
     bounds = arena_bounds(walls)
-    if bounds is not None:
-        x_min, x_max, y_min, y_max = bounds
-        if not (x_min < gx < x_max and y_min < gy < y_max):
-            raise ConfigFileError(
-                f"{source}: goal: ({gx:g}, {gy:g}) is outside the arena of scene "
-                f"'{scenario.scene}' (valid: x in ({x_min:g}, {x_max:g}), "
-                f"y in ({y_min:g}, {y_max:g}))"
-            )
-    for box in obstacles:
-        gap = box.distance_to(gx, gy)
-        if gap < scenario.min_clearance:
-            where = "inside" if gap == 0 else f"{gap:.2f} m from"
-            raise ConfigFileError(
-                f"{source}: goal: ({gx:g}, {gy:g}) is {where} the obstacle at "
-                f"({box.x:g}, {box.y:g}); a goal needs at least min_clearance = "
-                f"{scenario.min_clearance:g} m from every obstacle"
-            )
+    points = (
+        ("goal", scenario.goal.x, scenario.goal.y),
+        ("start", scenario.start.x, scenario.start.y),
+    )
+    for key, px, py in points:
+        if bounds is not None:
+            x_min, x_max, y_min, y_max = bounds
+            if not (x_min < px < x_max and y_min < py < y_max):
+                raise ConfigFileError(
+                    f"{source}: {key}: ({px:g}, {py:g}) is outside the arena of scene "
+                    f"'{scenario.scene}' (valid: x in ({x_min:g}, {x_max:g}), "
+                    f"y in ({y_min:g}, {y_max:g}))"
+                )
+        for box in obstacles:
+            gap = box.distance_to(px, py)
+            if gap < scenario.min_clearance:
+                where = "inside" if gap == 0 else f"{gap:.2f} m from"
+                raise ConfigFileError(
+                    f"{source}: {key}: ({px:g}, {py:g}) is {where} the obstacle at "
+                    f"({box.x:g}, {box.y:g}); it needs at least min_clearance = "
+                    f"{scenario.min_clearance:g} m from every obstacle"
+                )

@@ -18,8 +18,9 @@ def build_world(
     *,
     extra_obstacles: Sequence[BoxObstacle] = (),
     variant: Variant = "shipped",
+    start: tuple[float, float, float] = (0.0, 0.0, 0.0),
 ) -> RobotHardwareInterface:
-    """The simulated robot (MuJoCo) for ``config.world``."""
+    """The simulated robot (MuJoCo) for ``config.world``, placed at ``start``."""
     world = config.world
     return MujocoInterface(
         world.scene,
@@ -29,6 +30,7 @@ def build_world(
         timestep=world.timestep,
         extra_obstacles=extra_obstacles,
         variant=variant,
+        start=start,
     )
 
 
@@ -38,8 +40,10 @@ def build_actors(
     *,
     navigator: bool = True,
     goal: tuple[float, float] | None = None,
+    initial_pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
 ) -> list[Actor]:
-    """bridge + base controller (+ navigator) for ``hal``."""
+    """bridge + base controller (+ navigator) for ``hal``. ``initial_pose`` is where
+    odometry starts (the known start pose: odom is then the world frame)."""
     geometry = hal.geometry
     rates, base, nav, guard = config.rates, config.base, config.nav, config.guard
     actors: list[Actor] = [
@@ -49,6 +53,7 @@ def build_actors(
             odom_hz=rates.odom_hz,
             imu_hz=rates.imu_hz,
             scan_hz=rates.scan_hz,
+            initial_pose=initial_pose,
         ),
         BaseController(
             DiffDriveGeometry(geometry.wheel_radius, geometry.wheel_separation),

@@ -3,9 +3,11 @@ of sim time and never comes closer than 0.3 m to an obstacle (ground truth)."""
 
 from __future__ import annotations
 
+import math
+
 import pytest
 
-from otonav.scenario import ScenarioConfig, run_scenario
+from otonav.scenario import GoalSpec, ScenarioConfig, StartSpec, run_scenario
 from otonav.stack import NavConfig, StackConfig
 
 pytestmark = pytest.mark.sil
@@ -29,3 +31,18 @@ def test_gate_has_teeth_zero_linear_gain_fails() -> None:
     assert not verdict.reached
     assert verdict.sim_time_s == pytest.approx(20.0, abs=0.01)
     assert "did not reach the goal" in verdict.reason
+
+
+def test_start_pose_places_the_robot_and_its_odometry() -> None:
+    scenario = ScenarioConfig(
+        name="from_the_side",
+        scene="empty",
+        start=StartSpec(x=-1.0, y=1.0, yaw=math.pi / 2),
+        goal=GoalSpec(x=2.0, y=-1.0),
+    )
+    verdict = run_scenario(scenario, wall_ceiling=120)
+    assert verdict.passed, verdict.reason
+    # From the start pose, not the origin: the path is the straight 3.61 m less the
+    # 0.15 m tolerance, plus at most a little for the turn (facing +y, goal lower right).
+    straight = math.hypot(2.0 - -1.0, -1.0 - 1.0) - scenario.goal_tolerance
+    assert straight - 0.01 <= verdict.path_length_m < straight + 0.3

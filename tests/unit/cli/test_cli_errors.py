@@ -98,6 +98,13 @@ def test_goal_outside_the_arena(capsys: pytest.CaptureFixture[str], tmp_path: Pa
     )
 
 
+def test_start_inside_an_obstacle(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    f = _write(tmp_path / "s.yaml", "start: {x: 1.5, y: 1.4}\n")
+    _fails(
+        capsys, ["run", "--scenario", f, "--out", str(tmp_path)], f, "start", "inside the obstacle"
+    )
+
+
 def test_invalid_mjcf(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     xml = _write(
         tmp_path / "bad.xml", "<mujoco><worldbody><geom type='blob'/></worldbody></mujoco>"
