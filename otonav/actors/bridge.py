@@ -118,30 +118,30 @@ class Bridge(Actor):
         stream due then, in a fixed order (clock, odom, imu, scan): deterministic, and
         one wake per instant instead of one per stream."""
         start = self.clock.now()
-        counts = dict.fromkeys(self._periods, 0)
-        publishers = {
-            "clock": self._publish_clock,
-            "odom": self._publish_odom,
-            "imu": self._publish_imu,
-            "scan": self._publish_scan,
-        }
+        publishers = (
+            (self._periods["clock"], self._publish_clock),
+            (self._periods["odom"], self._publish_odom),
+            (self._periods["imu"], self._publish_imu),
+            (self._periods["scan"], self._publish_scan),
+        )
+        counts = [1] * len(publishers)
+        due = [start + period for period, _ in publishers]
         self._last_odom_time = start
         wheels = self.hal.read_wheels()  # odometry counts motion from the start
         self._last_wheels = (wheels.left_position, wheels.right_position)
+        clock = self.clock
         while True:
-            due = {
-                name: start + (counts[name] + 1) * period for name, period in self._periods.items()
-            }
-            instant = min(due.values())
-            await self.clock.sleep_until(instant)
+            instant = min(due)
+            await clock.sleep_until(instant)
             # A period that is not a whole number of ticks wakes at the next tick: stamp
             # (and integrate) with the instant the data is actually read at.
-            now = self.clock.now()
+            now = clock.now()
             stamp = Time.from_seconds(now)
-            for name, when in due.items():
-                if when <= instant + 1e-12:
-                    counts[name] += 1
-                    await publishers[name](stamp, now)
+            for i, (period, publish) in enumerate(publishers):
+                if due[i] <= instant + 1e-12:
+                    counts[i] += 1
+                    due[i] = start + counts[i] * period  # no drift: k periods from start
+                    await publish(stamp, now)
 
     async def _publish_clock(self, stamp: Time, _now: float) -> None:
         await self.clock_out.publish(Clock.fast(clock=stamp))
