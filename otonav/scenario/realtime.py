@@ -24,13 +24,12 @@ from otonav.runtime import Actor, RealTimeClock
 from otonav.runtime.timesource import tick_rate
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
-from otonav.scenario.plot import plot_trajectory
 from otonav.scenario.run import (
     Verdict,
-    _close_recording,
     drive_to_goal,
     effective_stack,
     judge_verdict,
+    save_artifacts,
 )
 from otonav.scenario.validate import check_goal
 from otonav.stack import StackConfig, build_world
@@ -159,22 +158,12 @@ def run_scenario_realtime(
                         f"({judge.distance:.3f} m from the goal)"
                     ),
                 )
-            if writer is not None:
-                _close_recording(writer, recorder, scenario, stack, verdict)
-                verdict = replace(verdict, recording=str(writer.path))
+            # Finish the recording and draw the plot before the viewer and world go.
+            verdict = save_artifacts(
+                verdict, scenario, stack, judge, writer, recorder, out_dir, plot
+            )
         finally:
             if viewer is not None:
                 viewer.close()
             hal.close()
-        if out_dir is not None and plot:
-            png = plot_trajectory(
-                out_dir / "trajectory.png",
-                judge.trajectory,
-                judge.boxes,
-                (scenario.goal.x, scenario.goal.y),
-                scenario.goal_tolerance,
-                judge.min_clearance_at,
-                f"{scenario.name}: {'PASSED' if verdict.passed else 'FAILED'}",
-            )
-            verdict = replace(verdict, plot=str(png))
     return verdict

@@ -181,21 +181,37 @@ def run_scenario(
         verdict = judge_verdict(scenario, judge, sim_time, time.perf_counter() - wall_start)
         if ended != "completed":
             verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
-        if writer is not None:
-            _close_recording(writer, recorder, scenario, stack, verdict)
-            verdict = replace(verdict, recording=str(writer.path))
         hal.close()
-        if out_dir is not None and plot:
-            png = plot_trajectory(
-                out_dir / "trajectory.png",
-                judge.trajectory,
-                judge.boxes,
-                (scenario.goal.x, scenario.goal.y),
-                scenario.goal_tolerance,
-                judge.min_clearance_at,
-                f"{scenario.name}: {'PASSED' if verdict.passed else 'FAILED'}",
-            )
-            verdict = replace(verdict, plot=str(png))
+        verdict = save_artifacts(verdict, scenario, stack, judge, writer, recorder, out_dir, plot)
+    return verdict
+
+
+def save_artifacts(
+    verdict: Verdict,
+    scenario: ScenarioConfig,
+    stack: StackConfig,
+    judge: Judge,
+    writer: RecordingWriter | None,
+    recorder: Recorder | None,
+    out_dir: Path | None,
+    plot: bool,
+) -> Verdict:
+    """Finish the recording (with the verdict appended) and draw the trajectory; the
+    verdict names both files."""
+    if writer is not None:
+        _close_recording(writer, recorder, scenario, stack, verdict)
+        verdict = replace(verdict, recording=str(writer.path))
+    if out_dir is not None and plot:
+        png = plot_trajectory(
+            out_dir / "trajectory.png",
+            judge.trajectory,
+            judge.boxes,
+            (scenario.goal.x, scenario.goal.y),
+            scenario.goal_tolerance,
+            judge.min_clearance_at,
+            f"{scenario.name}: {'PASSED' if verdict.passed else 'FAILED'}",
+        )
+        verdict = replace(verdict, plot=str(png))
     return verdict
 
 
