@@ -3,6 +3,7 @@ topic in a time range, and the cut-off case (no footer: the process was killed).
 
 from __future__ import annotations
 
+import struct
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -13,6 +14,10 @@ from mcap.reader import NonSeekingReader, make_reader
 from mcap_ros2.decoder import DecoderFactory
 
 MAGIC = b"\x89MCAP0\r\n"
+
+#: What mcap's readers raise where a file was cut off (a record or its length field
+#: ends mid-way: struct.error; a chunk ends early: EndOfFile, an McapError; ...).
+CUT_OFF_ERRORS = (McapError, EOFError, ValueError, KeyError, AssertionError, struct.error)
 
 
 class RecordingError(ValueError):
@@ -109,7 +114,7 @@ def summarize(path: str | Path) -> RecordingSummary:
                 sorted(topics, key=lambda t: t.topic),
                 metadata,
             )
-        except (McapError, EOFError, ValueError, KeyError, AssertionError):
+        except CUT_OFF_ERRORS:
             pass
     return _scan_truncated(path, size)
 
@@ -122,7 +127,7 @@ def _scan_truncated(path: Path, size: int) -> RecordingSummary:
         try:
             header = NonSeekingReader(f).get_header()
             profile, library = header.profile, header.library
-        except (McapError, EOFError, ValueError, KeyError, AssertionError):
+        except CUT_OFF_ERRORS:
             pass
     with path.open("rb") as f:
         reader = NonSeekingReader(f)
@@ -140,7 +145,7 @@ def _scan_truncated(path: Path, size: int) -> RecordingSummary:
                 t.last_ns = (
                     message.log_time if t.last_ns is None else max(t.last_ns, message.log_time)
                 )
-        except (McapError, EOFError, ValueError, KeyError, AssertionError):
+        except CUT_OFF_ERRORS:
             pass  # the cut: everything before it has been counted
     firsts = [t.first_ns for t in topics.values() if t.first_ns is not None]
     lasts = [t.last_ns for t in topics.values() if t.last_ns is not None]

@@ -6,11 +6,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from mcap.exceptions import McapError
 from mcap.reader import NonSeekingReader
 from mcap.writer import CompressionType, Writer
 
-from otonav.record.reader import RecordingError, _check_file
+from otonav.record.reader import CUT_OFF_ERRORS, RecordingError, _check_file
 from otonav.record.writer import CHUNK_SIZE
 
 
@@ -24,7 +23,7 @@ def salvage(source: str | Path, target: str | Path) -> int:
     with source.open("rb") as f:
         try:
             header = NonSeekingReader(f).get_header()
-        except (McapError, EOFError, ValueError) as exc:
+        except CUT_OFF_ERRORS as exc:
             raise RecordingError(f"{source}: no readable MCAP header ({exc})") from None
     with source.open("rb") as f, target.open("wb") as out:
         reader = NonSeekingReader(f)
@@ -53,7 +52,7 @@ def salvage(source: str | Path, target: str | Path) -> int:
                     sequence=message.sequence,
                 )
                 count += 1
-        except (McapError, EOFError, ValueError, KeyError, AssertionError):
+        except CUT_OFF_ERRORS:
             pass  # the cut-off point
         writer.finish()  # type: ignore[no-untyped-call]
     return count

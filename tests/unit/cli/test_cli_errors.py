@@ -140,3 +140,23 @@ def test_realtime_scale_must_be_positive(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
     _fails(capsys, ["run", "--realtime", "--scale", "0", "--out", str(tmp_path)], "--scale")
+
+
+def test_info_on_a_cut_off_recording_warns_and_still_shows_it(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    from otonav.msgs import Clock, Time
+    from otonav.record.writer import RecordingWriter
+
+    path = tmp_path / "cut.mcap"
+    writer = RecordingWriter(path, chunk_size=1024)
+    for i in range(500):
+        writer.write("/clock", Clock(clock=Time.from_seconds(i * 0.01)), i * 0.01)
+    writer._file.close()  # the process "dies" here: no finish(), no footer
+    cut = path.read_bytes()
+    path.write_bytes(cut[: len(cut) - 100])  # and the last chunk was half written
+    assert main(["info", str(path)]) == 0
+    out = capsys.readouterr()
+    assert "was cut off" in out.err
+    assert "otonav salvage" in out.err
+    assert "/clock" in out.out
