@@ -47,9 +47,12 @@ class Recorder(Actor):
         )
 
     def _now(self) -> float:
-        # Until the System hands out clocks, ask each time; then use the clock's own
-        # bound method (one call less per recorded message).
-        now = self.clock.now
+        # Until the System hands out clocks (a latched message replayed at wiring), the
+        # time is the start, 0; then use the clock's own bound method (one call less
+        # per recorded message).
+        if self._otonav_clock is None:
+            return 0.0
+        now = self._otonav_clock.now
         if self._funnel is not None:
             self._funnel._now = now
         return now()

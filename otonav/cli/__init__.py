@@ -47,6 +47,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (ConfigFileError, RecordingError, SceneError, NoDisplayError) as exc:
         print(f"otonav: error: {exc}", file=sys.stderr)
         return USAGE_ERROR
+    except OSError as exc:  # an unwritable --out, a directory given as a file, ...
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"otonav: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return USAGE_ERROR
     except KeyboardInterrupt:
         print("otonav: interrupted; the recording was finished and is readable", file=sys.stderr)
         return 130

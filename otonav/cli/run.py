@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import json
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -17,6 +18,7 @@ from otonav.cli.progress import ProgressLine
 from otonav.scenario import ScenarioConfig, Verdict, run_scenario
 from otonav.scenario.builtin import BUILTIN
 from otonav.scenario.realtime import run_scenario_realtime
+from otonav.scenario.run import finite_figures
 from otonav.stack import StackConfig
 from otonav.stack.files import ConfigFileError, describe_validation_error, load_model
 from otonav.stack.overrides import apply_overrides
@@ -70,10 +72,6 @@ def load_stack(config: Path | None, overrides: list[str]) -> StackConfig:
     return apply_overrides(stack, overrides) if overrides else stack
 
 
-def summary_dict(verdict: Verdict) -> dict[str, Any]:
-    return verdict.as_dict()
-
-
 def print_verdict(verdict: Verdict, console: Console) -> None:
     table = Table(
         title=f"scenario {verdict.scenario}: " + ("PASSED" if verdict.passed else "FAILED")
@@ -112,8 +110,10 @@ def main(args: argparse.Namespace) -> int:
     progress = ProgressLine() if sys.stderr.isatty() else None
     try:
         if args.gui or args.realtime:
-            if not args.scale > 0:
-                raise ConfigFileError(f"--scale {args.scale}: must be > 0 (sim s per wall s)")
+            if not (args.scale > 0 and math.isfinite(args.scale)):
+                raise ConfigFileError(
+                    f"--scale {args.scale}: must be a finite number > 0 (sim s per wall s)"
+                )
             verdict = run_scenario_realtime(
                 scenario,
                 stack,
@@ -139,7 +139,7 @@ def main(args: argparse.Namespace) -> int:
             progress.clear()
     out.mkdir(parents=True, exist_ok=True)
     summary = out / "summary.json"
-    summary.write_text(json.dumps(summary_dict(verdict), indent=2, default=str) + "\n")
+    summary.write_text(json.dumps(finite_figures(verdict.as_dict()), indent=2, default=str) + "\n")
     console = Console(highlight=False)
     print_verdict(verdict, console)
     console.print(f"summary: {summary}")

@@ -8,7 +8,6 @@ Reliable: when the funnel is full, publishers wait (backpressure); nothing is lo
 
 from __future__ import annotations
 
-import asyncio
 from collections import deque
 from collections.abc import Callable
 from typing import Any, NamedTuple
@@ -29,22 +28,27 @@ TAP_QOS = QoS(Reliability.BEST_EFFORT, depth=1)
 
 
 class _Tap(Subscription[Any]):
-    __slots__ = ("_funnel",)
+    __slots__ = ("_blocked_at", "_funnel")
 
     def __init__(self, funnel: Funnel, topic: Topic[Any], endpoint: Endpoint) -> None:
         super().__init__(topic.name, topic.msg_type, TAP_QOS, endpoint)
         self._funnel = funnel
+        self._blocked_at: float | None = None
 
     def _offer(self, message: Any) -> bool:
         funnel = self._funnel
         if len(funnel._queue) >= funnel.depth:
-            funnel._blocked.add(self)
+            # Full: the publisher waits. Remember when it published, so the message is
+            # stamped with that instant, not with the instant room was found.
+            if self._blocked_at is None:
+                self._blocked_at = funnel._now()
+            funnel._blocked.append(self)  # one entry per waiting publisher
             return False
-        funnel._queue.append(Delivery(self.topic, funnel._now(), message))
+        stamp, self._blocked_at = self._blocked_at, None
+        funnel._queue.append(
+            Delivery(self.topic, funnel._now() if stamp is None else stamp, message)
+        )
         self.received += 1
-        waiter = funnel._waiter
-        if waiter is not None and not waiter.done():
-            waiter.set_result(None)
         return True
 
     def _full(self) -> bool:
@@ -68,8 +72,7 @@ class Funnel:
         self._now = now
         self._wanted = wanted
         self._queue: deque[Delivery] = deque()
-        self._waiter: asyncio.Future[None] | None = None
-        self._blocked: set[_Tap] = set()
+        self._blocked: deque[_Tap] = deque()
         self.taps: dict[str, _Tap] = {}
         for topic in list(bus.topics.values()):
             self._tap(topic)
@@ -87,31 +90,17 @@ class Funnel:
                 tap._offer(message)
 
     def _took(self) -> None:
-        if self._blocked:
-            # Room again: wake every waiting publisher, in a deterministic order.
-            for tap in sorted(self._blocked, key=lambda t: t.topic):
-                while tap._space_waiters:
-                    waiter = tap._space_waiters.popleft()
-                    if not waiter.done():
-                        waiter.set_result(None)
-            self._blocked.clear()
+        # Room again: wake the blocked publishers in the order they blocked (FIFO).
+        while self._blocked:
+            self._blocked.popleft()._wake_room()
 
     def try_recv(self) -> Delivery | None:
+        """The oldest delivery, or None when the funnel is empty (the recorder drains it
+        on its own period: nothing waits on it)."""
         if not self._queue:
             return None
         delivery = self._queue.popleft()
         self.taps[delivery.topic].taken += 1
-        self._took()
-        return delivery
-
-    async def recv(self) -> Delivery:
-        while not self._queue:
-            self._waiter = asyncio.get_running_loop().create_future()
-            try:
-                await self._waiter
-            finally:
-                self._waiter = None
-        delivery = self._queue.popleft()
-        self.taps[delivery.topic].taken += 1
-        self._took()
+        if self._blocked:
+            self._took()
         return delivery

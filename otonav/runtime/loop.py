@@ -298,16 +298,18 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         owner: asyncio.Future[_T] = asyncio.ensure_future(future, loop=self)  # type: ignore[arg-type]
         self._owner = owner
         self._wall_start = time.monotonic()
-        result: _T | None = None
         try:
             result = super().run_until_complete(owner)
-        except (asyncio.CancelledError, RuntimeError):
-            if self._failure is None:
+        except BaseException as exc:
+            failure = self._failure
+            if failure is None:
                 raise
+            # Whatever the run turned the cancellation into, the cause is the failure.
+            raise failure from (None if isinstance(exc, asyncio.CancelledError) else exc)
         finally:
             self._owner = None
-        failure, self._failure = self._failure, None
-        if failure is not None:
+            failure, self._failure = self._failure, None
+        if failure is not None:  # the run swallowed its cancellation and returned
             raise failure
         return result
 

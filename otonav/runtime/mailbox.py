@@ -108,17 +108,27 @@ class Subscription(Generic[M]):
         self._space_waiters.append(waiter)
         try:
             await waiter
+        except BaseException:
+            # Cancelled after being given the room: hand it to the next publisher, or
+            # it would wait although there is room (a lost wakeup).
+            if waiter.done() and not waiter.cancelled():
+                self._wake_room()
+            raise
         finally:
             if waiter in self._space_waiters:
                 self._space_waiters.remove(waiter)
 
-    def _took_one(self) -> None:
-        self.taken += 1
+    def _wake_room(self) -> None:
         while self._space_waiters:
             waiter = self._space_waiters.popleft()
             if not waiter.done():
                 waiter.set_result(None)
                 return
+
+    def _took_one(self) -> None:
+        self.taken += 1
+        if self._space_waiters:
+            self._wake_room()
 
     def try_recv(self) -> M | None:
         """The oldest waiting message, or None when the mailbox is empty."""

@@ -11,7 +11,7 @@ class BoxSpec(BaseModel):
     """An extra box obstacle: centre (m), full size (m), yaw (rad)."""
 
     # strict: "yes" is not 1.0 (files are validated in JSON mode, where lists are tuples)
-    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
     x: float
     y: float
     size_x: PositiveFloat
@@ -23,7 +23,7 @@ class BoxSpec(BaseModel):
 
 
 class GoalSpec(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
     x: float
     y: float
 
@@ -31,7 +31,7 @@ class GoalSpec(BaseModel):
 class StartSpec(BaseModel):
     """The robot's start pose in the world: position (m), heading (rad, CCW from +x)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
     x: float = 0.0
     y: float = 0.0
     yaw: float = 0.0
@@ -43,7 +43,7 @@ class StartSpec(BaseModel):
 class ScenarioConfig(BaseModel):
     """What to run and how to judge it. Defaults: the acceptance scenario."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
     name: str = "acceptance"
     scene: str = "obstacles"
     """Built-in scene name or MJCF path (overrides the stack's ``world.scene``)."""

@@ -14,6 +14,7 @@ import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
+from typing import Any
 
 from otonav.actors import topics
 from otonav.actors.recorder import Recorder
@@ -59,6 +60,13 @@ class Verdict:
 
     def as_dict(self) -> dict[str, object]:
         return asdict(self)
+
+
+def finite_figures(figures: dict[str, Any]) -> dict[str, Any]:
+    """JSON has no Infinity or NaN: a figure that is not finite becomes null."""
+    return {
+        k: None if isinstance(v, float) and not math.isfinite(v) else v for k, v in figures.items()
+    }
 
 
 def effective_stack(scenario: ScenarioConfig, stack: StackConfig) -> StackConfig:
@@ -155,13 +163,13 @@ def run_scenario(
     )
     try:
         check_goal(scenario, hal.obstacles(), hal.walls(), source=source)
+        writer = RecordingWriter(out_dir / "recording.mcap") if out_dir and record else None
     except BaseException:
         hal.close()
         raise
     judge = Judge(
         hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance, progress=progress
     )
-    writer = RecordingWriter(out_dir / "recording.mcap") if out_dir and record else None
     recorder = Recorder(writer) if writer else None
     wall_start = time.perf_counter()
     sim_time = 0.0
@@ -178,11 +186,17 @@ def run_scenario(
         ended = f"{type(exc).__name__} at sim time {sim_time:.3f} s: {exc}".strip().rstrip(":")
         raise
     finally:
-        verdict = judge_verdict(scenario, judge, sim_time, time.perf_counter() - wall_start)
-        if ended != "completed":
-            verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
-        hal.close()
-        verdict = save_artifacts(verdict, scenario, stack, judge, writer, recorder, out_dir, plot)
+        try:
+            verdict = judge_verdict(scenario, judge, sim_time, time.perf_counter() - wall_start)
+            if ended != "completed":
+                verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
+            verdict = save_artifacts(
+                verdict, scenario, stack, judge, writer, recorder, out_dir, plot
+            )
+        finally:
+            if writer is not None:
+                writer.finish()  # idempotent: reached even if the verdict or plot failed
+            hal.close()
     return verdict
 
 
@@ -254,7 +268,7 @@ def _close_recording(
                 "seed": str(scenario.seed),
                 "scenario_config": scenario.model_dump_json(),
                 "stack_config": stack.model_dump_json(),
-                "verdict": json.dumps(figures, sort_keys=True, default=str),
+                "verdict": json.dumps(finite_figures(figures), sort_keys=True, default=str),
             },
         )
     finally:

@@ -3,12 +3,15 @@ installed wheel runs with no checkout); YAML files in ``config/`` override them.
 
 from __future__ import annotations
 
+import math
+
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, model_validator
 
 
 class _Section(BaseModel):
     # strict: "yes" is not 1.0 and "3" is not 3 (a number in YAML is still a number).
-    model_config = ConfigDict(extra="forbid", frozen=True, strict=True)
+    # allow_inf_nan=False: '.inf' is a YAML float, and an infinite rate is a zero period.
+    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
 
 
 class WorldConfig(_Section):
@@ -59,7 +62,7 @@ class NavConfig(_Section):
 class GuardConfig(_Section):
     """Obstacle guard: front sector half-angle (rad) and stop distance (m)."""
 
-    sector_half_angle: float = Field(0.5, gt=0.0, le=3.1416)
+    sector_half_angle: float = Field(0.5, gt=0.0, le=math.pi)
     stop_distance: PositiveFloat = 0.35
 
 

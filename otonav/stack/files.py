@@ -31,6 +31,18 @@ def describe_validation_error(source: str, error: ValidationError) -> str:
     return f"{source}: " + "; ".join(problems)
 
 
+def to_json(data: object, source: str) -> str:
+    """YAML data as JSON for strict validation; a value JSON cannot hold (a YAML date,
+    a binary) is a configuration error naming where it is."""
+    try:
+        return json.dumps(data)
+    except (TypeError, ValueError) as exc:
+        raise ConfigFileError(
+            f"{source}: a value is not a number, string, list or mapping ({exc}); "
+            "quote it if it is meant as text"
+        ) from None
+
+
 def load_model(path: Path, model: type[_M]) -> _M:
     """Load ``path`` (YAML) as ``model``; raise :class:`ConfigFileError` on any problem."""
     try:
@@ -55,6 +67,6 @@ def load_model(path: Path, model: type[_M]) -> _M:
     try:
         # JSON mode: with strict models, YAML lists become tuples and mappings models,
         # while "yes" or "3" stay refused where a number is expected.
-        return model.model_validate_json(json.dumps(data))
+        return model.model_validate_json(to_json(data, str(path)))
     except ValidationError as exc:
         raise ConfigFileError(describe_validation_error(str(path), exc)) from None

@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import json
 from collections.abc import Sequence
 from typing import Any, TypeVar
 
 import yaml
 from pydantic import BaseModel, ValidationError
 
-from otonav.stack.files import ConfigFileError, describe_validation_error
+from otonav.stack.files import ConfigFileError, describe_validation_error, to_json
 
 _M = TypeVar("_M", bound=BaseModel)
 
@@ -42,8 +41,13 @@ def apply_overrides(model: _M, assignments: Sequence[str], *, source: str = "--s
             raise ConfigFileError(
                 f"{source} {key}: unknown key '{parts[-1]}'; valid keys here: {', '.join(node)}"
             )
+        if isinstance(node[parts[-1]], dict):
+            raise ConfigFileError(
+                f"{source} {key}: is a section; set its keys one by one, e.g. "
+                f"{key}.{next(iter(node[parts[-1]]), 'key')}=VALUE"
+            )
         node[parts[-1]] = value
     try:
-        return type(model).model_validate_json(json.dumps(data))
+        return type(model).model_validate_json(to_json(data, source))
     except ValidationError as exc:
         raise ConfigFileError(describe_validation_error(source, exc)) from None

@@ -7,7 +7,13 @@ import asyncio
 import anyio
 import pytest
 
-from otonav.runtime import DeadlockError, WallClockCeilingError, until, virtual_loop_factory
+from otonav.runtime import (
+    DeadlockError,
+    VirtualTimeLoop,
+    WallClockCeilingError,
+    until,
+    virtual_loop_factory,
+)
 
 pytestmark = pytest.mark.unit
 
@@ -55,3 +61,25 @@ def test_a_waiting_thread_is_not_a_deadlock() -> None:
         anyio.run(main, backend_options={"loop_factory": virtual_loop_factory(deadlock_grace=0.05)})
         == 7
     )
+
+
+def test_a_failure_is_raised_once_and_never_leaks_into_the_next_run() -> None:
+    loop = VirtualTimeLoop(deadlock_grace=0.05)
+
+    async def converts_its_cancellation() -> None:
+        try:
+            await asyncio.Event().wait()  # deadlock
+        except asyncio.CancelledError:
+            raise ValueError("converted") from None
+
+    async def fine() -> str:
+        await asyncio.sleep(1.0)
+        return "ok"
+
+    try:
+        with pytest.raises(DeadlockError) as err:
+            loop.run_until_complete(converts_its_cancellation())
+        assert isinstance(err.value.__cause__, ValueError)
+        assert loop.run_until_complete(fine()) == "ok"
+    finally:
+        loop.close()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import asyncio
 from dataclasses import dataclass
 
 import anyio
@@ -245,5 +246,24 @@ def test_unsubscribe_mid_backpressure_frees_the_publisher_and_skips_no_one() -> 
         # The publisher moved on and delivered to the next subscriber.
         assert [after.try_recv(), after.try_recv()] == [Ping(0), Ping(1)]
         assert bus.topics["/t"].subscriptions == [after]
+
+    _run(main)
+
+
+def test_a_publisher_cancelled_after_being_given_room_hands_it_on() -> None:
+    bus = Bus()
+    pub = bus.publisher("/t", Ping, endpoint=Endpoint("a", "o"))
+    sub = bus.subscribe("/t", Ping, QoS(depth=1), endpoint=Endpoint("b", "i"))
+
+    async def main() -> None:
+        await pub.publish(Ping(0))  # the mailbox is full
+        first = asyncio.ensure_future(pub.publish(Ping(1)))
+        second = asyncio.ensure_future(pub.publish(Ping(2)))
+        await anyio.sleep(0.1)  # both wait for room
+        assert sub.try_recv() == Ping(0)  # room for one: the first is woken...
+        first.cancel()  # ...but cancelled before it runs
+        await anyio.sleep(0.1)
+        assert second.done()  # the room went to the second publisher
+        assert sub.try_recv() == Ping(2)
 
     _run(main)
