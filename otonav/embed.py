@@ -529,12 +529,14 @@ def check_run(
     an unknown or broken scene (:class:`~otonav.hal.mujoco.SceneError`), a goal outside
     the arena or on an obstacle (:class:`~otonav.stack.files.ConfigFileError`). Builds
     the world once (milliseconds): call it from a worker thread on a busy loop."""
+    stack = effective_stack(scenario, stack)
     hal = build_world(
-        effective_stack(scenario, stack),
+        stack,
         extra_obstacles=[b.to_obstacle() for b in scenario.obstacles],
+        start=scenario.start.as_tuple(),
     )
     try:
-        check_goal(scenario, hal.obstacles(), hal.walls(), source=source)
+        check_goal(scenario, stack.world.scene, hal.obstacles(), hal.walls(), source=source)
     finally:
         hal.close()
 

@@ -58,7 +58,7 @@ from otonav.scenario import GoalSpec, ScenarioConfig, Verdict
 from otonav.scenario.builtin import BUILTIN
 from otonav.scenario.validate import check_goal
 from otonav.stack import StackConfig
-from otonav.stack.files import ConfigFileError, describe_validation_error
+from otonav.stack.files import ConfigFileError, describe_validation_error, to_json
 
 log = logging.getLogger("otonav.service")
 
@@ -121,10 +121,11 @@ def resolve_scenario(spec: str | dict[str, Any], seed: int | None) -> tuple[Scen
     if isinstance(spec, dict):
         source = "scenario"
         try:
-            scenario = ScenarioConfig.model_validate(spec)
+            # JSON mode, as for files: strict numbers, lists fit the tuple fields.
+            scenario = ScenarioConfig.model_validate_json(to_json(spec, source))
         except ValidationError as exc:
             raise ConfigFileError(describe_validation_error(source, exc)) from None
-        if _names_a_file(scenario.scene, (".xml",)):
+        if scenario.scene is not None and _names_a_file(scenario.scene, (".xml",)):
             raise ConfigFileError(
                 f"{source}: scene: {scenario.scene!r}: the service runs built-in scenes "
                 f"({', '.join(scene_names())}) and reads no files"
@@ -407,6 +408,7 @@ class Service:
         goal: GoalRequest = _parse(GoalRequest, await _json_body(request), "goal")
         check_goal(
             ScenarioConfig(scene=self.stack.world.scene, goal=GoalSpec(x=goal.x, y=goal.y)),
+            self.stack.world.scene,
             live.hal.obstacles(),
             live.hal.walls(),
             source="goal",

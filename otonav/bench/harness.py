@@ -82,7 +82,7 @@ async def _stack(
 def run_case(case: Case) -> Sample:
     """Run ``case`` once in this process; wall time excludes building the world."""
     scenario = ScenarioConfig()
-    stack = StackConfig(world=WorldConfig(scene=scenario.scene, lidar_beams=case.beams))
+    stack = StackConfig(world=WorldConfig(lidar_beams=case.beams))  # the obstacle scene
     goal = (scenario.goal.x, scenario.goal.y)
     if case.kind == "bare":
         hal = build_world(stack)

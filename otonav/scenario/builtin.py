@@ -14,6 +14,7 @@ BUILTIN: dict[str, ScenarioConfig] = {
 def describe(name: str) -> str:
     s = BUILTIN[name]
     return (
-        f"scene {s.scene}, goal ({s.goal.x:g}, {s.goal.y:g}) within {s.goal_tolerance:g} m, "
+        f"scene {s.scene or 'of the stack (obstacles)'}, "
+        f"goal ({s.goal.x:g}, {s.goal.y:g}) within {s.goal_tolerance:g} m, "
         f"{s.sim_budget:g} s budget, clearance {s.min_clearance:g} m"
     )

@@ -45,8 +45,8 @@ class ScenarioConfig(BaseModel):
 
     model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
     name: str = "acceptance"
-    scene: str = "obstacles"
-    """Built-in scene name or MJCF path (overrides the stack's ``world.scene``)."""
+    scene: str | None = None
+    """Built-in scene name or MJCF path; None: the stack's ``world.scene`` (obstacles)."""
     obstacles: tuple[BoxSpec, ...] = ()
     start: StartSpec = StartSpec()
     """Where the robot starts; odometry starts there too (odom = world frame)."""

@@ -116,7 +116,7 @@ def run_scenario_realtime(
     )
     viewer: ViewerHandle | None = None
     try:
-        check_goal(scenario, hal.obstacles(), hal.walls())
+        check_goal(scenario, stack.world.scene, hal.obstacles(), hal.walls())
         if gui:
             if not isinstance(hal, MujocoInterface):
                 raise TypeError(f"gui=True needs the MuJoCo world, got {type(hal).__name__}")

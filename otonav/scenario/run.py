@@ -70,7 +70,9 @@ def finite_figures(figures: dict[str, Any]) -> dict[str, Any]:
 
 
 def effective_stack(scenario: ScenarioConfig, stack: StackConfig) -> StackConfig:
-    """The stack config with the scenario's scene."""
+    """The stack config with the scenario's scene, if it names one."""
+    if scenario.scene is None:
+        return stack
     world = stack.world.model_copy(update={"scene": scenario.scene})
     return stack.model_copy(update={"world": world})
 
@@ -162,7 +164,7 @@ def run_scenario(
         start=scenario.start.as_tuple(),
     )
     try:
-        check_goal(scenario, hal.obstacles(), hal.walls(), source=source)
+        check_goal(scenario, stack.world.scene, hal.obstacles(), hal.walls(), source=source)
         writer = RecordingWriter(out_dir / "recording.mcap") if out_dir and record else None
     except BaseException:
         hal.close()

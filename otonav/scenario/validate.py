@@ -30,6 +30,7 @@ def arena_bounds(walls: tuple[BoxObstacle, ...]) -> tuple[float, float, float, f
 
 def check_goal(
     scenario: ScenarioConfig,
+    scene: str,
     obstacles: tuple[BoxObstacle, ...],
     walls: tuple[BoxObstacle, ...],
     *,
@@ -48,7 +49,7 @@ def check_goal(
             if not (x_min < px < x_max and y_min < py < y_max):
                 raise ConfigFileError(
                     f"{source}: {key}: ({px:g}, {py:g}) is outside the arena of scene "
-                    f"'{scenario.scene}' (valid: x in ({x_min:g}, {x_max:g}), "
+                    f"'{scene}' (valid: x in ({x_min:g}, {x_max:g}), "
                     f"y in ({y_min:g}, {y_max:g}))"
                 )
         for box in obstacles:

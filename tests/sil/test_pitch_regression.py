@@ -101,7 +101,8 @@ async def test_same_guard_on_the_shipped_model_is_never_falsely_blocked() -> Non
 @pytest.mark.sim(wall_ceiling=120)
 async def test_shipped_model_never_sees_the_floor_during_the_acceptance_run() -> None:
     scenario = ScenarioConfig()
-    watch = await _drive(scenario.scene, (scenario.goal.x, scenario.goal.y), "shipped", 15.0)
+    scene = scenario.scene or StackConfig().world.scene
+    watch = await _drive(scene, (scenario.goal.x, scenario.goal.y), "shipped", 15.0)
     assert watch.scans >= 140
     assert watch.floor_hits == 0
     assert watch.false_blocks == 0
