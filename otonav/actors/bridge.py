@@ -85,7 +85,8 @@ class Bridge(Actor):
             "scan": 1.0 / scan_hz,
         }
         self._pose = Pose2D(*initial_pose)
-        self._last_wheels: tuple[float, float] | None = None
+        self._last_wheels = (0.0, 0.0)
+        self._v = 0.0
         self._last_odom_time = 0.0
         self._imu_sample: ImuSample | None = None
         self._imu_time = -1.0
@@ -152,19 +153,17 @@ class Bridge(Actor):
         gyro_z = self._imu_at(now).angular_velocity[2]
         geometry = hal.geometry
         dt = now - self._last_odom_time
-        self._last_odom_time = now
-        if self._last_wheels is None or dt <= 0:
-            self._last_wheels = (wheels.left_position, wheels.right_position)
-            v = 0.0
-        else:
-            left0, right0 = self._last_wheels
+        v = self._v  # the same instant again: the same estimate
+        if dt > 0:  # 0 in real-time mode when the world ran past two instants at once
+            self._last_odom_time = now
+            left0, right0 = self._last_wheels  # first read at the start of the loop
             self._last_wheels = (wheels.left_position, wheels.right_position)
             distance = (
                 geometry.wheel_radius
                 * ((wheels.left_position - left0) + (wheels.right_position - right0))
                 / 2
             )
-            v = distance / dt
+            v = self._v = distance / dt
             self._pose = integrate_odometry(self._pose, v, gyro_z, dt)
         pose = self._pose
         header = Header.fast(stamp=stamp, frame_id="odom")

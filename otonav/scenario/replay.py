@@ -54,6 +54,8 @@ def plot_recording(recording: Path, png: Path | None = None) -> Path:
             obstacles = world.obstacles() + world.walls()
             world.close()
     target = png or recording.with_suffix(".png")
+    if target.suffix.lower() != ".png":  # matplotlib would append it: say the real name
+        target = target.with_name(target.name + ".png")
     return plot_trajectory(
         target,
         recorded_path(recording),

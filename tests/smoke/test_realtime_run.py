@@ -21,7 +21,9 @@ def test_realtime_run_reaches_the_goal_paced_to_the_scaled_wall_clock(tmp_path: 
     assert verdict.reached
     assert verdict.final_distance_m <= BUILTIN["empty"].goal_tolerance
     ratio = verdict.sim_time_s / verdict.wall_time_s
-    assert 0.5 * SCALE <= ratio <= 1.2 * SCALE, (
+    # Paced, not racing: never faster than the scale. (The lower bound only says sim time
+    # followed the wall at all; the stack alone runs at ~60x, far above 0.2 * SCALE.)
+    assert 0.2 * SCALE <= ratio <= 1.2 * SCALE, (
         f"sim {verdict.sim_time_s:.3f} s in wall {verdict.wall_time_s:.3f} s: "
         f"ratio {ratio:.2f}, expected about the scale {SCALE:g}"
     )
