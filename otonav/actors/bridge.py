@@ -92,18 +92,28 @@ class Bridge(Actor):
         self._imu_time = -1.0
 
     async def on_start(self) -> None:
+        """/tf_static: base_link -> laser and base_link -> imu_link (latched), so a
+        viewer can place the scan and the IMU."""
         geometry = self.hal.geometry
-        laser = TransformStamped.fast(
-            header=Header.fast(stamp=Time.from_seconds(self.clock.now()), frame_id="base_link"),
-            child_frame_id="laser",
-            transform=Transform.fast(
-                translation=Vector3.fast(
-                    x=geometry.laser_offset_x, y=0.0, z=geometry.laser_offset_z
+        header = Header.fast(stamp=Time.from_seconds(self.clock.now()), frame_id="base_link")
+
+        def fixed(child: str, x: float, y: float, z: float) -> TransformStamped:
+            return TransformStamped.fast(
+                header=header,
+                child_frame_id=child,
+                transform=Transform.fast(
+                    translation=Vector3.fast(x=x, y=y, z=z), rotation=Quaternion()
                 ),
-                rotation=Quaternion(),
-            ),
+            )
+
+        await self.tf_static.publish(
+            TFMessage.fast(
+                transforms=(
+                    fixed("laser", geometry.laser_offset_x, 0.0, geometry.laser_offset_z),
+                    fixed("imu_link", *geometry.imu_offset),
+                )
+            )
         )
-        await self.tf_static.publish(TFMessage.fast(transforms=(laser,)))
 
     async def run(self) -> None:
         async with anyio.create_task_group() as tg:

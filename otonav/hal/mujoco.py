@@ -397,12 +397,16 @@ class MujocoInterface(RobotHardwareInterface):
         if int(m.site_bodyid[self._lidar_site]) != self._chassis:
             raise SceneError(f"MJCF file {self._label}: site 'lidar' must be on 'chassis'")
         lidar = m.site_pos[self._lidar_site]
+        if int(m.site_bodyid[self._imu_site]) != self._chassis:
+            raise SceneError(f"MJCF file {self._label}: site 'imu' must be on 'chassis'")
+        imu = m.site_pos[self._imu_site]
         return RobotGeometry(
             wheel_radius=radius,
             wheel_separation=separation,
             laser_offset_x=float(lidar[0]),
             laser_offset_z=float(lidar[2]),
             base_height=float(m.qpos0[self._base_qpos + 2]),
+            imu_offset=(float(imu[0]), float(imu[1]), float(imu[2])),
         )
 
     def _static_boxes(self, prefix: str) -> tuple[BoxObstacle, ...]:

@@ -126,6 +126,8 @@ class RobotGeometry:
     laser_offset_x: float
     laser_offset_z: float
     base_height: float = 0.0
+    imu_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    """Position of the IMU (frame ``imu_link``, axes as base_link) in base_link, m."""
 
 
 @dataclass(frozen=True, slots=True)

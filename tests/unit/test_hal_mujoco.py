@@ -219,3 +219,14 @@ def test_obstacle_scene_layout() -> None:
     assert min(clearance) >= 0.45, clearance
     assert min(clearance) <= 1.5
     assert min(w.distance_to(*GOAL) for w in walls) >= 0.9
+
+
+def test_geometry_places_the_imu_site_in_base_link() -> None:
+    from otonav.hal.mujoco import MujocoInterface
+
+    hal = MujocoInterface("empty", lidar_beams=8)
+    try:
+        # robot.xml: <site name="imu" pos="0 0 0.02"/> on the chassis (= base_link).
+        assert hal.geometry.imu_offset == pytest.approx((0.0, 0.0, 0.02))
+    finally:
+        hal.close()

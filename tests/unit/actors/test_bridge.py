@@ -160,7 +160,7 @@ def test_scan_and_imu_carry_the_hardware_readings() -> None:
 # -- /tf_static and /tf ------------------------------------------------------------------
 
 
-def test_tf_static_base_link_to_laser_is_latched_for_a_late_subscriber() -> None:
+def test_tf_static_laser_and_imu_frames_are_latched_for_a_late_subscriber() -> None:
     hal = FakeHardware(laser_offset_x=0.12, laser_offset_z=0.2)
 
     async def main() -> None:
@@ -170,13 +170,18 @@ def test_tf_static_base_link_to_laser_is_latched_for_a_late_subscriber() -> None
             message = late.try_recv()
             assert message is not None, "a transient-local subscriber joining late got nothing"
             assert late.try_recv() is None  # published once
-            (transform,) = message.transforms
-            assert transform.header.frame_id == "base_link"
-            assert transform.child_frame_id == "laser"
-            assert transform.header.stamp.to_nanoseconds() == 0  # the bridge started at 0 s
-            t, q = transform.transform.translation, transform.transform.rotation
+            laser, imu = message.transforms
+            for transform in (laser, imu):
+                assert transform.header.frame_id == "base_link"
+                assert transform.header.stamp.to_nanoseconds() == 0  # started at 0 s
+                q = transform.transform.rotation
+                assert (q.x, q.y, q.z, q.w) == (0.0, 0.0, 0.0, 1.0)
+            assert laser.child_frame_id == "laser"
+            t = laser.transform.translation
             assert (t.x, t.y, t.z) == (0.12, 0.0, 0.2)
-            assert (q.x, q.y, q.z, q.w) == (0.0, 0.0, 0.0, 1.0)
+            assert imu.child_frame_id == "imu_link"  # /imu's frame, placed for viewers
+            t = imu.transform.translation
+            assert (t.x, t.y, t.z) == hal.geometry.imu_offset
 
     _run(hal, main)
 
