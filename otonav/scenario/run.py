@@ -62,6 +62,15 @@ class Verdict:
         return asdict(self)
 
 
+def otonav_version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("otonav")
+    except PackageNotFoundError:  # a source tree that was never installed
+        return "unknown"
+
+
 def finite_figures(figures: dict[str, Any]) -> dict[str, Any]:
     """JSON has no Infinity or NaN: a figure that is not finite becomes null."""
     return {
@@ -268,6 +277,7 @@ def _close_recording(
             {
                 "scenario": scenario.name,
                 "seed": str(scenario.seed),
+                "otonav_version": otonav_version(),
                 "scenario_config": scenario.model_dump_json(),
                 "stack_config": stack.model_dump_json(),
                 "verdict": json.dumps(finite_figures(figures), sort_keys=True, default=str),

@@ -38,6 +38,11 @@ def _assert_failed_recording(out: Path, scenario: ScenarioConfig) -> None:
     assert not summary.truncated
     assert {t.topic for t in summary.topics} == EXPECTED_TOPICS
     assert summary.duration_s == pytest.approx(scenario.sim_budget, abs=0.02)
+    meta = summary.metadata["otonav"]
+    assert meta["scenario"] == scenario.name
+    assert meta["seed"] == str(scenario.seed)
+    assert meta["otonav_version"] == "0.1.0"
+    assert ScenarioConfig.model_validate_json(meta["scenario_config"]) == scenario
     verdict = [m for _t, _s, m in read_messages(recording, ["/scenario/verdict"])][-1]
     assert not verdict.passed
     assert not verdict.reached
