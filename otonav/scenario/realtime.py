@@ -6,8 +6,6 @@ viewer: the same world, actors, judge, recording and verdict as
 from __future__ import annotations
 
 import asyncio
-import signal
-import threading
 import time
 from collections.abc import Callable
 from dataclasses import replace
@@ -29,6 +27,7 @@ from otonav.scenario.run import (
     drive_to_goal,
     effective_stack,
     judge_verdict,
+    run_task,
     save_artifacts,
 )
 from otonav.scenario.validate import check_goal
@@ -63,24 +62,13 @@ async def _main(
     closed_at: list[float],
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None,
 ) -> None:
-    # As run._main: SIGTERM cancels the run like Ctrl-C, so every finally runs.
-    loop = asyncio.get_running_loop()
-    task = asyncio.current_task()
-    in_main_thread = threading.current_thread() is threading.main_thread()
-    if in_main_thread and task is not None:
-        loop.add_signal_handler(signal.SIGTERM, task.cancel)
-    try:
+    with run_task(on_start):
         clock = RealTimeClock(hal, scale=scale)
-        if on_start is not None and task is not None:
-            on_start(loop, task)
         async with anyio.create_task_group() as tg:
             if viewer is not None:
                 tg.start_soon(_show, viewer, clock, closed_at, tg.cancel_scope)
             await drive_to_goal(scenario, stack, hal, judge, before=before, clock=clock)
             tg.cancel_scope.cancel()
-    finally:
-        if in_main_thread:
-            loop.remove_signal_handler(signal.SIGTERM)
 
 
 def run_scenario_realtime(

@@ -11,7 +11,7 @@ import math
 import signal
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -129,8 +129,17 @@ async def _main(
     before: tuple[Actor, ...],
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None,
 ) -> None:
-    # SIGTERM ends the run like Ctrl-C does (asyncio.Runner handles SIGINT): by
-    # cancellation, so every finally runs and the recording is finished.
+    with run_task(on_start):
+        await drive_to_goal(scenario, stack, hal, judge, before=before)
+
+
+@contextlib.contextmanager
+def run_task(
+    on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None,
+) -> Iterator[None]:
+    """The current task is a scenario run: hand it to ``on_start`` (a host that may
+    cancel it), and let SIGTERM end it like Ctrl-C does (asyncio.Runner handles SIGINT):
+    by cancellation, so every finally runs and the recording is finished."""
     loop = asyncio.get_running_loop()
     task = asyncio.current_task()
     if on_start is not None and task is not None:
@@ -139,9 +148,9 @@ async def _main(
     if in_main_thread and task is not None:
         loop.add_signal_handler(signal.SIGTERM, task.cancel)
     try:
-        await drive_to_goal(scenario, stack, hal, judge, before=before)
+        yield
     finally:
-        if in_main_thread:
+        if in_main_thread and task is not None:
             loop.remove_signal_handler(signal.SIGTERM)
 
 

@@ -113,7 +113,9 @@ def test_same_program_gives_identical_event_trace() -> None:
 
 def test_run_blocking_holds_sim_time_still() -> None:
     def blocking() -> str:
-        time.sleep(0.05)  # real blocking work in a worker thread
+        # Real blocking work in a worker thread: hashing 64 MB takes tens of ms and
+        # releases the GIL, so the loop could run on (and sim time race) if not held.
+        hashlib.sha256(bytes(64 * 1024 * 1024)).digest()
         return "done"
 
     ticks: list[float] = []
@@ -137,7 +139,7 @@ def test_run_blocking_holds_sim_time_still() -> None:
         main, backend_options={"loop_factory": virtual_loop_factory()}
     )
     assert result == "done"
-    assert after == before  # 50 ms of wall time in the thread, 0 s of sim time
+    assert after == before  # tens of ms of wall time in the thread, 0 s of sim time
 
 
 @pytest.mark.sim
