@@ -1,6 +1,7 @@
 """Salvage: rewrite the readable part of a cut-off recording as an indexed file (what
 ``mcap recover`` does): every message of every complete chunk, same schemas and
-channels, plus the metadata it still holds."""
+channels. Metadata records (written at the end by ``finish``) are not in a cut-off
+file, so there are none to copy."""
 
 from __future__ import annotations
 

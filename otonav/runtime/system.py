@@ -266,15 +266,19 @@ class System:
             suppressed = await self._tg.__aexit__(exc_type, exc, tb)
         except BaseExceptionGroup as group:
             # anyio wraps the body's own exception in a group: give the caller the
-            # exception it raised (a test sees its SimTimeoutError, not a group).
+            # exception it raised (a test sees its SimTimeoutError, not a group) --
+            # unless an actor crashed too: that is the cause, and it is raised.
             if exc is not None and group.exceptions == (exc,):
+                failure, self._failure = self._failure, None
+                if failure is not None:
+                    raise failure from exc
                 raise exc from None
             raise
         finally:
             self._tg = None
             _reset_clock(self._clock_token)
-        if self._failure is not None:
-            failure, self._failure = self._failure, None
+        failure, self._failure = self._failure, None
+        if failure is not None:
             raise failure
         return bool(suppressed)
 
