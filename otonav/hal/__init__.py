@@ -16,7 +16,7 @@ from otonav.hal.types import (
     WheelState,
 )
 
-__all__ = [
+__all__ = (
     "BoxObstacle",
     "FakeHardware",
     "GroundTruth",
@@ -26,4 +26,4 @@ __all__ = [
     "RobotHardwareInterface",
     "WheelCommand",
     "WheelState",
-]
+)
