@@ -241,3 +241,39 @@ async def test_fake_stack_reaches_a_goal_two_metres_away(goal: tuple[float, floa
 def test_rate_must_be_positive() -> None:
     with pytest.raises(ValueError, match="rate_hz"):
         Navigator(rate_hz=0.0)
+
+
+def test_a_scan_that_stops_arriving_makes_it_wait_after_scan_timeout() -> None:
+    """The guard fails safe when the lidar goes silent, not only before the first scan."""
+    from otonav.msgs import LaserScan, Odometry
+
+    states: list[tuple[float, str]] = []
+
+    async def main() -> None:
+        nav = Navigator(goal=(5.0, 0.0), scan_timeout=0.5)
+        async with System([nav]) as system:
+            odom = system.publisher(topics.ODOM, Odometry, topics.SENSOR_QOS)
+            scan = system.publisher(topics.SCAN, LaserScan, topics.SENSOR_QOS)
+            watch = system.subscribe(topics.NAV_STATE, NavState, OBSERVE)
+            far = LaserScan(
+                angle_min=-math.pi,
+                angle_increment=2 * math.pi / 8,
+                range_max=8.0,
+                ranges=(5.0,) * 8,
+            )
+            for k in range(40):  # odometry keeps coming; the lidar stops after 1 s
+                await odom.publish(Odometry())
+                if k < 10:
+                    await scan.publish(far)
+                await system.clock.sleep(0.1)
+            while (m := watch.try_recv()) is not None:
+                states.append((m.header.stamp.to_seconds(), m.state))
+
+    anyio.run(main, backend_options={"loop_factory": virtual_loop_factory()})
+    driving = [t for t, s in states if s == "driving"]
+    waiting_after = [t for t, s in states if s == "waiting" and t > 1.0]
+    assert driving
+    assert max(driving) <= 0.9 + 0.5 + NAV_PERIOD
+    assert waiting_after
+    assert min(waiting_after) > 0.9 + 0.5 - 1e-9
+    assert all(s == "waiting" for t, s in states if t > 0.9 + 0.5 + NAV_PERIOD)
