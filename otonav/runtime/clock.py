@@ -115,17 +115,36 @@ class RealTimeClock(Clock):
     The world is stepped lazily to follow the wall clock: whenever anyone asks for the
     time or wakes from a sleep, ``source`` is advanced to the tick the wall clock has
     reached. Watchers are evaluated after each advance.
+
+    ``max_step_batch`` (s of sim time) caps one advance: after the loop was held up (a
+    stalled host, a slow callback) the excess is dropped instead of stepped in one
+    burst; sim time slips behind the wall clock by it (:attr:`slip_s`) and follows it
+    again from there, as a simulator running below real time does. Run :meth:`pace`
+    alongside to step the world in small batches even while every actor sleeps.
     """
 
-    def __init__(self, source: TimeSource, *, scale: float = 1.0) -> None:
-        if not scale > 0:
-            raise ValueError(f"real-time scale must be > 0, got {scale!r}")
+    def __init__(
+        self, source: TimeSource, *, scale: float = 1.0, max_step_batch: float | None = None
+    ) -> None:
+        if not (scale > 0 and math.isfinite(scale)):
+            raise ValueError(f"real-time scale must be a finite number > 0, got {scale!r}")
+        if max_step_batch is not None and not max_step_batch > 0:
+            raise ValueError(f"max_step_batch must be > 0 s, got {max_step_batch!r}")
         self._source = source
         self._rate = tick_rate(source.tick)
         self.scale = scale
         self._ticks = 0
         self._wall0: float | None = None
         self._watchers: list[Callable[[], bool]] = []
+        self.max_batch_ticks = (
+            max(1, math.floor(max_step_batch * self._rate + 1e-9)) if max_step_batch else None
+        )
+        self.slipped_ticks = 0
+
+    @property
+    def slip_s(self) -> float:
+        """Sim seconds dropped so far (how far sim time fell behind the scaled wall)."""
+        return self.slipped_ticks / self._rate
 
     def _wall(self) -> float:
         loop = asyncio.get_running_loop()
@@ -144,7 +163,26 @@ class RealTimeClock(Clock):
     def _follow_wall(self) -> None:
         wall = self._wall()
         assert self._wall0 is not None
-        self._advance_to(math.floor((wall - self._wall0) * self.scale * self._rate + 1e-9))
+        ticks_per_wall_s = self.scale * self._rate
+        target = math.floor((wall - self._wall0) * ticks_per_wall_s + 1e-9)
+        if self.max_batch_ticks is not None:
+            excess = target - self._ticks - self.max_batch_ticks
+            if excess > 0:
+                # Slip: from now on the wall clock maps to sim time `excess` ticks later.
+                self._wall0 += excess / ticks_per_wall_s
+                self.slipped_ticks += excess
+                target -= excess
+        self._advance_to(target)
+
+    async def pace(self) -> None:
+        """Step the world to the wall clock every half batch of wall time, forever
+        (needs ``max_step_batch``)."""
+        if self.max_batch_ticks is None:
+            raise ValueError("pace() needs a RealTimeClock with max_step_batch")
+        period = self.max_batch_ticks / self._rate / self.scale / 2
+        while True:
+            await anyio.sleep(period)
+            self._follow_wall()
 
     def now(self) -> float:
         self._follow_wall()
@@ -156,10 +194,17 @@ class RealTimeClock(Clock):
         return self._wall0 + sim_time / self.scale
 
     async def sleep_until(self, sim_time: float) -> None:
-        await anyio.sleep_until(self.to_loop_time(sim_time))
-        self._follow_wall()
-        # A timer may fire a hair early; the world still reaches the asked instant.
-        self._advance_to(max(self._ticks, math.ceil(sim_time * self._rate - 1e-9)))
+        goal = math.ceil(sim_time * self._rate - 1e-9)
+        while True:
+            await anyio.sleep_until(self.to_loop_time(sim_time))
+            self._follow_wall()
+            if self._ticks >= goal:
+                return
+            if goal - self._ticks <= 1:
+                # The timer fired a hair early: the world still reaches the asked instant.
+                self._advance_to(goal)
+                return
+            # Sim time slipped while we slept: the instant is later on the wall clock now.
 
     def watch(self, check: Callable[[], bool]) -> Callable[[], None]:
         self._watchers.append(check)

@@ -88,6 +88,8 @@ class System:
         self._states: dict[str, _ActorState] = {}
         self.events: list[SystemEvent] = []
         self._event_listeners: list[Callable[[SystemEvent], None]] = []
+        self._running = 0  # supervisors still running; _all_done is set when none are
+        self._all_done: anyio.Event | None = None
         self._failure: ActorCrashedError | None = None
         self._tg: TaskGroup | None = None
         self._clock_token: contextvars.Token[Clock] | None = None
@@ -187,8 +189,13 @@ class System:
 
     async def _supervise(self, state: _ActorState) -> None:
         state.scope = anyio.CancelScope()
-        with state.scope:
-            await self._supervise_in_scope(state)
+        try:
+            with state.scope:
+                await self._supervise_in_scope(state)
+        finally:
+            self._running -= 1
+            if not self._running and self._all_done is not None:
+                self._all_done.set()
 
     async def _supervise_in_scope(self, state: _ActorState) -> None:
         actor = state.actor
@@ -248,6 +255,10 @@ class System:
     async def __aenter__(self) -> System:
         self._clock_token = set_current_clock(self.clock)
         self._give_clocks()
+        self._all_done = anyio.Event()
+        self._running = len(self._states)
+        if not self._running:
+            self._all_done.set()
         self._tg = anyio.create_task_group()
         await self._tg.__aenter__()
         for state in self._states.values():
@@ -299,20 +310,9 @@ class System:
 
     async def run(self) -> None:
         """Run until every actor's ``run`` returned, :meth:`stop` is called, or a crash."""
-        token = set_current_clock(self.clock)
-        self._give_clocks()
-        self._tg = anyio.create_task_group()
-        try:
-            async with self._tg:
-                for state in self._states.values():
-                    self._tg.start_soon(self._supervise, state, name=f"actor:{state.actor.name}")
-        finally:
-            self._tg = None
-            _reset_clock(token)
-        if self._failure is not None:
-            failure, self._failure = self._failure, None
-            raise failure
-
+        async with self:
+            assert self._all_done is not None
+            await self._all_done.wait()
 
 def _reset_clock(token: contextvars.Token[Clock] | None) -> None:
     if token is not None:

@@ -50,7 +50,8 @@ async def running_stack(
         actors: list[Actor] = [Recorder(writer)] if writer is not None else []
         actors += [*build_actors(config, hal, navigator=navigator), *extra_actors]
         if realtime_scale is not None:
-            system = System(actors, clock=RealTimeClock(hal, scale=realtime_scale))
+            clock = RealTimeClock(hal, scale=realtime_scale, max_step_batch=0.05)
+            system = System(actors, clock=clock)
         elif isinstance(loop, VirtualTimeLoop):
             loop.attach_source(hal)
             system = System(actors)
