@@ -314,6 +314,7 @@ class System:
             assert self._all_done is not None
             await self._all_done.wait()
 
+
 def _reset_clock(token: contextvars.Token[Clock] | None) -> None:
     if token is not None:
         # ValueError: exited in another context (e.g. a different task).
