@@ -181,7 +181,7 @@ class Subscription(Generic[M]):
 class Publisher(Generic[M]):
     """The sending end of a topic for one publisher."""
 
-    __slots__ = ("_history", "_subscriptions", "endpoint", "msg_type", "published", "qos", "topic")
+    __slots__ = ("_history", "_topic", "endpoint", "msg_type", "published", "qos", "topic")
 
     def __init__(
         self,
@@ -193,8 +193,8 @@ class Publisher(Generic[M]):
         self.msg_type = topic.msg_type
         self.qos = qos
         self.endpoint = endpoint
-        # The topic's subscriber list, shared (not copied): a late joiner is seen at once.
-        self._subscriptions = topic.subscriptions
+        # Read the topic's subscriber list at each publish: a late joiner is seen at once.
+        self._topic = topic
         self._history: deque[M] | None = (
             deque(maxlen=qos.depth) if qos.durability is Durability.TRANSIENT_LOCAL else None
         )
@@ -216,8 +216,9 @@ class Publisher(Generic[M]):
         self.published += 1
         if self._history is not None:
             self._history.append(message)
-        # A snapshot: a subscriber may leave (Bus.unsubscribe) while this waits for room.
-        for subscription in tuple(self._subscriptions):
+        # Bus.unsubscribe replaces the list rather than mutate it, so this loop is safe
+        # while it waits for room, with no copy per message.
+        for subscription in self._topic.subscriptions:
             while not subscription._offer(message):
                 await subscription._wait_for_room()
 
@@ -226,13 +227,13 @@ class Publisher(Generic[M]):
         rather than wait when a reliable mailbox is full (no subscriber receives it)."""
         if type(message) is not self.msg_type:
             self._check_type(message)
-        for subscription in self._subscriptions:
+        for subscription in self._topic.subscriptions:
             if subscription._full():
                 raise anyio.WouldBlock(f"mailbox {subscription.endpoint} of '{self.topic}' is full")
         self.published += 1
         if self._history is not None:
             self._history.append(message)
-        for subscription in self._subscriptions:
+        for subscription in self._topic.subscriptions:
             subscription._offer(message)
 
 
@@ -298,7 +299,8 @@ class Bus:
         Idempotent."""
         topic = self.topics.get(subscription.topic)
         if topic is not None and subscription in topic.subscriptions:
-            topic.subscriptions.remove(subscription)
+            # A new list: a publisher iterating the old one mid-delivery is unaffected.
+            topic.subscriptions = [s for s in topic.subscriptions if s is not subscription]
         while subscription._space_waiters:
             waiter = subscription._space_waiters.popleft()
             if not waiter.done():
