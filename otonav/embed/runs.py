@@ -18,9 +18,8 @@ from otonav.runtime import (
     Actor,
 )
 from otonav.scenario import ScenarioConfig, Verdict, run_scenario
-from otonav.scenario.run import effective_stack
-from otonav.scenario.validate import check_goal
-from otonav.stack import StackConfig, build_world
+from otonav.scenario.run import scenario_world
+from otonav.stack import StackConfig
 
 _T = TypeVar("_T")
 
@@ -84,16 +83,8 @@ def check_run(
     an unknown or broken scene (:class:`~otonav.hal.mujoco.SceneError`), a goal outside
     the arena or on an obstacle (:class:`~otonav.stack.files.ConfigFileError`). Builds
     the world once (milliseconds): call it from a worker thread on a busy loop."""
-    stack = effective_stack(scenario, stack)
-    hal = build_world(
-        stack,
-        extra_obstacles=[b.to_obstacle() for b in scenario.obstacles],
-        start=scenario.start.as_tuple(),
-    )
-    try:
-        check_goal(scenario, stack.world.scene, hal.obstacles(), hal.walls(), source=source)
-    finally:
-        hal.close()
+    _stack, hal = scenario_world(scenario, stack, source=source)
+    hal.close()
 
 
 async def run_scenario_async(

@@ -25,13 +25,12 @@ from otonav.scenario.judge import Judge
 from otonav.scenario.run import (
     Verdict,
     drive_to_goal,
-    effective_stack,
     judge_verdict,
     run_task,
     save_artifacts,
+    scenario_world,
 )
-from otonav.scenario.validate import check_goal
-from otonav.stack import StackConfig, build_world
+from otonav.stack import StackConfig
 
 __all__ = ["VIEWER_HZ", "run_scenario_realtime"]
 
@@ -100,15 +99,9 @@ def run_scenario_realtime(
         raise ValueError(f"real-time scale must be > 0, got {scale!r}")
     if gui:
         check_display()
-    stack = effective_stack(scenario, stack)
-    hal = build_world(
-        stack,
-        extra_obstacles=[b.to_obstacle() for b in scenario.obstacles],
-        start=scenario.start.as_tuple(),
-    )
+    stack, hal = scenario_world(scenario, stack)
     viewer: ViewerHandle | None = None
     try:
-        check_goal(scenario, stack.world.scene, hal.obstacles(), hal.walls())
         if gui:
             if not isinstance(hal, MujocoInterface):
                 raise TypeError(f"gui=True needs the MuJoCo world, got {type(hal).__name__}")

@@ -71,6 +71,26 @@ def otonav_version() -> str:
         return "unknown"
 
 
+def scenario_world(
+    scenario: ScenarioConfig, stack: StackConfig, *, source: str = "scenario"
+) -> tuple[StackConfig, RobotHardwareInterface]:
+    """The stack config with the scenario's scene, and its world with the scenario's
+    obstacles and start pose, checked: a goal or start outside the arena or on an
+    obstacle raises ``ConfigFileError`` naming ``source`` (the world is then closed)."""
+    stack = effective_stack(scenario, stack)
+    hal = build_world(
+        stack,
+        extra_obstacles=[b.to_obstacle() for b in scenario.obstacles],
+        start=scenario.start.as_tuple(),
+    )
+    try:
+        check_goal(scenario, stack.world.scene, hal.obstacles(), hal.walls(), source=source)
+    except BaseException:
+        hal.close()
+        raise
+    return stack, hal
+
+
 def finite_figures(figures: dict[str, Any]) -> dict[str, Any]:
     """JSON has no Infinity or NaN: a figure that is not finite becomes null."""
     return {
@@ -175,14 +195,8 @@ def run_scenario(
     task)`` is called on the run's loop as it starts: a host running this in a worker
     thread cancels the run with ``loop.call_soon_threadsafe(task.cancel)``. A goal
     outside the arena or on an obstacle raises ``ConfigFileError`` naming ``source``."""
-    stack = effective_stack(scenario, stack)
-    hal = build_world(
-        stack,
-        extra_obstacles=[b.to_obstacle() for b in scenario.obstacles],
-        start=scenario.start.as_tuple(),
-    )
+    stack, hal = scenario_world(scenario, stack, source=source)
     try:
-        check_goal(scenario, stack.world.scene, hal.obstacles(), hal.walls(), source=source)
         writer = RecordingWriter(out_dir / "recording.mcap") if out_dir and record else None
     except BaseException:
         hal.close()
