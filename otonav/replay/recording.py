@@ -17,6 +17,7 @@ from pathlib import Path
 from mcap.reader import make_reader
 from pydantic import ValidationError
 
+from otonav.record.fastreader import iter_raw_messages
 from otonav.record.reader import CUT_OFF_ERRORS, MAGIC
 from otonav.stack import StackConfig
 
@@ -93,14 +94,18 @@ def load_recording(path: Path, topics: Collection[str] | None) -> Recording:
                         schema.name, schema.encoding, schema.data
                     )
             wanted = None if topics is None else [t for t in topics if t in types]
+            topic_of = {c.id: c.topic for c in summary.channels.values()}
+            ids = (
+                None
+                if wanted is None
+                else [i for i, topic in topic_of.items() if topic in set(wanted)]
+            )
             messages = (
                 []
-                if wanted == []
+                if ids == []
                 else [
-                    RecordedMessage(channel.topic, message.log_time, message.data)
-                    for _schema, channel, message in reader.iter_messages(
-                        topics=wanted, log_time_order=False
-                    )
+                    RecordedMessage(topic_of[channel], log_time, data)
+                    for channel, log_time, data in iter_raw_messages(f, summary, ids)
                 ]
             )
             metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
