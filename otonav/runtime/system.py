@@ -340,11 +340,17 @@ class System:
         if self._tg is not None:
             self._tg.cancel_scope.cancel()
 
+    async def wait_finished(self) -> None:
+        """Inside ``async with system``: wait until every actor's ``run`` returned or
+        the system was stopped (:meth:`stop`, a crash)."""
+        if self._all_done is None:
+            raise RuntimeError("wait_finished() is for a running system (async with system)")
+        await self._all_done.wait()
+
     async def run(self) -> None:
         """Run until every actor's ``run`` returned, :meth:`stop` is called, or a crash."""
         async with self:
-            assert self._all_done is not None
-            await self._all_done.wait()
+            await self.wait_finished()
 
 
 def _reset_clock(token: contextvars.Token[Clock] | None) -> None:
