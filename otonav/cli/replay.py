@@ -8,13 +8,12 @@ import argparse
 import math
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from rich.console import Console
+if TYPE_CHECKING:
+    from rich.console import Console
 
-from otonav.replay import ReplayInputError, ReplayResult, replay_recording
-from otonav.replay.output import write_replay
-from otonav.stack.files import ConfigFileError
+    from otonav.replay import ReplayResult
 
 
 def add_parser(commands: Any) -> None:
@@ -59,6 +58,12 @@ def add_parser(commands: Any) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    from rich.console import Console
+
+    from otonav.replay import ReplayInputError, replay_recording
+    from otonav.replay.output import write_replay
+    from otonav.stack.files import ConfigFileError
+
     nodes = [name.strip() for spec in args.nodes for name in spec.split(",") if name.strip()]
     if not nodes:
         raise ConfigFileError("--node: name a node to replay, e.g. --node nav")
