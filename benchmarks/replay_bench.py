@@ -53,8 +53,9 @@ def main() -> None:
     print(f"acceptance recording: {sim:.2f} s of sim time; medians of {args.reps}")
     for name, values in walls.items():
         median = statistics.median(values)
+        spread = f"[{min(values) * 1e3:.1f}..{max(values) * 1e3:.1f}]"
         print(
-            f"{name:<18} wall {median * 1e3:7.1f} ms [{min(values) * 1e3:.1f}..{max(values) * 1e3:.1f}]"
+            f"{name:<18} wall {median * 1e3:7.1f} ms {spread}"
             f"  RTF {sim / median:6.0f}x  original / this = {base / median:5.1f}"
         )
 
