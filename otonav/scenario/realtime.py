@@ -29,6 +29,7 @@ from otonav.scenario.run import (
     run_task,
     save_artifacts,
     scenario_world,
+    start_recording,
 )
 from otonav.stack import StackConfig
 
@@ -108,6 +109,8 @@ def run_scenario_realtime(
             viewer = hal.open_viewer()
         judge = Judge(hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance)
         writer = RecordingWriter(out_dir / "recording.mcap") if out_dir and record else None
+        if writer is not None:
+            start_recording(writer, hal, scenario, stack)
     except BaseException:
         if viewer is not None:
             viewer.close()

@@ -36,8 +36,10 @@ from otonav.scenario.plot import plot_trajectory
 from otonav.scenario.validate import check_goal
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.rosout import attach_rosout
+from otonav.stack.worldmeta import WORLD_METADATA, world_metadata
 
 VERDICT_TOPIC = "/scenario/verdict"
+RUN_METADATA = "otonav"
 
 
 @dataclass(frozen=True, slots=True)
@@ -202,9 +204,14 @@ def run_scenario(
     thread cancels the run with ``loop.call_soon_threadsafe(task.cancel)``. A goal
     outside the arena or on an obstacle raises ``ConfigFileError`` naming ``source``."""
     stack, hal = scenario_world(scenario, stack, source=source)
+    writer: RecordingWriter | None = None
     try:
         writer = RecordingWriter(out_dir / "recording.mcap") if out_dir and record else None
+        if writer is not None:
+            start_recording(writer, hal, scenario, stack)
     except BaseException:
+        if writer is not None:
+            writer.finish()
         hal.close()
         raise
     judge = Judge(
@@ -269,6 +276,30 @@ def save_artifacts(
     return verdict
 
 
+def run_metadata(scenario: ScenarioConfig, stack: StackConfig) -> dict[str, str]:
+    """The ``otonav`` metadata record of a scenario run, without its verdict."""
+    return {
+        "scenario": scenario.name,
+        "seed": str(scenario.seed),
+        "otonav_version": otonav_version(),
+        "scenario_config": scenario.model_dump_json(),
+        "stack_config": stack.model_dump_json(),
+    }
+
+
+def start_recording(
+    writer: RecordingWriter,
+    hal: RobotHardwareInterface,
+    scenario: ScenarioConfig,
+    stack: StackConfig,
+) -> None:
+    """What the recording says before the first message, so that a cut-off file still
+    says it: the world (``otonav.world``) and the run (``otonav``, its verdict is added
+    in a second ``otonav`` record at the end; readers take the last)."""
+    writer.add_metadata(WORLD_METADATA, world_metadata(hal, stack.world.scene))
+    writer.add_metadata(RUN_METADATA, run_metadata(scenario, stack))
+
+
 def _close_recording(
     writer: RecordingWriter,
     recorder: Recorder | None,
@@ -302,13 +333,9 @@ def _close_recording(
             if k not in ("wall_time_s", "rtf", "recording", "plot")
         }
         writer.add_metadata(
-            "otonav",
+            RUN_METADATA,
             {
-                "scenario": scenario.name,
-                "seed": str(scenario.seed),
-                "otonav_version": otonav_version(),
-                "scenario_config": scenario.model_dump_json(),
-                "stack_config": stack.model_dump_json(),
+                **run_metadata(scenario, stack),
                 "verdict": json.dumps(finite_figures(figures), sort_keys=True, default=str),
             },
         )

@@ -15,6 +15,7 @@ from otonav.record.writer import RecordingWriter
 from otonav.runtime import Actor, RealTimeClock, System, VirtualTimeLoop
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.rosout import attach_rosout
+from otonav.stack.worldmeta import WORLD_METADATA, world_metadata
 
 
 @dataclass(slots=True)
@@ -46,6 +47,8 @@ async def running_stack(
     hal = build_world(config, extra_obstacles=extra_obstacles, variant=variant)
     writer = RecordingWriter(record_to) if record_to is not None else None
     try:
+        if writer is not None:  # where the obstacles are: the kept plot draws them
+            writer.add_metadata(WORLD_METADATA, world_metadata(hal, config.world.scene))
         loop = asyncio.get_running_loop()
         actors: list[Actor] = [Recorder(writer)] if writer is not None else []
         actors += [*build_actors(config, hal, navigator=navigator), *extra_actors]
