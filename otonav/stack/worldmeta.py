@@ -1,6 +1,7 @@
 """What a recording says about its world: an MCAP metadata record, ``otonav.world``,
-written when the recording starts (so a cut-off file keeps it), holding the scene and
-every obstacle and wall box. ``otonav plot`` draws them from the recording alone."""
+written by :class:`~otonav.stack.session.StackSession` when the recording opens (so a
+cut-off file keeps it), holding every obstacle and wall box. ``otonav plot`` draws
+them from the recording alone."""
 
 from __future__ import annotations
 
@@ -17,10 +18,10 @@ def _boxes(boxes: tuple[BoxObstacle, ...]) -> str:
     return json.dumps([[b.x, b.y, b.half_x, b.half_y, b.yaw] for b in boxes])
 
 
-def world_metadata(hal: RobotHardwareInterface, scene: str) -> dict[str, str]:
-    """The record for ``hal``'s world: ``scene``, and ``obstacles`` and ``walls`` as JSON
-    lists of ``[x, y, half_x, half_y, yaw]`` (m, m, m, m, rad; world frame)."""
-    return {"scene": scene, "obstacles": _boxes(hal.obstacles()), "walls": _boxes(hal.walls())}
+def world_metadata(hal: RobotHardwareInterface) -> dict[str, str]:
+    """The record for ``hal``'s world: ``obstacles`` and ``walls`` as JSON lists of
+    ``[x, y, half_x, half_y, yaw]`` (m, m, m, m, rad; world frame)."""
+    return {"obstacles": _boxes(hal.obstacles()), "walls": _boxes(hal.walls())}
 
 
 def boxes_from_metadata(record: Mapping[str, str]) -> tuple[BoxObstacle, ...]:

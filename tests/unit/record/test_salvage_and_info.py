@@ -112,5 +112,5 @@ def test_a_killed_runs_file_still_says_its_world_scenario_and_seed(tmp_path: Pat
     assert summary.message_count > 0
     assert summary.metadata["otonav"] == run_metadata(scenario, effective_stack(scenario, STACK))
     world = summary.metadata[WORLD_METADATA]
-    assert world["scene"] == "empty"
+    assert json.loads(world["obstacles"]) == []  # the empty scene
     assert len(json.loads(world["walls"])) == 4

@@ -35,7 +35,7 @@ def _recording(path: Path, *, goal: bool = True, world: bool = False, seconds: f
     """A recording like the pytest plugin's: /goal, then /odom at 100 Hz; no scenario."""
     with RecordingWriter(path, chunk_size=4096) as writer:
         if world:
-            writer.add_metadata(WORLD_METADATA, {"scene": "t", "obstacles": BOXES, "walls": WALLS})
+            writer.add_metadata(WORLD_METADATA, {"obstacles": BOXES, "walls": WALLS})
         if goal:
             writer.write("/goal", PoseStamped(pose=Pose(position=Point(x=GOAL[0], y=GOAL[1]))), 0.0)
         for i in range(round(seconds * 100)):
