@@ -17,11 +17,11 @@ from otonav.msgs import (
     DiagnosticArray,
     DiagnosticStatus,
     HardwareStatus,
-    KeyValue,
-    Log,
     Header,
     Imu,
+    KeyValue,
     LaserScan,
+    Log,
     Odometry,
     Point,
     Pose,
@@ -46,6 +46,7 @@ _LOG_LEVELS = {
     HealthLevel.ERROR: (Log.ERROR, logging.ERROR),
     HealthLevel.STALE: (Log.ERROR, logging.ERROR),
 }
+
 
 def _diag6(*variances: float) -> tuple[float, ...]:
     """A row-major 6x6 covariance with ``variances`` on the diagonal."""

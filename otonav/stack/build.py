@@ -64,8 +64,7 @@ def _can_world(config: StackConfig, world: MujocoInterface) -> CanBusInterface:
         from otonav.hal.sim import AxisParams, DriveEmulator, DriveMount
     except ImportError as exc:  # python-can is an extra
         raise ConfigFileError(
-            f"hal.kind: can needs python-can ({exc.name} is missing): "
-            "pip install 'otonav[can]'"
+            f"hal.kind: can needs python-can ({exc.name} is missing): pip install 'otonav[can]'"
         ) from None
     can, sim = config.hal.can, config.hal.sim
     channel = can.channel

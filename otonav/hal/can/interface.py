@@ -119,6 +119,8 @@ class CanBusInterface(RobotHardwareInterface):
         self._logged = 0
         self.frames_dropped_from_log = 0
         self._closed = False
+        self._serviced_at = -1  # the tick of the last bus instant
+        self._sent = False  # frames sent since then (the peer must hear them)
         self._tick = sensors.tick
         self._start(sensors.ticks * self._tick)
 
@@ -149,7 +151,10 @@ class CanBusInterface(RobotHardwareInterface):
         target = sensors.ticks + n
         while True:
             now = sensors.ticks
-            self._service(now)
+            # The instant we stopped at last time was serviced then; again only if
+            # something was sent since (a wheel command the drives must apply now).
+            if now != self._serviced_at or self._sent:
+                self._service(now)
             if now >= target:
                 return
             nxt = target if peer is None else min(target, peer.next_event_tick(now))
@@ -158,6 +163,8 @@ class CanBusInterface(RobotHardwareInterface):
     def _service(self, now: int) -> None:
         """One bus instant: the peer exchanges, we drain and decode, the monitor checks."""
         t = now * self._tick
+        self._serviced_at = now
+        self._sent = False
         if self._peer is not None:
             self._peer.exchange(now)
         monitor = self.monitor
@@ -192,10 +199,10 @@ class CanBusInterface(RobotHardwareInterface):
         i = self._index.get(node)
         if i is None:
             return
-        est = p.decode_encoder_estimates(data)
+        position, velocity = p.unpack_two_f32(data)
         scale = self._scale[i]
-        self._pos[i] = est.position / scale
-        self._vel[i] = est.velocity / scale
+        self._pos[i] = position / scale
+        self._vel[i] = velocity / scale
         self._wheels = None
 
     def _apply(self, actions: tuple[Action, ...], t: float) -> None:
@@ -228,6 +235,7 @@ class CanBusInterface(RobotHardwareInterface):
         except BusError as exc:
             self.monitor.bus_off(t, str(exc))
             return
+        self._sent = True
         self._record(t, frame)
 
     def _record(self, t: float, frame: RawFrame) -> None:

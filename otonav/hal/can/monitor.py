@@ -81,7 +81,7 @@ class MonitorLimits:
 
 
 class _Node:
-    __slots__ = ("arrivals", "error", "heartbeat_at", "label", "state", "encoder_at")
+    __slots__ = ("arrivals", "encoder_at", "error", "heartbeat_at", "label", "state")
 
     def __init__(self, label: NodeLabel) -> None:
         self.label = label
@@ -108,6 +108,7 @@ class DriveMonitor:
         self._attempts = 0
         self._bus_off = False
         self._bus_restarted = False
+        self._loss_due = -math.inf
         self.events: list[tuple[float, str]] = []
         self.health = HardwareHealth(
             level=HealthLevel.WARN,
@@ -192,13 +193,18 @@ class DriveMonitor:
             self._fault = self._fault_message = ""
             return ()
         if now - self._requested_at > self.limits.startup_timeout + 1e-9:
-            self._enter_fault(now, "startup_timeout", self._startup_message(now))
+            if self.phase is Phase.RECOVERING:
+                fault = self._fault
+                cause = self._fault_message.split("; recovery from")[0]
+                message = f"{cause}; recovery from {fault} failed: {self._startup_message(now)}"
+            else:
+                fault, message = "startup_timeout", self._startup_message(now)
+            self._enter_fault(now, fault, message)
             return (Action.ESTOP_ALL,)
         return ()
 
     def _startup_message(self, now: float) -> str:
         parts = []
-        waited = now - self._requested_at
         for node in self._nodes.values():
             if self._in_closed_loop(node):
                 continue
@@ -211,12 +217,14 @@ class DriveMonitor:
                 )
         text = (
             "; ".join(parts)
-            + f" within {waited:.2f} s of sim time after requesting CLOSED_LOOP_CONTROL"
+            + f" within {self.limits.startup_timeout:g} s of sim time after requesting "
+            f"CLOSED_LOOP_CONTROL (at {self._requested_at:.2f} s)"
         )
         foreign = sorted(self._foreign)
+        heard = any(n.heartbeat_at > self._requested_at for n in self._nodes.values())
         if foreign:
             text += f"; drives answering on this bus: node ids {foreign} (check hal.can.*.node_id)"
-        else:
+        elif not heard:
             text += "; no drive answered at all (check wiring, power and hal.can.channel)"
         return text
 
@@ -249,6 +257,9 @@ class DriveMonitor:
                     f"(timeout {limits.encoder_timeout:g} s; frames delayed or lost)",
                 )
                 return (Action.ZERO_ALL,)
+            # The loss is judged ten times per window, not at every instant.
+            if now < self._loss_due:
+                continue
             loss = self._loss(node, now, self._running_since)
             if loss is not None and loss > limits.max_frame_loss:
                 self._enter_fault(
@@ -258,6 +269,8 @@ class DriveMonitor:
                     f"{limits.loss_window:g} s (max {limits.max_frame_loss:.0%})",
                 )
                 return (Action.ZERO_ALL,)
+        if now >= self._loss_due:
+            self._loss_due = now + limits.loss_window / 10.0
         return ()
 
     def _loss(self, node: _Node, now: float, since: float) -> float | None:
@@ -277,9 +290,7 @@ class DriveMonitor:
         limits = self.limits
         if self._bus_off:
             return False
-        fresh = all(
-            now - n.heartbeat_at <= limits.heartbeat_timeout for n in self._nodes.values()
-        )
+        fresh = all(now - n.heartbeat_at <= limits.heartbeat_timeout for n in self._nodes.values())
         if self._fault in ("encoder_stale", "frame_loss"):
             for node in self._nodes.values():
                 loss = self._loss(node, now, -math.inf)
@@ -333,8 +344,10 @@ class DriveMonitor:
 
     def _set(self, now: float, level: HealthLevel, ready: bool, fault: str, message: str) -> None:
         values = tuple(
-            (f"node {n.label.node_id}", f"{n.label.label}: state {_state_name(n.state)}, "
-             f"error 0x{n.error:08x}")
+            (
+                f"node {n.label.node_id}",
+                f"{n.label.label}: state {_state_name(n.state)}, error 0x{n.error:08x}",
+            )
             for n in self._nodes.values()
         )
         self.health = HardwareHealth(

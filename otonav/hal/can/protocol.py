@@ -51,6 +51,7 @@ __all__ = [
     "set_controller_mode",
     "set_input_vel",
     "split_id",
+    "unpack_two_f32",
 ]
 
 CMD_HEARTBEAT: Final = 0x001
@@ -228,3 +229,8 @@ def encode_encoder_estimates(node_id: int, est: EncoderEstimates) -> tuple[int, 
 def decode_encoder_estimates(data: bytes) -> EncoderEstimates:
     pos, vel = _TWO_F32.unpack_from(data)
     return EncoderEstimates(float(pos), float(vel))
+
+
+unpack_two_f32 = _TWO_F32.unpack_from
+"""``(a, b)`` from two little-endian float32: the hot-path decoder of encoder estimates
+and Set_Input_Vel (a frozen dataclass per frame cost 9 us of a 10 ms instant)."""

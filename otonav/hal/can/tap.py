@@ -28,11 +28,13 @@ _PAD: Final = tuple(bytes(8 - n) for n in range(9))
 
 class CanFrameTap(Actor):
     """At ``rate_hz``, publish the frames logged since the last wake, in bus order,
-    each stamped with the sim time it crossed the bus."""
+    each stamped with the sim time it crossed the bus (the recording's log time is the
+    publish time, up to one period later: 20 Hz costs a fifth of the wake-ups of 100 Hz
+    and the frames keep their exact stamps)."""
 
     frames = Output(FRAMES_TOPIC, Frame, FRAMES_QOS)
 
-    def __init__(self, hal: CanBusInterface, *, rate_hz: float = 100.0, name: str = "can_tap"):
+    def __init__(self, hal: CanBusInterface, *, rate_hz: float = 20.0, name: str = "can_tap"):
         super().__init__(name)
         if not rate_hz > 0:
             raise ValueError(f"can tap rate must be > 0 Hz, got {rate_hz}")
@@ -49,20 +51,25 @@ class CanFrameTap(Actor):
         # The last frames (the IDLE requests are sent when the HAL closes, later).
         for t, raw in self.hal.take_frames():
             with contextlib.suppress(anyio.WouldBlock):
-                self.frames.publish_nowait(_frame(t, raw, self.hal.channel))
+                header = Header.fast(stamp=Time.from_seconds(t), frame_id=self.hal.channel)
+                self.frames.publish_nowait(_frame(header, raw))
 
     async def flush(self) -> None:
         channel = self.hal.channel
         publish = self.frames.publish
+        header: Header | None = None
+        last = -1.0
         for t, raw in self.hal.take_frames():
-            await publish(_frame(t, raw, channel))
+            if header is None or t != last:  # frames of one instant share a header
+                header, last = Header.fast(stamp=Time.from_seconds(t), frame_id=channel), t
+            await publish(_frame(header, raw))
 
 
-def _frame(t: float, raw: RawFrame, channel: str) -> Frame:
+def _frame(header: Header, raw: RawFrame) -> Frame:
     data = raw.data
     n = len(data)
     return Frame.fast(
-        header=Header.fast(stamp=Time.from_seconds(t), frame_id=channel),
+        header=header,
         id=raw.arbitration_id,
         is_rtr=raw.is_remote,
         is_extended=False,

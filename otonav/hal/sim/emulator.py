@@ -32,7 +32,7 @@ from otonav.hal.can import protocol as p
 from otonav.hal.can.bus import CAN_ERR_BUSOFF, CAN_ERR_RESTARTED, CanEndpoint, RawFrame
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.sim.odrive import AxisModel, AxisParams
-from otonav.hal.types import WheelCommand
+from otonav.hal.types import WheelCommand, WheelState
 
 __all__ = ["BusFaults", "DriveEmulator", "DriveMount"]
 
@@ -179,11 +179,12 @@ class DriveEmulator:
                 self.frames_sent += 1
             else:
                 self._handle(frame, t)
-        self._drive_wheels(t)
+        wheels = self._world.read_wheels()
+        self._drive_wheels(t, wheels)
         if now != self._sent_at and not self._bus_off:
             self._sent_at = now
             if now % self._enc_ticks == 0:
-                self._send_encoders(now, t)
+                self._send_encoders(now, t, wheels)
             if now % self._hb_ticks == 0:
                 self._send_heartbeats(now, t)
 
@@ -220,7 +221,7 @@ class DriveEmulator:
         axis, data = drive.axis, frame.data
         try:
             if cmd == p.CMD_SET_INPUT_VEL:
-                axis.set_input_vel(p.decode_set_input_vel(data)[0], t)
+                axis.set_input_vel(p.unpack_two_f32(data)[0], t)
             elif cmd == p.CMD_SET_AXIS_STATE:
                 axis.request_state(p.decode_set_axis_state(data), t)
             elif cmd == p.CMD_ESTOP:
@@ -232,8 +233,7 @@ class DriveEmulator:
         except ValueError:  # a short payload (struct.error is a ValueError): ignored
             return
 
-    def _drive_wheels(self, t: float) -> None:
-        wheels = self._world.read_wheels()
+    def _drive_wheels(self, t: float, wheels: WheelState) -> None:
         left, right = self.drives
         out = []
         for drive, wheel_vel in ((left, wheels.left_velocity), (right, wheels.right_velocity)):
@@ -246,8 +246,7 @@ class DriveEmulator:
             self._last_cmd = cmd
             self._world.write(WheelCommand(cmd[0], cmd[1]))
 
-    def _send_encoders(self, now: int, t: float) -> None:
-        wheels = self._world.read_wheels()
+    def _send_encoders(self, now: int, t: float, wheels: WheelState) -> None:
         left, right = self.drives
         for drive, pos, vel in (
             (left, wheels.left_position, wheels.left_velocity),
