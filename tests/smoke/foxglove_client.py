@@ -129,25 +129,29 @@ class FoxgloveClient:
                     return
                 if isinstance(frame, bytes):
                     self._binary(frame, by_id)
+                else:
+                    self._text(frame)
 
     async def _advertisements(self, ws: ClientConnection) -> None:
         while not self.expect <= set(self.channels):
             frame = await ws.recv()
-            if isinstance(frame, bytes):
-                continue
-            message = json.loads(frame)
-            if message["op"] == "serverInfo":
-                self.server_info = message
-            elif message["op"] == "advertise":
-                for c in message["channels"]:
-                    self.channels[c["topic"]] = Channel(
-                        c["id"],
-                        c["topic"],
-                        c["encoding"],
-                        c["schemaName"],
-                        c.get("schemaEncoding", ""),
-                        c["schema"],
-                    )
+            if isinstance(frame, str):
+                self._text(frame)
+
+    def _text(self, frame: str) -> None:
+        message = json.loads(frame)
+        if message["op"] == "serverInfo":
+            self.server_info = message
+        elif message["op"] == "advertise":
+            for c in message["channels"]:
+                self.channels[c["topic"]] = Channel(
+                    c["id"],
+                    c["topic"],
+                    c["encoding"],
+                    c["schemaName"],
+                    c.get("schemaEncoding", ""),
+                    c["schema"],
+                )
 
     def _binary(self, frame: bytes, by_id: dict[int, str]) -> None:
         if frame[0] == _MESSAGE_DATA:
