@@ -10,7 +10,7 @@ import argparse
 import sys
 from collections.abc import Sequence
 
-from otonav.cli import bench, info, inspect, run
+from otonav.cli import bench, info, inspect, run, sweep
 from otonav.hal.mujoco import SceneError
 from otonav.hal.viewer import NoDisplayError
 from otonav.record.reader import RecordingError
@@ -33,6 +33,7 @@ def build_parser() -> argparse.ArgumentParser:
     info.add_parsers(commands)
     inspect.add_parsers(commands)
     bench.add_parser(commands)
+    sweep.add_parser(commands)
     return parser
 
 
