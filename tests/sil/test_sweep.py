@@ -1,7 +1,9 @@
 """Sweeps on the local process pool: results that do not depend on the worker count, a
 repro line that reproduces the run byte for byte, crashed and hung workers recorded as
 errors while the sweep goes on, and resuming after SIGTERM or a killed worker with
-nothing rerun and nothing lost. (Ray: test_sweep_ray.py, one module, one cluster.)"""
+nothing rerun and nothing lost. The Ray backend is tested last, against a real local
+cluster (``ray.init(num_cpus=2)``, about 5 s to start) shared by this module's Ray
+tests only."""
 
 from __future__ import annotations
 
@@ -14,6 +16,7 @@ import signal
 import subprocess
 import sys
 from collections import Counter
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -237,3 +240,47 @@ def test_cancelling_the_iterating_task_stops_the_pool(tmp_path: Path) -> None:
         with pytest.raises(ProcessLookupError):
             os.kill(int(pid), 0)
     assert len(read_results(out / "results.jsonl")) < len(tasks)
+
+
+# -- Ray ---------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def local_ray() -> Iterator[None]:
+    import ray  # the dev extra includes otonav[ray]: a missing Ray fails, never skips
+
+    # Workers inherit the environment the cluster starts with: the crash hook is set for
+    # them only (this process runs inline references and must not have it).
+    os.environ[FAULT_ENV] = "crash:crashy"
+    try:
+        ray.init(
+            num_cpus=2,
+            include_dashboard=False,
+            log_to_driver=False,
+            object_store_memory=128 * 1024 * 1024,  # results are small (default: 30 % of RAM)
+        )
+    finally:
+        del os.environ[FAULT_ENV]
+    yield
+    ray.shutdown()
+
+
+def test_ray_gives_the_serial_results_and_survives_a_dead_worker(
+    local_ray: None, tmp_path: Path
+) -> None:
+    sweep = write_sweep(tmp_path, names=("crashy",))
+    serial = run_inline(sweep, tmp_path / "serial")  # crashy passes here: no hook in this process
+    records = execute(prepare(tmp_path / "ray", tasks_of(sweep)), make_backend("ray", workers=2))
+    assert len(records) == len(serial) == 12
+    crashed = {r["run_id"] for r in records if r["scenario"] == "crashy"}
+    assert all(
+        r["status"] == "error" and "worker died" in r["reason"]
+        for r in records
+        if r["run_id"] in crashed
+    )
+    healthy = [r for r in records if r["run_id"] not in crashed]
+    assert fingerprints(healthy) == fingerprints([r for r in serial if r["run_id"] not in crashed])
+    assert {r["status"] for r in healthy} == {"passed", "failed"}
+    assert len({r["worker"] for r in healthy}) >= 2  # ran on more than one Ray worker
+    kept = [r for r in records if r["status"] == "failed"]
+    assert all((tmp_path / "ray" / r["artifacts"] / "recording.mcap").exists() for r in kept)
