@@ -13,21 +13,13 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 from types import FrameType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from rich.console import Console
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TextColumn,
-    TimeElapsedColumn,
-    TimeRemainingColumn,
-)
-from rich.table import Table
+if TYPE_CHECKING:  # the command's imports are in main(): --help stays fast
+    from rich.console import Console
+    from rich.progress import Progress
 
-from otonav.stack.files import ConfigFileError
-from otonav.sweep.spec import Scalar
+    from otonav.sweep.spec import Scalar, SweepSpec
 
 DEFAULT_OUT = Path("out/sweep")
 
@@ -81,6 +73,8 @@ def _scalar(text: str) -> Scalar:
 
 
 def _pairs(items: list[str], flag: str) -> list[tuple[str, str]]:
+    from otonav.stack.files import ConfigFileError
+
     pairs = []
     for item in items:
         key, sep, value = item.partition("=")
@@ -90,15 +84,18 @@ def _pairs(items: list[str], flag: str) -> list[tuple[str, str]]:
     return pairs
 
 
-def quick_spec(args: argparse.Namespace) -> Any:
+def quick_spec(args: argparse.Namespace) -> SweepSpec:
     """The sweep the quick-form flags describe."""
+    from otonav.stack.files import ConfigFileError
     from otonav.sweep.spec import GenerateSource, GenerateSpec, SeedRange, SweepSpec
 
     scenarios: list[str | GenerateSource] = list(args.scenario)
     if args.generate is not None:
         if args.generate <= 0:
             raise ConfigFileError(f"--generate {args.generate}: must be a count > 0")
-        params = {k: _scalar(v) for k, v in _pairs(args.gen, "--gen")}
+        params: dict[str, Scalar | tuple[Scalar, ...]] = {
+            k: _scalar(v) for k, v in _pairs(args.gen, "--gen")
+        }
         if args.density is not None:
             params["density"] = args.density
         scenarios.append(GenerateSource(generate=GenerateSpec(count=args.generate, params=params)))
@@ -148,6 +145,16 @@ class _Live:
         self.tty = sys.stderr.isatty()
         self.progress: Progress | None = None
         if self.tty:
+            from rich.console import Console
+            from rich.progress import (
+                BarColumn,
+                MofNCompleteColumn,
+                Progress,
+                TextColumn,
+                TimeElapsedColumn,
+                TimeRemainingColumn,
+            )
+
             self.progress = Progress(
                 TextColumn("sweep"),
                 BarColumn(),
@@ -193,6 +200,8 @@ class _Live:
 
 
 def print_summary(summary: dict[str, Any], console: Console) -> None:
+    from rich.table import Table
+
     def pct(rate: dict[str, Any]) -> tuple[str, str, str]:
         if rate["rate"] is None:
             return (str(rate["runs"]), "-", "-")
@@ -231,6 +240,9 @@ def print_summary(summary: dict[str, Any], console: Console) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    from rich.console import Console
+
+    from otonav.stack.files import ConfigFileError
     from otonav.sweep import runner
     from otonav.sweep.plan import plan_runs
     from otonav.sweep.report import summarize, write_report

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Literal
+
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat
 
-from otonav.hal import BoxObstacle
+if TYPE_CHECKING:  # imported in to_obstacle: reading a scenario file needs no numpy
+    from otonav.hal.types import BoxObstacle
 
 
 class BoxSpec(BaseModel):
@@ -19,6 +22,8 @@ class BoxSpec(BaseModel):
     yaw: float = 0.0
 
     def to_obstacle(self) -> BoxObstacle:
+        from otonav.hal.types import BoxObstacle
+
         return BoxObstacle(self.x, self.y, self.size_x / 2, self.size_y / 2, self.yaw)
 
 
@@ -58,3 +63,7 @@ class ScenarioConfig(BaseModel):
     min_clearance: PositiveFloat = 0.3
     """m: the robot centre must never come closer than this to an obstacle or wall."""
     seed: int = Field(0, ge=0)
+    expect: Literal["reached", "unreachable"] = "reached"
+    """The outcome that passes: ``reached`` (the goal within tolerance inside the budget)
+    or ``unreachable`` (the navigator reports ``unreachable`` on /nav/state inside the
+    budget, e.g. a walled-in goal). Either way the clearance must hold."""

@@ -9,7 +9,7 @@ import glob
 import hashlib
 import itertools
 import json
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -20,7 +20,8 @@ from otonav.scenario.builtin import BUILTIN
 from otonav.stack import StackConfig
 from otonav.stack.files import ConfigFileError, describe_validation_error, load_model
 from otonav.stack.overrides import apply_overrides
-from otonav.sweep.spec import GenerateSource, GenerateSpec, Keep, Scalar, SweepSpec
+from otonav.sweep.spec import GenerateSource, Keep, Scalar, SweepSpec
+from otonav.sweep.worlds import world_name, world_params_json
 
 Override = tuple[str, Scalar]
 
@@ -43,11 +44,14 @@ class RunTask:
     seed: int
     overrides: tuple[Override, ...]
     scenario_json: str
+    """The scenario to run; empty for a generated world (the worker draws it)."""
     stack_json: str
     keep: Keep
     wall_ceiling_s: float
     config: str | None = None
     """The base stack config file, for the repro command."""
+    world: tuple[str, int] | None = None
+    """A generated world: (generator parameters as JSON, world seed)."""
 
     @property
     def label(self) -> str:
@@ -64,12 +68,25 @@ def format_value(value: Scalar) -> str:
 
 @dataclass(frozen=True, slots=True)
 class _Scenario:
-    config: ScenarioConfig
+    config: ScenarioConfig | None
+    """None for a generated world (drawn by the worker)."""
     family: str
     source: str | None
+    world: tuple[str, int] | None = None
 
+    @property
+    def name(self) -> str:
+        if self.config is not None:
+            return self.config.name
+        assert self.world is not None
+        return world_name(*self.world)
 
-GeneratorFn = Callable[[GenerateSpec, str], list[ScenarioConfig]]
+    @property
+    def seed(self) -> int:
+        if self.config is not None:
+            return self.config.seed
+        assert self.world is not None
+        return self.world[1]
 
 
 def _display(path: Path) -> str:
@@ -81,18 +98,22 @@ def _display(path: Path) -> str:
         return str(absolute)
 
 
-def _resolve_scenarios(
-    spec: SweepSpec, base: Path, where: str, generator: GeneratorFn | None
-) -> list[_Scenario]:
+def _resolve_scenarios(spec: SweepSpec, base: Path, where: str) -> list[_Scenario]:
     found: list[_Scenario] = []
     for i, entry in enumerate(spec.scenarios):
         key = f"{where}: scenarios.{i}"
         if isinstance(entry, GenerateSource):
-            gen = generator or _default_generator
-            params = sorted(entry.generate.params.items())
-            label = ",".join(f"{k}={format_value(v)}" for k, v in params)
+            gen = entry.generate
+            params_json = world_params_json(gen, key)
+            label = ",".join(
+                f"{k}={format_value(v) if not isinstance(v, tuple) else list(v)}"
+                for k, v in sorted(gen.params.items())
+            )
             family = f"generated({label})" if label else "generated"
-            found += [_Scenario(s, family, None) for s in gen(entry.generate, key)]
+            found += [
+                _Scenario(None, family, None, (params_json, world_seed))
+                for world_seed in range(gen.seed, gen.seed + gen.count)
+            ]
         elif entry in BUILTIN:
             found.append(_Scenario(BUILTIN[entry], entry, entry))
         elif any(c in entry for c in "*?["):
@@ -115,10 +136,6 @@ def _resolve_scenarios(
     return found
 
 
-def _default_generator(spec: GenerateSpec, where: str) -> list[ScenarioConfig]:
-    raise ConfigFileError(f"{where}.generate: the world generator is not available in this otonav")
-
-
 def override_combinations(spec: SweepSpec) -> list[tuple[Override, ...]]:
     """The grid's every combination (keys in file order), or the list as given."""
     if isinstance(spec.overrides, dict):
@@ -139,8 +156,14 @@ def _with_seed(scenario: ScenarioConfig, seed: int, where: str) -> ScenarioConfi
         raise ConfigFileError(describe_validation_error(f"{where}: seeds", exc)) from None
 
 
-def run_id(scenario_json: str, seed: int, overrides: Sequence[Override]) -> str:
-    key = json.dumps([scenario_json, seed, [list(o) for o in overrides]], sort_keys=True)
+def run_id(
+    scenario_json: str,
+    seed: int,
+    overrides: Sequence[Override],
+    world: tuple[str, int] | None = None,
+) -> str:
+    what: object = scenario_json if world is None else ["generate", *world]
+    key = json.dumps([what, seed, [list(o) for o in overrides]], sort_keys=True)
     return hashlib.sha256(key.encode()).hexdigest()[:12]
 
 
@@ -149,19 +172,16 @@ def plan_runs(
     *,
     base: Path = Path("."),
     where: str = "sweep",
-    generator: GeneratorFn | None = None,
 ) -> list[RunTask]:
     """Every run of ``spec``, in order, each once. ``base``: where relative paths in the
     spec start (the sweep file's directory); ``where`` names the file in errors."""
-    return list(_iter_runs(spec, base, where, generator))
+    return list(_iter_runs(spec, base, where))
 
 
-def _iter_runs(
-    spec: SweepSpec, base: Path, where: str, generator: GeneratorFn | None
-) -> Iterator[RunTask]:
+def _iter_runs(spec: SweepSpec, base: Path, where: str) -> Iterator[RunTask]:
     config_path = str(base / spec.config) if spec.config is not None else None
     stack = load_model(Path(config_path), StackConfig) if config_path else StackConfig()
-    scenarios = _resolve_scenarios(spec, base, where, generator)
+    scenarios = _resolve_scenarios(spec, base, where)
     combos = override_combinations(spec)
     stacks = [
         apply_overrides(
@@ -176,17 +196,18 @@ def _iter_runs(
     index = 0
     for sc in scenarios:
         for combo, stack_json in zip(combos, stacks, strict=True):
-            for seed in seeds if seeds is not None else (sc.config.seed,):
-                scenario = _with_seed(sc.config, seed, where)
-                scenario_json = scenario.model_dump_json()
-                rid = run_id(scenario_json, seed, combo)
+            for seed in seeds if seeds is not None else (sc.seed,):
+                scenario_json = (
+                    _with_seed(sc.config, seed, where).model_dump_json() if sc.config else ""
+                )
+                rid = run_id(scenario_json, seed, combo, sc.world)
                 if rid in seen:  # the same run twice: a deterministic sim gives the same answer
                     continue
                 seen.add(rid)
                 yield RunTask(
                     run_id=rid,
                     index=index,
-                    scenario=scenario.name,
+                    scenario=sc.name,
                     family=sc.family,
                     source=sc.source,
                     seed=seed,
@@ -196,5 +217,6 @@ def _iter_runs(
                     keep=spec.keep,
                     wall_ceiling_s=spec.wall_ceiling_s,
                     config=_display(Path(config_path)) if config_path else None,
+                    world=sc.world,
                 )
                 index += 1

@@ -103,7 +103,8 @@ def _write_artifacts(
     folder.mkdir(parents=True, exist_ok=True)
     for name, data in outcome.artifacts.items():
         (folder / name).write_bytes(data)
-    scenario = yaml.safe_dump(json.loads(task.scenario_json), sort_keys=False)
+    scenario_json = outcome.scenario_json or task.scenario_json
+    scenario = yaml.safe_dump(json.loads(scenario_json), sort_keys=False)
     (folder / "scenario.yaml").write_text(scenario)
     return str(rel), str(out / rel / "scenario.yaml")
 

@@ -41,7 +41,9 @@ class GenerateSpec(_Model):
 
     count: PositiveInt
     seed: int = Field(0, ge=0)
-    params: dict[str, Scalar] = {}
+    params: dict[str, Scalar | tuple[Scalar, ...]] = {}
+    """``density`` (a preset: sparse, dense, walled_in) and fields of the generator's
+    ``WorldParams`` to replace (see ``otonav.sweep.worlds``)."""
 
 
 class GenerateSource(_Model):

@@ -27,6 +27,7 @@ from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.scenario.run import finite_figures
 from otonav.stack import StackConfig
 from otonav.sweep.plan import RunTask
+from otonav.sweep.worlds import draw_world
 
 Status = Literal["passed", "failed", "error"]
 
@@ -54,6 +55,8 @@ class RunOutcome:
     worker: str
     artifacts: dict[str, bytes] = field(default_factory=dict)
     """File name -> content, for runs the sweep keeps."""
+    scenario_json: str | None = None
+    """The scenario a generated world turned out to be (None: the task's own)."""
 
 
 def worker_name() -> str:
@@ -83,9 +86,20 @@ def execute(task: RunTask, scratch: Path) -> RunOutcome:
     start = time.perf_counter()
     recording = scratch / RECORDING
     recording.unlink(missing_ok=True)
+    scenario_json: str | None = None
+    labels: dict[str, Any] = {}
     try:
         _inject_fault(task)
-        scenario = ScenarioConfig.model_validate_json(task.scenario_json)
+        if task.world is not None:
+            scenario_json, labels = draw_world(*task.world)
+            scenario = ScenarioConfig.model_validate_json(scenario_json)
+            if scenario.seed != task.seed:
+                scenario = ScenarioConfig.model_validate(
+                    {**scenario.model_dump(), "seed": task.seed}
+                )
+                scenario_json = scenario.model_dump_json()
+        else:
+            scenario = ScenarioConfig.model_validate_json(task.scenario_json)
         stack = StackConfig.model_validate_json(task.stack_json)
         verdict = run_scenario(
             scenario,
@@ -108,12 +122,14 @@ def execute(task: RunTask, scratch: Path) -> RunOutcome:
             wall_time_s=time.perf_counter() - start,
             worker=worker_name(),
             artifacts=_artifacts(recording, None) if task.keep != "none" else {},
+            scenario_json=scenario_json,
         )
     status: Status = "passed" if verdict.passed else "failed"
     figures = finite_figures(verdict.as_dict())
     for key in ("recording", "plot", "wall_time_s", "rtf", "scenario", "reason"):
         figures.pop(key, None)
     figures["sim_wall_s"] = verdict.wall_time_s
+    figures.update(labels)
     artifacts = _artifacts(recording, scratch / PLOT) if _keeps(task, status) else {}
     return RunOutcome(
         run_id=task.run_id,
@@ -124,6 +140,7 @@ def execute(task: RunTask, scratch: Path) -> RunOutcome:
         wall_time_s=time.perf_counter() - start,
         worker=worker_name(),
         artifacts=artifacts,
+        scenario_json=scenario_json,
     )
 
 

@@ -113,6 +113,24 @@ def test_the_repro_line_reproduces_the_run_byte_for_byte(
     assert hashlib.sha256(recording).hexdigest() == failed["recording_sha256"]
 
 
+def test_a_generated_world_is_kept_with_a_repro_that_reproduces_it(tmp_path: Path) -> None:
+    sweep = tmp_path / "gen.yaml"
+    sweep.write_text(  # small, nearly empty worlds: a few seconds of sim each
+        "scenarios:\n  - generate: {count: 1, seed: 7, params: {arena: 5, "
+        "obstacle_count: [1, 1], start_goal_distance: [1.0, 1.2]}}\nkeep: all\n"
+    )
+    [record] = run_inline(sweep, tmp_path / "out")
+    assert record["scenario"] == "sparse-7"
+    assert record["status"] == "passed", record["reason"]
+    assert record["world_reachable"] is True
+    assert record["shortest_path_m"] >= 1.0
+    argv = shlex.split(record["repro"])
+    assert argv[3].endswith("runs/" + record["run_id"] + "/scenario.yaml")
+    assert main([*argv[1:], "--out", str(tmp_path / "repro")]) == 0
+    recording = (tmp_path / "repro" / "recording.mcap").read_bytes()
+    assert hashlib.sha256(recording).hexdigest() == record["recording_sha256"]
+
+
 def test_crashed_and_hung_workers_are_errors_then_resume_retries_only_them(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -145,3 +145,65 @@ def test_an_out_dir_holding_another_sweep_is_refused(
         "different sweep",
     )
     assert (out / "results.jsonl").read_text() == '{"run_id": "x"}\n'  # nothing lost
+
+
+def test_generated_worlds_are_named_by_params_and_seed_and_drawn_by_workers(
+    tmp_path: Path,
+) -> None:
+    from otonav.scenario.generator import DENSE, generate_world
+    from otonav.sweep.worlds import draw_world
+
+    sweep = _write(
+        tmp_path / "s.yaml",
+        "scenarios:\n  - generate: {count: 3, seed: 10, params: {density: dense}}\n"
+        "  - generate: {count: 1, params: {obstacle_count: [0, 2]}}\n"
+        "overrides: {nav.max_v: [0.3, 0.5]}\n",
+    )
+    tasks = plan_runs(load_sweep(sweep), base=tmp_path)
+    assert [(t.scenario, t.seed) for t in tasks[:6:2]] == [
+        ("dense-10", 10), ("dense-11", 11), ("dense-12", 12)
+    ]  # fmt: skip
+    assert tasks[0].family == "generated(density=dense)"
+    assert tasks[6].scenario == "sparse-0"
+    assert tasks[6].family == "generated(obstacle_count=[0, 2])"
+    assert all(t.scenario_json == "" and t.world is not None for t in tasks)
+    assert len({t.run_id for t in tasks}) == 8
+    # the worker's world is the generator's own for that seed
+    assert tasks[2].world is not None
+    scenario_json, labels = draw_world(*tasks[2].world)
+    world = generate_world(11, DENSE)
+    assert scenario_json == world.scenario.model_dump_json()
+    assert labels["world_reachable"] == world.reachable
+    assert labels["shortest_path_m"] == world.shortest_path_m
+
+
+@pytest.mark.parametrize(
+    ("params", "fragments"),
+    [
+        ("{density: thick}", ("scenarios.0.generate.params.density", "sparse, dense")),
+        ("{obstacles: 3}", ("scenarios.0.generate.params.obstacles", "obstacle_count")),
+        ("{arena: 50}", ("scenarios.0.generate.params", "arena must be in (2, 10]")),
+    ],
+)
+def test_bad_generator_parameters(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path, params: str, fragments: tuple[str, ...]
+) -> None:
+    sweep = _write(
+        tmp_path / "g.yaml", f"scenarios: [{{generate: {{count: 2, params: {params}}}}}]\n"
+    )
+    _fails(capsys, ["sweep", str(sweep), "--out", str(tmp_path / "o")], "g.yaml", *fragments)
+
+
+def test_the_quick_form_generates_worlds(tmp_path: Path) -> None:
+    import argparse
+
+    from otonav.cli.sweep import quick_spec
+
+    args = argparse.Namespace(
+        scenario=[], generate=4, density="dense", gen=["max_speed=0.5"], seeds=None,
+        overrides=["nav.max_v=0.3,0.5"], keep="failures",
+    )  # fmt: skip
+    tasks = plan_runs(quick_spec(args))
+    assert len(tasks) == 8
+    assert tasks[0].family == "generated(density=dense,max_speed=0.5)"
+    assert [t.overrides for t in tasks[:2]] == [(("nav.max_v", 0.3),), (("nav.max_v", 0.5),)]
