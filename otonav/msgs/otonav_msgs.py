@@ -19,7 +19,8 @@ class WheelCommand(Message):
 
 class NavState(Message):
     """What the navigator is doing: ``idle`` (no goal), ``waiting`` (no fresh scan),
-    ``driving``, ``blocked`` (obstacle ahead) or ``reached``."""
+    ``driving``, ``blocked`` (obstacle ahead), ``reached`` or ``fault`` (the hardware
+    reports a fault: it commands zero)."""
 
     ros_type: ClassVar[str] = "otonav_msgs/msg/NavState"
     header: Header = Header()

@@ -3,7 +3,7 @@ through the public :func:`~otonav.scenario.run_scenario` in a private scratch
 directory, hash the recording, and hand back the verdict figures plus, for runs the
 sweep keeps, the artifacts as bytes. The driver alone writes into ``--out``, so a
 worker on another machine needs no shared filesystem
-(docs/adr/0016-sweep-backends-and-artifacts.md).
+(docs/adr/0018-sweep-backends-and-artifacts.md).
 
 A worker imports otonav once and runs many tasks; nothing of one run survives into the
 next (each run builds its own world, loop and recorder), which is what makes a run's

@@ -7,8 +7,8 @@ waits on all of them (``ray.wait``), so a dead actor (``RayActorError``) or a ru
 its wall ceiling (the actor is killed) costs only that run, recorded as an ``error``,
 and a fresh actor takes the slot. Outcomes come back through Ray's object store, kept
 artifacts included as bytes, and the driver writes them into ``--out``: remote workers
-need no shared filesystem (docs/adr/0016-sweep-backends-and-artifacts.md). Every node needs otonav
-installed (the same version) in the Python that runs Ray.
+need no shared filesystem (docs/adr/0018-sweep-backends-and-artifacts.md). Every node
+needs otonav installed (the same version) in the Python that runs Ray.
 """
 
 from __future__ import annotations
