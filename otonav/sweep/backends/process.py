@@ -22,6 +22,7 @@ parent decides what stops) and exit by themselves when the parent goes away (EOF
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import multiprocessing.connection
 import os
@@ -62,7 +63,11 @@ def _worker_main(fd: int, scratch: Path) -> None:
             return
         if task is None:
             return
-        conn.send(execute(task, scratch))
+        try:
+            outcome = execute(task, scratch)
+        except (KeyboardInterrupt, asyncio.CancelledError):  # SIGTERM to the process group:
+            return  # the run was cancelled (recording finished); the parent decides the rest
+        conn.send(outcome)
 
 
 @dataclass
@@ -93,7 +98,7 @@ class ProcessBackend:
 
     def __init__(self, workers: int | None = None) -> None:
         self.workers = workers or len(os.sched_getaffinity(0))
-        self._root = Path(tempfile.mkdtemp(prefix="otonav-sweep-"))
+        self._root = Path(tempfile.gettempdir())
         self._spawned = 0
 
     def _spawn(self) -> _Worker:
@@ -114,6 +119,7 @@ class ProcessBackend:
 
     def run(self, tasks: Sequence[RunTask], emit: Emit, stop: threading.Event) -> None:
         queue = deque(tasks)
+        self._root = Path(tempfile.mkdtemp(prefix="otonav-sweep-"))
         pool = [self._spawn() for _ in range(min(self.workers, len(queue)))]
         try:
             while not stop.is_set():
@@ -123,11 +129,11 @@ class ProcessBackend:
                         w.conn.send(w.task)
                 if not queue and all(w.task is None for w in pool):
                     return
-                self._wait(pool, emit)
+                self._wait(pool, emit, stop)
         finally:
             self._shutdown(pool)
 
-    def _wait(self, pool: list[_Worker], emit: Emit) -> None:
+    def _wait(self, pool: list[_Worker], emit: Emit, stop: threading.Event) -> None:
         now = time.perf_counter()
         timeout = _POLL_S
         for w in pool:
@@ -149,6 +155,9 @@ class ProcessBackend:
                         emit(task, message)
             if dead:
                 code = w.proc.wait()
+                if stop.is_set():  # a stop's signal may reach the workers too: their runs
+                    w.task = None  # are unfinished, not errors, and nothing replaces them
+                    continue
                 if not w.ready:
                     raise RuntimeError(
                         f"a sweep worker failed to start ({_exit_description(code)}); "
