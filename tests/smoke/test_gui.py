@@ -184,6 +184,13 @@ class _Child:
         return f" (exit {self.proc.poll()}); child stderr:\n{''.join(self.stderr)[-3000:]}"
 
 
+def _first_display() -> int:
+    return 100 + (os.getpid() * 7 + len(_STARTED)) % 800
+
+
+_STARTED: list[int] = []
+
+
 def _start_children(tmp_path: Path, source: str) -> Iterator[Callable[..., _Child]]:
     """Start ``source`` as a script under its own ``xvfb-run``, with the given argv."""
     xvfb_run = _need("xvfb-run")
@@ -193,7 +200,10 @@ def _start_children(tmp_path: Path, source: str) -> Iterator[Callable[..., _Chil
 
     def start(*argv: object) -> _Child:
         proc = subprocess.Popen(
-            [xvfb_run, "-a", "-s", XVFB_SCREEN, sys.executable, str(script)]
+            # -a from a number of our own: parallel suites on one machine (each starting at
+            # :99) raced for the same display ("Failed to open display").
+            [xvfb_run, "-a", "-n", str(_first_display()), "-s", XVFB_SCREEN]
+            + [sys.executable, str(script)]
             + [str(a) for a in argv],
             env=_child_env(),
             stdin=subprocess.PIPE,
@@ -202,6 +212,7 @@ def _start_children(tmp_path: Path, source: str) -> Iterator[Callable[..., _Chil
             text=True,
             start_new_session=True,  # its own process group: xvfb-run, Xvfb and python
         )
+        _STARTED.append(proc.pid)
         child = _Child(proc)
         children.append(child)
         child.start_readers()
