@@ -29,7 +29,10 @@ from otonav.hal.viewer import NO_DISPLAY_FIX
 
 pytestmark = pytest.mark.smoke
 
-XVFB_SCREEN = "-screen 0 640x480x24"
+# -noreset: Xvfb resets whenever its last client disconnects, and a connection made
+# during the reset fails ("Failed to open display"): a screenshot taken while the viewer
+# probes the display, or a probe made while a screenshot closes, raced it.
+XVFB_SCREEN = "-screen 0 640x480x24 -noreset"
 ENSURE = "scripts/ensure_xvfb.sh (Debian packages xvfb, x11-apps)"
 
 NO_DISPLAY_CHILD = """
@@ -368,7 +371,11 @@ def test_gui_camera_follows_the_robot_and_hold_keeps_the_window_open(
     deadline = time.monotonic() + 15.0
     start = (0, math.nan, math.nan)
     while start[0] < 30 and time.monotonic() < deadline and child.proc.poll() is None:
-        start = _robot(_screenshot(display, xauthority))  # the window is up, robot in it
+        try:
+            start = _robot(_screenshot(display, xauthority))  # the window is up, robot in it
+        except subprocess.CalledProcessError as exc:
+            child.proc.wait(timeout=10)  # the X server went: the child ended
+            raise AssertionError(f"no screenshot ({exc.stderr!r}){child}") from None
     assert start[0] >= 30, f"no robot on screen after the viewer opened: {start}{child}"
 
     child.expect("the recording is finished;", timeout=30)  # the run ended, window held
