@@ -30,7 +30,8 @@ class NavState(Message):
     heading_error: float = 0.0
     """rad, wrapped to [-pi, pi]."""
     closest_ahead: float = 0.0
-    """m, closest valid return in the guard's front sector (inf if none)."""
+    """m, closest valid return in the guard's front sector (inf if none; -inf: a return
+    closer than the lidar's range_min, REP 117)."""
 
 
 class ScenarioVerdict(Message):
