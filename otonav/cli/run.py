@@ -63,7 +63,45 @@ def add_parser(commands: Any) -> None:
         default=None,
         help="with --realtime/--gui only: sim seconds per wall second (default 1)",
     )
+<<<<<<< HEAD
     p.add_argument("--gui", action="store_true", help="show the run in MuJoCo's viewer (real time)")
+    live = p.add_argument_group("live view in Foxglove (needs the otonav[foxglove] extra)")
+    live.add_argument(
+        "--foxglove",
+        action="store_true",
+        help="serve every topic over the Foxglove WebSocket protocol while the run goes",
+    )
+    live.add_argument(
+        "--foxglove-port",
+        type=int,
+        default=8765,
+        metavar="PORT",
+        help="TCP port (default 8765; 0: any free port)",
+    )
+    live.add_argument(
+        "--foxglove-host",
+        default="127.0.0.1",
+        metavar="HOST",
+        help="interface to bind (default 127.0.0.1, loopback only; 0.0.0.0: every interface)",
+    )
+    live.add_argument(
+        "--foxglove-wait",
+        type=float,
+        default=None,
+        metavar="S",
+        help="hold sim time at the start until a client subscribes (at most S wall seconds)",
+=======
+    p.add_argument(
+        "--gui",
+        action="store_true",
+        help="show the run in MuJoCo's viewer (real time); the camera follows the robot",
+    )
+    p.add_argument(
+        "--hold",
+        action="store_true",
+        help="with --gui: keep the window open at the end, until you close it",
+>>>>>>> main
+    )
     p.set_defaults(handler=main)
 
 
@@ -116,6 +154,8 @@ def main(args: argparse.Namespace) -> int:
             f"--scale {args.scale:g}: only with --realtime or --gui "
             "(a headless run is not paced: it runs as fast as it can)"
         )
+    if args.hold and not args.gui:
+        raise ConfigFileError("--hold: only with --gui (it keeps the viewer window open)")
     if not (scale > 0 and math.isfinite(scale)):
         raise ConfigFileError(f"--scale {scale}: must be a finite number > 0 (sim s per wall s)")
     scenario = load_scenario(args.scenario)
@@ -137,6 +177,18 @@ def main(args: argparse.Namespace) -> int:
         for path in stale:
             path.unlink(missing_ok=True)
 
+<<<<<<< HEAD
+    server, extra = _live_view(args)
+=======
+    console = Console(highlight=False)
+    held: list[Verdict] = []
+
+    def hold(verdict: Verdict) -> None:
+        print_verdict(verdict, console)
+        console.print("the recording is finished; close the viewer window to exit")
+        held.append(verdict)
+
+>>>>>>> main
     try:
         if args.gui or args.realtime:
             from otonav.scenario.realtime import run_scenario_realtime
@@ -149,6 +201,11 @@ def main(args: argparse.Namespace) -> int:
                 scale=scale,
                 gui=args.gui,
                 on_start=on_start,
+<<<<<<< HEAD
+                extra_actors=extra,
+=======
+                hold=hold if args.hold else None,
+>>>>>>> main
             )
         else:
             verdict = run_scenario(
@@ -159,6 +216,7 @@ def main(args: argparse.Namespace) -> int:
                 progress=progress,
                 source=source,
                 on_start=on_start,
+                extra_actors=extra,
             )
     except asyncio.CancelledError:
         print("otonav: terminated; the recording was finished and is readable", file=sys.stderr)
@@ -166,10 +224,43 @@ def main(args: argparse.Namespace) -> int:
     finally:
         if progress is not None:
             progress.clear()
+        if server is not None:
+            server.close()
     out.mkdir(parents=True, exist_ok=True)
     summary = out / "summary.json"
     summary.write_text(json.dumps(finite_figures(verdict.as_dict()), indent=2, default=str) + "\n")
-    console = Console(highlight=False)
-    print_verdict(verdict, console)
+    if held:  # the table was printed while the window was held open
+        for label, path in (("recording", verdict.recording), ("plot", verdict.plot)):
+            if path:
+                console.print(f"{label}: {path}")
+    else:
+        print_verdict(verdict, console)
     console.print(f"summary: {summary}")
     return 0 if verdict.passed else 1
+
+
+def _live_view(args: argparse.Namespace) -> tuple[Any, tuple[Any, ...]]:
+    """The Foxglove server and its actor when ``--foxglove`` (one line, exit 2, when it
+    cannot start); ``(None, ())`` otherwise."""
+    import sys
+
+    from otonav.stack.files import ConfigFileError
+
+    if not args.foxglove:
+        return None, ()
+    from otonav.actors.live_view import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
+
+    try:
+        options = LiveViewOptions(
+            host=args.foxglove_host, port=args.foxglove_port, wait_for_subscriber=args.foxglove_wait
+        )
+        server = FoxgloveServer(options)
+    except LiveViewError as exc:
+        raise ConfigFileError(str(exc)) from None
+    print(
+        f"foxglove: serving every topic on {server.url} (Foxglove: Open connection -> "
+        "Foxglove WebSocket)",
+        file=sys.stderr,
+        flush=True,
+    )
+    return server, (LiveView(server),)
