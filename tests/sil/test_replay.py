@@ -149,8 +149,9 @@ def test_a_real_time_recording_replays_with_recorded_wakes(tmp_path: Path) -> No
     timers = replay_recording(recording, ["nav"])
     cmd = next(t for t in timers.topics if t.topic == "/cmd_vel")
     assert cmd.recorded >= 35
-    assert cmd.identical == 0
-    assert {d.kind for d in timers.divergences} == {"missing", "extra"}
+    assert cmd.missing > 0.5 * cmd.recorded  # (a wake can land on its deadline by chance)
+    timing = [d for d in timers.divergences if d.kind != "content"]
+    assert len(timing) > 0.9 * len(timers.divergences)
     # Woken at the recorded instants, it decides the same: every command identical
     # (a burst whose outputs were published at two instants can differ, hence 90 %).
     recorded = replay_recording(recording, ["nav"], wake="recorded")
