@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import asyncio
 import json
-import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -15,12 +14,15 @@ from rich.console import Console
 from rich.table import Table
 
 from otonav.cli.progress import ProgressLine
+from otonav.cli.signals import StopOnSignals
+from otonav.runtime import WallClockCeilingError
 from otonav.scenario import ScenarioConfig, Verdict, run_scenario
 from otonav.scenario.builtin import BUILTIN
 from otonav.scenario.realtime import run_scenario_realtime
 from otonav.scenario.run import finite_figures
 from otonav.stack import StackConfig
 from otonav.stack.files import ConfigFileError, describe_validation_error, load_model
+from otonav.stack.limits import check_scale
 from otonav.stack.overrides import apply_overrides
 
 DEFAULT_OUT = Path("out")
@@ -98,6 +100,11 @@ def print_verdict(verdict: Verdict, console: Console) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    with StopOnSignals() as guard:
+        return _main(args, guard)
+
+
+def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
     scenario = load_scenario(args.scenario)
     if args.seed is not None:  # validated like the file (model_copy would not check it)
         try:
@@ -108,12 +115,12 @@ def main(args: argparse.Namespace) -> int:
     out: Path = args.out
     source = args.scenario if args.scenario not in BUILTIN else f"scenario '{args.scenario}'"
     progress = ProgressLine() if sys.stderr.isatty() else None
+    guard.arm()  # from here a signal stops the run and lets it finish its artifacts
     try:
         if args.gui or args.realtime:
-            if not (args.scale > 0 and math.isfinite(args.scale)):
-                raise ConfigFileError(
-                    f"--scale {args.scale}: must be a finite number > 0 (sim s per wall s)"
-                )
+            problem = check_scale(args.scale)
+            if problem is not None:
+                raise ConfigFileError(problem)
             verdict = run_scenario_realtime(
                 scenario,
                 stack,
@@ -121,6 +128,7 @@ def main(args: argparse.Namespace) -> int:
                 record=not args.no_record,
                 scale=args.scale,
                 gui=args.gui,
+                on_start=guard.attach,
             )
         else:
             verdict = run_scenario(
@@ -130,13 +138,28 @@ def main(args: argparse.Namespace) -> int:
                 record=not args.no_record,
                 progress=progress,
                 source=source,
+                on_start=guard.attach,
             )
     except asyncio.CancelledError:
+        if guard.received is not None:
+            return guard.report()
         print("otonav: terminated; the recording was finished and is readable", file=sys.stderr)
         return 143
+    except WallClockCeilingError as exc:
+        # A run that outlasts its wall-clock ceiling is a failed run, not a crash: the
+        # recording and the plot were finished on the way out.
+        kept = [str(out / name) for name in ("recording.mcap", "trajectory.png")]
+        kept = [path for path in kept if Path(path).exists()]
+        print(
+            f"otonav: error: {exc}" + (f"; kept {', '.join(kept)}" if kept else ""),
+            file=sys.stderr,
+        )
+        return 1
     finally:
         if progress is not None:
             progress.clear()
+    if guard.received is not None:  # the run had ended; the signal came while saving
+        return guard.report()
     out.mkdir(parents=True, exist_ok=True)
     summary = out / "summary.json"
     summary.write_text(json.dumps(finite_figures(verdict.as_dict()), indent=2, default=str) + "\n")

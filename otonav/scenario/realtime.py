@@ -31,6 +31,7 @@ from otonav.scenario.run import (
     scenario_world,
 )
 from otonav.stack import StackConfig
+from otonav.stack.limits import check_scale
 
 __all__ = ["VIEWER_HZ", "run_scenario_realtime"]
 
@@ -95,8 +96,9 @@ def run_scenario_realtime(
     closed at the end. Closing the window stops the run: the verdict fails and says so.
     ``on_start(loop, task)`` is called on the run's loop once the window (if any) is up.
     """
-    if not scale > 0:
-        raise ValueError(f"real-time scale must be > 0, got {scale!r}")
+    problem = check_scale(scale, "scale")
+    if problem is not None:
+        raise ValueError(problem)
     if gui:
         check_display()
     stack, hal = scenario_world(scenario, stack)
