@@ -26,3 +26,5 @@ COMMAND_QOS = QoS(depth=10)
 TF_QOS = QoS(depth=100)
 #: Goals and static transforms: latched (a late subscriber gets the last one).
 LATCHED = LATCHED_QOS
+#: /rosout: as in ROS 2, reliable, keep the last 1000 (publishers never block on it).
+ROSOUT_QOS = QoS(depth=1000)
