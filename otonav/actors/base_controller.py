@@ -10,7 +10,7 @@ import anyio
 
 from otonav.actors import topics
 from otonav.control import DiffDriveGeometry, limit_twist, twist_to_wheels
-from otonav.msgs import Header, Log, Time, Twist, WheelCommand
+from otonav.msgs import HardwareStatus, Header, Log, Time, Twist, WheelCommand
 from otonav.runtime import Actor, Input, Output
 
 
@@ -29,6 +29,10 @@ class BaseController(Actor):
     limits, convert to wheel speeds, publish /wheel_cmd. With no /cmd_vel for
     ``cmd_timeout`` s of sim time the target falls to zero (the watchdog).
 
+    While /hardware/status says the hardware is not drivable (a fault, or starting or
+    recovering), it commands zero at once, bypassing the acceleration limits, and
+    counts it in ``hardware_stops``; when it is drivable again it ramps up from rest.
+
     A /cmd_vel that is not finite (NaN, inf) is dropped: the base keeps the last good
     command (the watchdog still counts from it), counts it in ``rejected_commands`` and
     says so on /rosout, at most once per second of sim time. One bad message from one
@@ -36,6 +40,7 @@ class BaseController(Actor):
 
     cmd_vel = Input(topics.CMD_VEL, Twist, topics.COMMAND_QOS)
     wheel_cmd = Output(topics.WHEEL_CMD, WheelCommand, topics.COMMAND_QOS)
+    hardware = Input(topics.HARDWARE_STATUS, HardwareStatus, topics.HARDWARE_QOS)
     rosout = Output(topics.ROSOUT, Log, topics.ROSOUT_QOS)
 
     LOG_EVERY = 1.0
@@ -63,6 +68,7 @@ class BaseController(Actor):
         self.rejected_commands = 0
         self._logged_at = -math.inf
         self._logged_count = 0
+        self.hardware_stops = 0
 
     async def run(self) -> None:
         rate = self.clock.rate(self.rate_hz)
@@ -71,9 +77,15 @@ class BaseController(Actor):
         target: Twist | None = None
         received_at = -math.inf
         timed_out = False
+        drivable = True
         while True:
             await rate.sleep()
             now = self.clock.now()
+            status = self.hardware.take_latest()
+            if status is not None:
+                if drivable and not status.drivable:
+                    self.hardware_stops += 1
+                drivable = status.drivable
             latest = self.cmd_vel.take_latest()
             if latest is not None:
                 if math.isfinite(latest.linear.x) and math.isfinite(latest.angular.z):
@@ -92,6 +104,8 @@ class BaseController(Actor):
                 if target is not None and not timed_out
                 else (0.0, 0.0)
             )
+            if not drivable:
+                v = omega = want_v = want_omega = 0.0
             v, omega = limit_twist(
                 want_v,
                 want_omega,

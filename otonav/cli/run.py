@@ -3,34 +3,44 @@
 from __future__ import annotations
 
 import argparse
-import asyncio
-import json
-import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from pydantic import ValidationError
-from rich.console import Console
-from rich.table import Table
+if TYPE_CHECKING:  # the command's imports are in main(): --help stays fast
+    from rich.console import Console
 
-from otonav.cli.progress import ProgressLine
-from otonav.cli.signals import StopOnSignals
-from otonav.runtime import WallClockCeilingError
-from otonav.scenario import ScenarioConfig, Verdict, run_scenario
-from otonav.scenario.builtin import BUILTIN
-from otonav.scenario.realtime import run_scenario_realtime
-from otonav.scenario.run import finite_figures
-from otonav.stack import StackConfig
-from otonav.stack.files import ConfigFileError, describe_validation_error, load_model
-from otonav.stack.limits import check_scale
-from otonav.stack.overrides import apply_overrides
+    from otonav.cli.signals import StopOnSignals
+    from otonav.scenario import Verdict
 
 DEFAULT_OUT = Path("out")
 
 
+class _HelpFormatter(argparse.HelpFormatter):
+    """Fills ``{builtin}`` in a flag's help with the built-in scenario names, only when
+    the help is printed (building the parser must not import the scenarios)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = super()._get_help_string(action)
+        if text is not None and "{builtin}" in text:
+            from otonav.scenario.builtin import BUILTIN
+
+            text = text.replace("{builtin}", ", ".join(BUILTIN))
+        return text
+
+
 def add_parser(commands: Any) -> None:
-    p = commands.add_parser("run", help="run a scenario (default: acceptance) headless")
-    p.add_argument("--scenario", default="acceptance", help="built-in name or YAML path")
+    p = commands.add_parser(
+        "run",
+        help="run a scenario (default: acceptance) headless",
+        formatter_class=_HelpFormatter,
+    )
+    p.add_argument(
+        "--scenario",
+        default="acceptance",
+        metavar="NAME|PATH",
+        help="a built-in scenario ({builtin}; 'otonav scenarios' describes them) "
+        "or a scenario YAML file (default: acceptance)",
+    )
     p.add_argument("--config", type=Path, help="stack config YAML (default: built-in)")
     p.add_argument(
         "--set",
@@ -51,30 +61,25 @@ def add_parser(commands: Any) -> None:
     p.add_argument(
         "--scale",
         type=float,
-        default=1.0,
-        help="with --realtime/--gui: sim seconds per wall second",
+        default=None,
+        help="with --realtime/--gui only: sim seconds per wall second (default 1)",
     )
-    p.add_argument("--gui", action="store_true", help="show the run in MuJoCo's viewer (real time)")
+    p.add_argument(
+        "--gui",
+        action="store_true",
+        help="show the run in MuJoCo's viewer (real time); the camera follows the robot",
+    )
+    p.add_argument(
+        "--hold",
+        action="store_true",
+        help="with --gui: keep the window open at the end, until you close it",
+    )
     p.set_defaults(handler=main)
 
 
-def load_scenario(spec: str) -> ScenarioConfig:
-    if spec in BUILTIN:
-        return BUILTIN[spec]
-    path = Path(spec)
-    if path.suffix in (".yaml", ".yml") or path.exists():
-        return load_model(path, ScenarioConfig)
-    raise ConfigFileError(
-        f"--scenario {spec!r}: not a built-in scenario ({', '.join(BUILTIN)}) nor a YAML file"
-    )
-
-
-def load_stack(config: Path | None, overrides: list[str]) -> StackConfig:
-    stack = load_model(config, StackConfig) if config is not None else StackConfig()
-    return apply_overrides(stack, overrides) if overrides else stack
-
-
 def print_verdict(verdict: Verdict, console: Console) -> None:
+    from rich.table import Table
+
     table = Table(
         title=f"scenario {verdict.scenario}: " + ("PASSED" if verdict.passed else "FAILED")
     )
@@ -100,11 +105,40 @@ def print_verdict(verdict: Verdict, console: Console) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    from otonav.cli.signals import StopOnSignals
+
     with StopOnSignals() as guard:
         return _main(args, guard)
 
 
 def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
+    import asyncio
+    import json
+    import sys
+
+    from pydantic import ValidationError
+    from rich.console import Console
+
+    from otonav.cli.loading import load_scenario, load_stack
+    from otonav.cli.progress import ProgressLine
+    from otonav.runtime import WallClockCeilingError
+    from otonav.scenario import ScenarioConfig, run_scenario
+    from otonav.scenario.builtin import BUILTIN
+    from otonav.scenario.run import finite_figures
+    from otonav.stack.files import ConfigFileError, describe_validation_error
+    from otonav.stack.limits import check_scale
+
+    scale = 1.0 if args.scale is None else args.scale
+    if args.scale is not None and not (args.realtime or args.gui):
+        raise ConfigFileError(
+            f"--scale {args.scale:g}: only with --realtime or --gui "
+            "(a headless run is not paced: it runs as fast as it can)"
+        )
+    if args.hold and not args.gui:
+        raise ConfigFileError("--hold: only with --gui (it keeps the viewer window open)")
+    problem = check_scale(scale)
+    if problem is not None:
+        raise ConfigFileError(problem)
     scenario = load_scenario(args.scenario)
     if args.seed is not None:  # validated like the file (model_copy would not check it)
         try:
@@ -115,20 +149,38 @@ def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
     out: Path = args.out
     source = args.scenario if args.scenario not in BUILTIN else f"scenario '{args.scenario}'"
     progress = ProgressLine() if sys.stderr.isatty() else None
+    stale = [out / "summary.json"] + ([out / "recording.mcap"] if args.no_record else [])
+
+    def on_start(loop: asyncio.AbstractEventLoop, task: asyncio.Task[None]) -> None:
+        # The run has started (its input is valid, its world built, its recording
+        # opened): the previous run's artifacts must not pass for this one's. Nothing is
+        # deleted on bad input. An interrupted run writes no summary.json.
+        for path in stale:
+            path.unlink(missing_ok=True)
+        guard.attach(loop, task)  # a signal now cancels the run, which then finishes
+
+    console = Console(highlight=False)
+    held: list[Verdict] = []
+
+    def hold(verdict: Verdict) -> None:
+        print_verdict(verdict, console)
+        console.print("the recording is finished; close the viewer window to exit")
+        held.append(verdict)
+
     guard.arm()  # from here a signal stops the run and lets it finish its artifacts
     try:
         if args.gui or args.realtime:
-            problem = check_scale(args.scale)
-            if problem is not None:
-                raise ConfigFileError(problem)
+            from otonav.scenario.realtime import run_scenario_realtime
+
             verdict = run_scenario_realtime(
                 scenario,
                 stack,
                 out_dir=out,
                 record=not args.no_record,
-                scale=args.scale,
+                scale=scale,
                 gui=args.gui,
-                on_start=guard.attach,
+                on_start=on_start,
+                hold=hold if args.hold else None,
             )
         else:
             verdict = run_scenario(
@@ -138,7 +190,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
                 record=not args.no_record,
                 progress=progress,
                 source=source,
-                on_start=guard.attach,
+                on_start=on_start,
             )
     except asyncio.CancelledError:
         if guard.received is not None:
@@ -163,7 +215,11 @@ def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
     out.mkdir(parents=True, exist_ok=True)
     summary = out / "summary.json"
     summary.write_text(json.dumps(finite_figures(verdict.as_dict()), indent=2, default=str) + "\n")
-    console = Console(highlight=False)
-    print_verdict(verdict, console)
+    if held:  # the table was printed while the window was held open
+        for label, path in (("recording", verdict.recording), ("plot", verdict.plot)):
+            if path:
+                console.print(f"{label}: {path}")
+    else:
+        print_verdict(verdict, console)
     console.print(f"summary: {summary}")
     return 0 if verdict.passed else 1

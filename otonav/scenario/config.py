@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated, Literal
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, PositiveFloat
 
-from otonav.hal import BoxObstacle
 from otonav.stack import limits
+
+if TYPE_CHECKING:  # imported in to_obstacle: reading a scenario file needs no numpy
+    from otonav.hal.types import BoxObstacle
+
 
 # Bounds: what the stack can honour, and why (otonav/stack/limits.py).
 Coordinate = Annotated[float, Field(ge=-limits.MAX_COORDINATE_M, le=limits.MAX_COORDINATE_M)]
@@ -39,6 +42,8 @@ class BoxSpec(BaseModel):
     yaw: Yaw = 0.0
 
     def to_obstacle(self) -> BoxObstacle:
+        from otonav.hal.types import BoxObstacle
+
         return BoxObstacle(self.x, self.y, self.size_x / 2, self.size_y / 2, self.yaw)
 
 
@@ -84,3 +89,7 @@ class ScenarioConfig(BaseModel):
     min_clearance: Distance = 0.3
     """m: the robot centre must never come closer than this to an obstacle or wall."""
     seed: int = Field(0, ge=0, le=limits.MAX_SEED)
+    expect: Literal["reached", "unreachable"] = "reached"
+    """The outcome that passes: ``reached`` (the goal within tolerance inside the budget)
+    or ``unreachable`` (the navigator reports ``unreachable`` on /nav/state inside the
+    budget, e.g. a walled-in goal). Either way the clearance must hold."""

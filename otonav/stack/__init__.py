@@ -1,6 +1,15 @@
-"""Composition: the robot stack from its config (the launch file)."""
+"""Composition: the robot stack from its config (the launch file), and the session
+that runs it (time mode, recording, one teardown: ``otonav.stack.session``).
 
-from otonav.stack.build import build_actors, build_world
+The config models are imported here; ``build_actors``, ``build_world`` and the session
+(the actors, MuJoCo, numpy) on first use, so reading a config file stays cheap (``otonav --help``).
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
+
 from otonav.stack.config import (
     BaseConfig,
     GuardConfig,
@@ -10,13 +19,32 @@ from otonav.stack.config import (
     WorldConfig,
 )
 
+if TYPE_CHECKING:
+    from otonav.stack.build import build_actors, build_world
+    from otonav.stack.session import RealTime, StackSession
+
 __all__ = (
     "BaseConfig",
     "GuardConfig",
     "NavConfig",
     "RatesConfig",
+    "RealTime",
     "StackConfig",
+    "StackSession",
     "WorldConfig",
     "build_actors",
     "build_world",
 )
+
+_LAZY = {
+    "build_actors": "otonav.stack.build",
+    "build_world": "otonav.stack.build",
+    "RealTime": "otonav.stack.session",
+    "StackSession": "otonav.stack.session",
+}
+
+
+def __getattr__(name: str) -> object:
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

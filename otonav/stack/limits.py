@@ -5,7 +5,7 @@ naming the key), because inside them the stack was measured to run, and outside 
 it crashed, hung or ran for hours (issue 17: ``lidar_range_max=1e300`` overflowed the
 float32 scan, ``timestep=1e-9`` and ``scan_hz=1e9`` livelocked the loop,
 ``lidar_beams=1e7`` ran out of memory, a 10 MB name hung the plot). Each constant
-says why it is where it is; ADR 0013 records the trade and how to move a bound.
+says why it is where it is; ADR 0019 records the trade and how to move a bound.
 
 Costs quoted below were measured on the 2-core development machine (2026-11-23,
 ``python -m otonav run`` with ``--set``, noisy: shared with other jobs).

@@ -20,6 +20,8 @@ PACKAGES = [
     "otonav.scenario",
     "otonav.testing",
     "otonav.embed",
+    "otonav.replay",
+    "otonav.sweep",
 ]
 
 

@@ -141,11 +141,13 @@ def test_realtime_scale_is_bounded(
 def test_hitting_the_wall_ceiling_is_one_line_not_a_traceback(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, tmp_path: Path
 ) -> None:
-    import otonav.cli.run as cli_run
+    import otonav.scenario as scenario_pkg
     from otonav.scenario import run_scenario
 
     # A tiny ceiling stands in for a machine far slower than the reference one.
-    monkeypatch.setattr(cli_run, "run_scenario", functools.partial(run_scenario, wall_ceiling=0.3))
+    monkeypatch.setattr(
+        scenario_pkg, "run_scenario", functools.partial(run_scenario, wall_ceiling=0.3)
+    )
     f = tmp_path / "s.yaml"
     f.write_text("sim_budget: 1800.0\n")
     code = main(["run", "--scenario", str(f), "--set", "nav.kp_lin=0", "--out", str(tmp_path)])
