@@ -121,12 +121,12 @@ def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
 
     from otonav.cli.loading import load_scenario, load_stack
     from otonav.cli.progress import ProgressLine
+    from otonav.limits import check_scale
     from otonav.runtime import WallClockCeilingError
     from otonav.scenario import ScenarioConfig, run_scenario
     from otonav.scenario.builtin import BUILTIN
     from otonav.scenario.run import finite_figures
     from otonav.stack.files import ConfigFileError, describe_validation_error
-    from otonav.stack.limits import check_scale
 
     scale = 1.0 if args.scale is None else args.scale
     if args.scale is not None and not (args.realtime or args.gui):

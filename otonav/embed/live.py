@@ -14,6 +14,7 @@ from otonav.actors import topics
 from otonav.embed._wait import _wait_done
 from otonav.embed.paced import PacedClock
 from otonav.hal import RobotHardwareInterface
+from otonav.limits import check_scale
 from otonav.msgs import Header, Message, Point, Pose, PoseStamped, Time
 from otonav.runtime import (
     DEFAULT_QOS,
@@ -30,7 +31,6 @@ from otonav.runtime import (
     System,
 )
 from otonav.stack import StackConfig, build_actors, build_world
-from otonav.stack.limits import check_scale
 from otonav.stack.session import StackSession
 
 M = TypeVar("M")
@@ -318,7 +318,7 @@ async def open_live_stack(
     On exit (normal, an exception, or the host's cancellation) the stack stops and the
     recording is finished. If an actor crashed and stopped the stack while the body ran
     normally, its :class:`~otonav.runtime.ActorCrashedError` is raised on exit.
-    A ``scale`` outside [0.01, 100] raises ``ValueError`` (``otonav.stack.limits``).
+    A ``scale`` outside [0.01, 100] raises ``ValueError`` (``otonav.limits``).
     """
     problem = check_scale(scale, "scale")
     if problem is not None:

@@ -6,13 +6,13 @@ from typing import TYPE_CHECKING, Annotated, Literal
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, PositiveFloat
 
-from otonav.stack import limits
+from otonav import limits
 
 if TYPE_CHECKING:  # imported in to_obstacle: reading a scenario file needs no numpy
     from otonav.hal.types import BoxObstacle
 
 
-# Bounds: what the stack can honour, and why (otonav/stack/limits.py).
+# Bounds: what the stack can honour, and why (otonav/limits.py).
 Coordinate = Annotated[float, Field(ge=-limits.MAX_COORDINATE_M, le=limits.MAX_COORDINATE_M)]
 """m, a position in the world plane."""
 Size = Annotated[float, Field(gt=0.0, le=limits.MAX_COORDINATE_M)]

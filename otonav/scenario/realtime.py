@@ -15,6 +15,7 @@ import anyio
 
 from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
+from otonav.limits import check_scale
 from otonav.runtime import RealTimeClock
 from otonav.runtime.timesource import tick_rate
 from otonav.scenario.config import ScenarioConfig
@@ -29,7 +30,6 @@ from otonav.scenario.run import (
     scenario_world,
 )
 from otonav.stack import StackConfig
-from otonav.stack.limits import check_scale
 from otonav.stack.session import RealTime, StackSession
 
 __all__ = ["VIEWER_HZ", "run_scenario_realtime"]

@@ -5,9 +5,10 @@ from __future__ import annotations
 
 import math
 
+from otonav import limits
 from otonav.hal import BoxObstacle
 from otonav.scenario.config import ScenarioConfig
-from otonav.stack import StackConfig, limits
+from otonav.stack import StackConfig
 from otonav.stack.files import ConfigFileError
 
 
@@ -71,7 +72,7 @@ def check_cost(
     scenario: ScenarioConfig, stack: StackConfig, boxes: int, *, source: str = "scenario"
 ) -> None:
     """Raise :class:`ConfigFileError` when a run of this scenario on this stack is
-    estimated to take more wall time than :data:`~otonav.stack.limits.WALL_BUDGET_S`
+    estimated to take more wall time than :data:`~otonav.limits.WALL_BUDGET_S`
     (each value within its own bound, together too much: a tiny timestep and a long
     budget, a dense lidar at a high rate, ...). ``boxes``: obstacles and walls."""
     rates = stack.rates_hz()

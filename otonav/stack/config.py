@@ -8,7 +8,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, model_validator
 
-from otonav.stack import limits
+from otonav import limits
 
 
 class _Section(BaseModel):
@@ -24,7 +24,7 @@ class WorldConfig(_Section):
     """Built-in scene name (``empty``, ``obstacles``) or a path to an MJCF file."""
     timestep: float = Field(0.002, ge=limits.MIN_TIMESTEP_S, le=limits.MAX_TIMESTEP_S)
     """Physics step, s: one tick of sim time. Bounded by the cost of a step below and by
-    the fastest timer (the judge's 100 Hz) above: see ``otonav.stack.limits``."""
+    the fastest timer (the judge's 100 Hz) above: see ``otonav.limits``."""
     lidar_beams: PositiveInt = Field(360, le=limits.MAX_LIDAR_BEAMS)
     """Beams over a full circle, at most 3600 (0.1 degree, the finest 2D lidars)."""
     lidar_range_min: float = Field(0.12, ge=0.0)

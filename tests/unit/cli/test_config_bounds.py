@@ -1,5 +1,5 @@
 """Every number and string a user can configure is bounded by what the stack can honour
-(otonav/stack/limits.py): values that crashed, hung or ran for hours are refused at
+(otonav/limits.py): values that crashed, hung or ran for hours are refused at
 load time with one line naming the key, exit 2 (issue 17, item 2)."""
 
 from __future__ import annotations
