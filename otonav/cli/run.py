@@ -74,6 +74,32 @@ def add_parser(commands: Any) -> None:
         action="store_true",
         help="with --gui: keep the window open at the end, until you close it",
     )
+    live = p.add_argument_group("live view in Foxglove (needs the otonav[foxglove] extra)")
+    live.add_argument(
+        "--foxglove",
+        action="store_true",
+        help="serve every topic over the Foxglove WebSocket protocol while the run goes",
+    )
+    live.add_argument(
+        "--foxglove-port",
+        type=int,
+        default=8765,
+        metavar="PORT",
+        help="TCP port (default 8765; 0: any free port)",
+    )
+    live.add_argument(
+        "--foxglove-host",
+        default="127.0.0.1",
+        metavar="HOST",
+        help="interface to bind (default 127.0.0.1, loopback only; 0.0.0.0: every interface)",
+    )
+    live.add_argument(
+        "--foxglove-wait",
+        type=float,
+        default=None,
+        metavar="S",
+        help="hold sim time at the start until a client subscribes (at most S wall seconds)",
+    )
     p.set_defaults(handler=main)
 
 
@@ -159,6 +185,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
             path.unlink(missing_ok=True)
         guard.attach(loop, task)  # a signal now cancels the run, which then finishes
 
+    server, extra = _live_view(args)
     console = Console(highlight=False)
     held: list[Verdict] = []
 
@@ -180,6 +207,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
                 scale=scale,
                 gui=args.gui,
                 on_start=on_start,
+                extra_actors=extra,
                 hold=hold if args.hold else None,
             )
         else:
@@ -191,6 +219,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
                 progress=progress,
                 source=source,
                 on_start=on_start,
+                extra_actors=extra,
             )
     except asyncio.CancelledError:
         if guard.received is not None:
@@ -210,6 +239,8 @@ def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
     finally:
         if progress is not None:
             progress.clear()
+        if server is not None:
+            server.close()
     if guard.received is not None:  # the run had ended; the signal came while saving
         return guard.report()
     out.mkdir(parents=True, exist_ok=True)
@@ -223,3 +254,30 @@ def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
         print_verdict(verdict, console)
     console.print(f"summary: {summary}")
     return 0 if verdict.passed else 1
+
+
+def _live_view(args: argparse.Namespace) -> tuple[Any, tuple[Any, ...]]:
+    """The Foxglove server and its actor when ``--foxglove`` (one line, exit 2, when it
+    cannot start); ``(None, ())`` otherwise."""
+    import sys
+
+    from otonav.stack.files import ConfigFileError
+
+    if not args.foxglove:
+        return None, ()
+    from otonav.actors.live_view import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
+
+    try:
+        options = LiveViewOptions(
+            host=args.foxglove_host, port=args.foxglove_port, wait_for_subscriber=args.foxglove_wait
+        )
+        server = FoxgloveServer(options)
+    except LiveViewError as exc:
+        raise ConfigFileError(str(exc)) from None
+    print(
+        f"foxglove: serving every topic on {server.url} (Foxglove: Open connection -> "
+        "Foxglove WebSocket)",
+        file=sys.stderr,
+        flush=True,
+    )
+    return server, (LiveView(server),)
