@@ -17,9 +17,9 @@ from websockets.asyncio.client import ClientConnection, connect
 from websockets.exceptions import ConnectionClosed
 from websockets.typing import Subprotocol
 
-#: The protocol's name as foxglove-sdk >= 0.5 negotiates it. Its wire protocol is the
-#: one the spec calls foxglove.websocket.v1; the SDK refuses that older name (ADR 16).
-SUBPROTOCOL = Subprotocol("foxglove.sdk.v1")
+#: What the Foxglove app offers: the protocol's original name and its current one. The
+#: wire protocol is the same; foxglove-sdk negotiates only the current name (ADR 16).
+SUBPROTOCOLS = [Subprotocol("foxglove.websocket.v1"), Subprotocol("foxglove.sdk.v1")]
 CEILING = 30.0
 """Wall seconds after which a wait is a hang (never a timing assertion)."""
 
@@ -105,7 +105,7 @@ class FoxgloveClient:
 
     async def _main(self) -> None:
         async with connect(
-            self.url, subprotocols=[SUBPROTOCOL], max_size=None, close_timeout=1
+            self.url, subprotocols=SUBPROTOCOLS, max_size=None, close_timeout=1
         ) as ws:
             self.subprotocol = ws.subprotocol
             await asyncio.wait_for(self._advertisements(ws), CEILING)

@@ -14,7 +14,10 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from foxglove_client import FoxgloveClient
+from foxglove_client import SUBPROTOCOLS, FoxgloveClient
+from websockets.asyncio.client import connect
+from websockets.exceptions import InvalidStatus
+from websockets.typing import Subprotocol
 
 from otonav.actors.live_view import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
 from otonav.cli import main as cli_main
@@ -230,3 +233,14 @@ async def test_open_live_stack_serves_foxglove_on_the_host_loop() -> None:
     assert server.closed  # stopped with the stack
     stamps = [t for t, _ in client.received["/odom"]]
     assert stamps == sorted(stamps)
+
+
+@pytest.mark.asyncio
+async def test_a_client_offering_only_the_old_protocol_name_is_refused() -> None:
+    # What README and ADR 16 say: foxglove-sdk negotiates foxglove.sdk.v1 only.
+    with serving() as server:
+        with pytest.raises(InvalidStatus, match="400"):
+            async with connect(server.url, subprotocols=[Subprotocol("foxglove.websocket.v1")]):
+                pass
+        async with connect(server.url, subprotocols=SUBPROTOCOLS) as ws:
+            assert ws.subprotocol == "foxglove.sdk.v1"
