@@ -3,6 +3,7 @@ indexed recording that starts with the same metadata, none lost in between."""
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import pytest
@@ -43,7 +44,7 @@ def test_rotation_keeps_the_newest_files_under_the_cap(tmp_path: Path) -> None:
     # Oldest to newest, the kept files are contiguous: no message lost at a rotation.
     times = _times(writer.rotated(2)) + _times(writer.rotated(1)) + _times(live)
     assert times[-1] == pytest.approx(199.99)
-    steps = {round(b - a, 6) for a, b in zip(times, times[1:], strict=False)}
+    steps = {round(b - a, 6) for a, b in itertools.pairwise(times)}
     assert steps == {0.01}
 
 
