@@ -18,7 +18,7 @@ from otonav.record.writer import RecordingWriter
 from otonav.replay import replay_recording
 from otonav.replay.nodes import stack_actor_names
 from otonav.replay.recording import load_recording
-from otonav.scenario import run_scenario
+from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.stack import StackConfig
 from otonav.testing import replay
 
@@ -136,3 +136,27 @@ def test_cli_bad_files_are_exit_2(
         err = capsys.readouterr().err
         assert expected in err, err
         assert len(err.strip().splitlines()) == 1
+
+
+def test_a_real_time_recording_replays_with_recorded_wakes(tmp_path: Path) -> None:
+    from otonav.scenario.realtime import run_scenario_realtime
+
+    run_scenario_realtime(ScenarioConfig(sim_budget=2.0), out_dir=tmp_path, scale=10.0, plot=False)
+    recording = tmp_path / "recording.mcap"
+    # On its own timers the navigator wakes at k * 50 ms; in real time it woke when the
+    # world had caught up with the wall clock, a little later: only timing differs.
+    timers = replay_recording(recording, ["nav"])
+    cmd = next(t for t in timers.topics if t.topic == "/cmd_vel")
+    assert cmd.recorded >= 35
+    assert cmd.identical == 0
+    assert {d.kind for d in timers.divergences} == {"missing", "extra"}
+    # Woken at the recorded instants, it decides the same: every command identical
+    # (a burst whose outputs were published at two instants can differ, hence 90 %).
+    recorded = replay_recording(recording, ["nav"], wake="recorded")
+    cmd = next(t for t in recorded.topics if t.topic == "/cmd_vel")
+    assert cmd.identical >= 0.9 * cmd.recorded
+    # /nav/state's stamp is taken at the wake-up, which the recording does not keep.
+    assert {d.field for d in recorded.divergences if d.kind == "content"} <= {
+        "header.stamp.nanosec",
+        "header.stamp.sec",
+    }
