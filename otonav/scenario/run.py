@@ -174,11 +174,20 @@ async def drive(session: StackSession, scenario: ScenarioConfig, judge: Judge) -
         # passes depends on the scenario's ``expect``.
         with contextlib.suppress(SimTimeoutError):
             await until(
-                lambda: judge.finished,
+                lambda: judge.finished or judge.entered,
                 within=scenario.sim_budget,
                 observe=lambda: f"{judge.distance:.3f} m from the goal",
                 what=f"reaching the goal within {scenario.goal_tolerance} m",
             )
+        if judge.entered and not judge.finished:
+            # Entering the tolerance is not arriving: the judge checks settle_s later
+            # (past the budget if need be) that the robot stopped there.
+            with contextlib.suppress(SimTimeoutError):
+                await until(
+                    lambda: judge.finished,
+                    within=judge.settle_s + 2.0 / judge.rate_hz,
+                    what="the arrival check",
+                )
 
 
 async def _main(
@@ -353,7 +362,9 @@ def judge_verdict(scenario: ScenarioConfig, judge: Judge, sim_time: float, wall:
     reasons = []
     if scenario.expect == "reached":
         outcome = judge.reached
-        if not judge.reached:
+        if judge.arrival_problem is not None:
+            reasons.append(judge.arrival_problem)
+        elif not judge.reached:
             why = (
                 f"the navigator reported the goal unreachable at {judge.unreachable_at:.1f} s"
                 if judge.unreachable_at is not None

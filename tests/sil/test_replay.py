@@ -88,8 +88,9 @@ def test_cli_exit_codes_summary_and_out(
     assert "angular.z" in printed
     assert "DIVERGED" in printed
     topics = {t.topic: t.count for t in summarize(out).topics}
-    assert topics["/cmd_vel"] == topics["/recorded/cmd_vel"] == 226
-    assert topics["/odom"] == 1130  # the inputs, copied
+    # 13.3 s of acceptance run (reached at 11.3 s, then the 2 s arrival check).
+    assert topics["/cmd_vel"] == topics["/recorded/cmd_vel"] == 266
+    assert topics["/odom"] == 1330  # the inputs, copied
     assert "/scenario/verdict" not in topics
     # Within a tolerance as large as the change, the same run passes.
     assert cli_main(["replay", str(acceptance), "--node", "nav", "--tolerance", "10"]) == 0
