@@ -65,6 +65,11 @@ class ReplayResult:
         return self.sim_time_s / self.wall_time_s if self.wall_time_s > 0 else float("inf")
 
 
+SHARED_LOG_TOPICS = frozenset({"/rosout"})
+"""Output topics a replay does not compare: the recording holds every actor's lines and
+the system's lifecycle events there, which a replay of some nodes cannot reproduce."""
+
+
 @dataclass(frozen=True, slots=True)
 class _Ports:
     inputs: dict[str, tuple[type[Message], list[QoS]]]
@@ -81,6 +86,8 @@ def _ports(actors: Sequence[Actor]) -> _Ports:
         for port in actor.ports():
             topic = actor.topic_of(port)
             if port.direction == "out":
+                if topic in SHARED_LOG_TOPICS:
+                    continue  # every actor and the system log there: not one node's output
                 outputs[topic] = port.msg_type
                 publishers_of.setdefault(topic, set()).add(actor.name)
             else:

@@ -33,7 +33,7 @@ from otonav.runtime import (
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
 from otonav.scenario.plot import plot_trajectory
-from otonav.scenario.validate import check_goal
+from otonav.scenario.validate import check_cost, check_goal
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.session import RealTime, StackSession
 
@@ -90,6 +90,7 @@ def scenario_world(
     )
     try:
         check_goal(scenario, stack.world.scene, hal.obstacles(), hal.walls(), source=source)
+        check_cost(scenario, stack, len(hal.obstacles() + hal.walls()), source=source)
     except BaseException:
         hal.close()
         raise
@@ -211,14 +212,26 @@ def run_task(
     task = asyncio.current_task()
     if on_start is not None and task is not None:
         on_start(loop, task)
-    in_main_thread = threading.current_thread() is threading.main_thread()
-    if in_main_thread and task is not None:
-        loop.add_signal_handler(signal.SIGTERM, task.cancel)
+    # Only over the default handler (asyncio.Runner's rule for SIGINT): a host that
+    # handles SIGTERM itself (the CLI) keeps its handler. Cancel once: a second
+    # SIGTERM must not cancel the shutdown's own awaits.
+    own = (
+        threading.current_thread() is threading.main_thread()
+        and task is not None
+        and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL
+    )
+    if own and task is not None:
+        loop.add_signal_handler(signal.SIGTERM, _cancel_once, task)
     try:
         yield
     finally:
-        if in_main_thread and task is not None:
+        if own:
             loop.remove_signal_handler(signal.SIGTERM)
+
+
+def _cancel_once(task: asyncio.Task[Any]) -> None:
+    if not task.cancelling():
+        task.cancel()
 
 
 def run_scenario(
