@@ -31,7 +31,7 @@ asyncio_default_fixture_loop_scope = function
 
 
 def _block(marker: str) -> str:
-    (block,) = [b for b in BLOCKS if marker in b]
+    (block,) = [str(b) for b in BLOCKS if marker in b]
     return block
 
 
