@@ -93,8 +93,8 @@ def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
             if process.stdout is not None:
                 process.stdout.close()
     log = (out / "stderr.log").read_text()
-    # After its graceful shutdown uvicorn re-raises the signal it caught: -SIGTERM.
-    assert code in (0, -signal.SIGTERM), log
+    # After its graceful shutdown the service exits 128 + the signal it caught.
+    assert code == 128 + signal.SIGTERM, log
     assert "Traceback" not in log, log
     live = summarize(out / "live.mcap")
     assert live.truncated is False
@@ -217,15 +217,11 @@ def test_bad_input_gets_4xx_with_the_cli_message(
     client: httpx.Client, capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
     out = str(tmp_path / "cli")
-    mars = tmp_path / "mars.yaml"
-    mars.write_text("scene: mars\n")
     same_as_cli = [
-        ({"scenario": "nope"}, ["run", "--scenario", "nope"]),
         ({"set": ["nav.kp_lin=-1"]}, ["run", "--set", "nav.kp_lin=-1"]),
         ({"set": ["nav.bogus=1"]}, ["run", "--set", "nav.bogus=1"]),
         ({"set": ["rates.odom_hz=fast"]}, ["run", "--set", "rates.odom_hz=fast"]),
         ({"set": ["nav"]}, ["run", "--set", "nav"]),
-        ({"scenario": {"scene": "mars"}}, ["run", "--scenario", str(mars)]),
     ]
     for body, argv in same_as_cli:
         response = client.post("/runs", json=body)
@@ -245,6 +241,9 @@ def test_bad_input_gets_4xx_with_the_cli_message(
         ("POST", "/runs", {"json": {"bogus": 1}}, 400, "request: bogus: unknown key"),
         ("POST", "/runs", {"json": {"scenario": {"goal_tolerance": -1}}}, 400, "scenario: "),
         ("POST", "/runs", {"json": {"scenario": "../etc/passwd"}}, 400, "reads no files"),
+        # Unlike the CLI, which looks for the file: the service never does (issue 17).
+        ("POST", "/runs", {"json": {"scenario": "nope"}}, 400, "reads no files"),
+        ("POST", "/runs", {"json": {"scenario": {"scene": "mars"}}}, 400, "reads no files"),
         ("POST", "/runs", {"json": {"scenario": {"scene": "/etc/passwd"}}}, 400, "no files"),
         ("POST", "/runs", {"json": {"seed": -3}}, 400, "--seed: seed:"),
         ("GET", "/runs/nope", {}, 404, "no run 'nope'"),
@@ -309,3 +308,56 @@ def test_same_verdict_and_recording_from_cli_pytest_embedding_and_service(
     data = recordings["direct"].read_bytes()
     for name, path in recordings.items():
         assert path.read_bytes() == data, f"{name}: {path} differs from {recordings['direct']}"
+
+
+def test_adversarial_requests_get_4xx_and_reveal_no_files(
+    client: httpx.Client, tmp_path: Path
+) -> None:
+    # Issue 17, item 4. A scene path in an override made the server read a file the
+    # client named, and its errors told whether the path existed; these were 500s.
+    real = tmp_path / "real.xml"
+    real.write_text("<mujoco/>")
+    missing = tmp_path / "missing.xml"
+
+    def error(body: dict[str, Any]) -> str:
+        response = client.post("/runs", json=body)
+        assert response.status_code == 400, (body, response.text)
+        message: str = response.json()["error"]
+        assert "\n" not in message
+        return message
+
+    said_real = error({"set": [f"world.scene={real}"]})
+    said_missing = error({"set": [f"world.scene={missing}"]})
+    assert "reads no files" in said_real
+    assert said_real.replace(str(real), "P") == said_missing.replace(str(missing), "P")
+    for name in (str(real), "real.xml", "etc", "nothing-here"):  # no oracle in the cwd either
+        assert "reads no files" in error({"scenario": name}), name
+    said = [error({"scenario": {"scene": s}}) for s in (str(real), str(missing))]
+    assert said[0].replace(str(real), "P") == said[1].replace(str(missing), "P")
+    hardware = error({"set": ["hal.kind=can", "hal.can.interface=socketcan"]})
+    assert "hal.can.interface" in hardware
+
+    cases: list[tuple[str, str, dict[str, Any], int]] = [
+        ("POST", "/runs", {"content": b'{"scenario": "\xff\xfe"}'}, 400),  # not UTF-8
+        ("POST", "/runs", {"content": b"[" * 100_000 + b"]" * 100_000}, 400),  # deep JSON
+        ("POST", "/runs", {"json": {"scenario": "s" * 100_000}}, 400),  # a long name
+        ("POST", "/runs", {"json": {"scenario": {"name": "n" * 100_000}}}, 400),
+        ("POST", "/runs", {"json": {"set": ["world.scene=" + "x" * 100_000]}}, 400),
+        ("POST", "/runs", {"content": b'{"scenario": "' + b"s" * (2 << 20) + b'"}'}, 413),
+        ("GET", "/runs/x", {"params": {"wait": "nan"}}, 404),
+        ("GET", "/live/pose", {"params": {"hz": "nan"}}, 400),
+        ("POST", "/live/goal", {"json": {"x": 1e308, "y": 0}}, 400),
+    ]
+    for method, path, kwargs, status in cases:
+        response = client.request(method, path, **kwargs)
+        assert response.status_code == status, (path, response.status_code, response.text[:200])
+        message = response.json()["error"]
+        assert "\n" not in message
+        assert len(message) < 500, message[:600]
+    run_id = _start(client, {"scenario": "acceptance"})
+    for wait in ("nan", "inf", "-inf", "1e999", "soon"):
+        response = client.get(f"/runs/{run_id}", params={"wait": wait})
+        assert response.status_code == 400, (wait, response.text)
+        assert "wait=" in response.json()["error"]
+    client.delete(f"/runs/{run_id}")
+    assert client.get("/health").json()["status"] == "ok"
