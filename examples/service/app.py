@@ -14,13 +14,19 @@ Endpoints::
                                    "set": ["nav.kp_lin=0.5"], "seed": 3} -> 202 {"id": ...}
     GET    /runs                  every run and its status
     GET    /runs/{id}?wait=10     status, sim time so far, verdict (wait: for the end, s)
+    GET    /runs/{id}/recording   the finished run's MCAP file (409 while it runs)
+    GET    /runs/{id}/plot        the finished run's trajectory.png (409 while it runs)
     DELETE /runs/{id}             cancel; its recording is finished and indexed
     GET    /live/pose?hz=10       text/event-stream of {"t", "x", "y", "yaw"} (odometry)
     POST   /live/goal             {"x": 4.0, "y": 1.5} -> 202
     GET    /live/graph            actors, topics, QoS and statistics of the live stack
 
-Bad input gets a 4xx whose ``error`` is the one-line message the CLI prints after
-``otonav: error:``. The server binds to 127.0.0.1 unless told otherwise.
+Bad input gets a 4xx whose ``error`` is one line naming the request's field (``scenario``,
+``set``, ``seed``, ``goal``), what is wrong and what is valid. The live robot's recording,
+OUT/live.mcap, rotates at ``--live-record-mb`` (64 MB): the finished file becomes
+live.1.mcap (older ones move up; ``--live-record-keep`` of them stay, default 2), so disk
+use stays under about (keep + 1) x the cap. The server binds to 127.0.0.1 unless told
+otherwise.
 
 What a client may ask is narrower than the CLI (issue 17): built-in scenes and scenarios
 only, so the server reads no file a client names and its errors never say whether a path
@@ -56,7 +62,7 @@ import uvicorn
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from starlette.applications import Starlette
 from starlette.requests import Request
-from starlette.responses import JSONResponse, Response, StreamingResponse
+from starlette.responses import FileResponse, JSONResponse, Response, StreamingResponse
 from starlette.routing import Route
 
 from otonav.actors import topics
@@ -65,6 +71,7 @@ from otonav.embed import LiveStack, check_run, open_live_stack, run_scenario_asy
 from otonav.hal.mujoco import SceneError, scene_names
 from otonav.limits import check_scale
 from otonav.msgs import Odometry
+from otonav.record.rotating import RotatingRecordingWriter
 from otonav.runtime import QoS, Reliability
 from otonav.scenario import GoalSpec, ScenarioConfig, Verdict
 from otonav.scenario.builtin import BUILTIN
@@ -72,6 +79,7 @@ from otonav.scenario.config import Coordinate
 from otonav.scenario.validate import check_goal
 from otonav.stack import StackConfig
 from otonav.stack.files import ConfigFileError, describe_validation_error, to_json
+from otonav.stack.overrides import apply_overrides
 
 log = logging.getLogger("otonav.service")
 
@@ -145,21 +153,24 @@ async def _json_body(request: Request) -> object:
         raise BadRequest("request body: JSON nested too deeply") from None
 
 
-def _no_files(what: str, value: str, kind: str, valid: tuple[str, ...]) -> ConfigFileError:
+def _no_files(what: str, value: str, valid: tuple[str, ...]) -> ConfigFileError:
     """The same answer whatever ``value`` names, existing or not: no oracle."""
     return ConfigFileError(
-        f"{what} {_short(value)}: the service runs built-in {kind} ({', '.join(valid)}) "
-        "and reads no files"
+        f"{what} {_short(value)} is not a built-in scene ({', '.join(valid)}); "
+        "the service reads no files"
     )
 
 
-def check_client_stack(stack: StackConfig, source: str = "set") -> None:
-    """What a client's overrides may not ask of the server: a scene file (a read of a
-    path the client names), real hardware (a CAN interface other than the emulated one)."""
-    if stack.world.scene not in scene_names():
-        raise _no_files(f"{source}: world.scene", stack.world.scene, "scenes", scene_names())
+def check_client_stack(stack: StackConfig, base: StackConfig, source: str = "set") -> None:
+    """What a client's overrides (``stack``, made from the operator's ``base``) may not
+    ask of the server: a scene file (a read of a path the client names), real hardware
+    (a CAN interface other than the emulated one). What the operator configured stands."""
+    scene = stack.world.scene
+    if scene != base.world.scene and scene not in scene_names():
+        raise _no_files(f"{source}: world.scene", scene, scene_names())
     can = stack.hal.can
-    if stack.hal.kind == "can" and (can.interface != "virtual" or not can.emulate):
+    hardware = stack.hal.kind == "can" and (can.interface != "virtual" or not can.emulate)
+    if hardware and stack.hal != base.hal:
         raise ConfigFileError(
             f"{source}: hal.can.interface {_short(can.interface)} (emulate: {can.emulate}): "
             "the service simulates and opens no hardware; use interface virtual, emulate true"
@@ -178,18 +189,21 @@ def resolve_scenario(spec: str | dict[str, Any], seed: int | None) -> tuple[Scen
         except ValidationError as exc:
             raise ConfigFileError(describe_validation_error(source, exc)) from None
         if scenario.scene is not None and scenario.scene not in scene_names():
-            raise _no_files(f"{source}: scene", scenario.scene, "scenes", scene_names())
+            raise _no_files(f"{source}: scene", scenario.scene, scene_names())
     elif spec in BUILTIN:
         scenario, source = BUILTIN[spec], f"scenario '{spec}'"
     else:  # never looked up on disk: the answer must not depend on what exists there
-        raise _no_files("--scenario", spec, "or inline scenarios", tuple(BUILTIN))
+        raise ConfigFileError(
+            f"scenario: {_short(spec)} is not a built-in scenario ({', '.join(BUILTIN)}); "
+            "give one of those names or a scenario object (the service reads no files)"
+        )
     if seed is not None:
         data = scenario.model_dump()
         data["seed"] = seed
         try:
             scenario = ScenarioConfig.model_validate(data)
-        except ValidationError as exc:
-            raise ConfigFileError(describe_validation_error("--seed", exc)) from None
+        except ValidationError as exc:  # the location says "seed": no prefix to repeat it
+            raise ConfigFileError(describe_validation_error("", exc).removeprefix(": ")) from None
     return scenario, source
 
 
@@ -222,7 +236,16 @@ class Run:
             "verdict": self.verdict.as_dict() if self.verdict else None,
             "error": self.error,
             "recording": str(recording) if recording.exists() else None,
+            "links": {
+                name: f"/runs/{self.id}/{name}"
+                for name, path in (("recording", recording), ("plot", self.plot_path))
+                if self.done.is_set() and path.exists()
+            },
         }
+
+    @property
+    def plot_path(self) -> Path:
+        return self.out_dir / "trajectory.png"
 
 
 class Runs:
@@ -342,12 +365,16 @@ class Service:
         live: bool = True,
         live_scale: float = 1.0,
         live_record: Path | None = None,
+        live_record_bytes: int = 64 * 2**20,
+        live_record_keep: int = 2,
         max_runs: int = 2,
     ) -> None:
         self.stack = stack
         self.live_enabled = live
         self.live_scale = live_scale
         self.live_record = live_record
+        self.live_record_bytes = live_record_bytes
+        self.live_record_keep = live_record_keep
         self.runs = Runs(out_root, max_runs)
         self.live: LiveStack | None = None
         self.closing: asyncio.Event | None = None
@@ -373,8 +400,19 @@ class Service:
         self._loop = asyncio.get_running_loop()
         async with AsyncExitStack() as stack:
             if self.live_enabled:
+                # The live robot runs for as long as the service does: its recording
+                # rotates at a size cap instead of growing without limit.
+                record = (
+                    RotatingRecordingWriter(
+                        self.live_record,
+                        max_bytes=self.live_record_bytes,
+                        keep=self.live_record_keep,
+                    )
+                    if self.live_record is not None
+                    else None
+                )
                 self.live = await stack.enter_async_context(
-                    open_live_stack(self.stack, scale=self.live_scale, record_to=self.live_record)
+                    open_live_stack(self.stack, scale=self.live_scale, record_to=record)
                 )
             try:
                 yield
@@ -389,6 +427,8 @@ class Service:
             Route("/runs", self.list_runs, methods=["GET"]),
             Route("/runs/{run_id}", _errors_as_4xx(self.get_run), methods=["GET"]),
             Route("/runs/{run_id}", _errors_as_4xx(self.delete_run), methods=["DELETE"]),
+            Route("/runs/{run_id}/recording", _errors_as_4xx(self.get_recording), methods=["GET"]),
+            Route("/runs/{run_id}/plot", _errors_as_4xx(self.get_plot), methods=["GET"]),
             Route("/live/pose", _errors_as_4xx(self.live_pose), methods=["GET"]),
             Route("/live/goal", _errors_as_4xx(self.live_goal), methods=["POST"]),
             Route("/live/graph", _errors_as_4xx(self.live_graph), methods=["GET"]),
@@ -411,11 +451,14 @@ class Service:
     async def post_run(self, request: Request) -> Response:
         body: RunRequest = _parse(RunRequest, await _json_body(request), "request")
         scenario, source = resolve_scenario(body.scenario, body.seed)
-        stack = load_stack(None, body.set)
-        check_client_stack(stack)
+        stack = apply_overrides(self.stack, body.set, source="set")
+        check_client_stack(stack, self.stack)
         # What the CLI would reject before running (scene, goal): a 400 now, not a
         # failed run later. Building the world takes milliseconds: off the loop.
-        await anyio.to_thread.run_sync(lambda: check_run(scenario, stack, source=source))
+        try:
+            await anyio.to_thread.run_sync(lambda: check_run(scenario, stack, source=source))
+        except SceneError as exc:  # names the scene, not where it came from: add that
+            raise BadRequest(f"{source}: {exc}") from None
         run = self.runs.start(scenario, stack, source)
         return _json(run.as_dict(), 202)
 
@@ -445,6 +488,28 @@ class Service:
             with anyio.move_on_after(min(max(seconds, 0.0), MAX_WAIT_S)):
                 await _either(run.done, self.closing)
         return _json(run.as_dict())
+
+    def _artifact(self, request: Request, path: Path, what: str) -> Path:
+        run = self._run(request)
+        if not run.done.is_set():
+            raise BadRequest(
+                f"run {run.id} is {run.status}: its {what} is not finished yet "
+                "(ask again when it ends)",
+                409,
+            )
+        if not path.exists():
+            raise BadRequest(f"run {run.id} ({run.status}) left no {what}", 404)
+        return path
+
+    async def get_recording(self, request: Request) -> Response:
+        run = self._run(request)
+        path = self._artifact(request, run.out_dir / "recording.mcap", "recording")
+        return FileResponse(path, media_type="application/octet-stream", filename=f"{run.id}.mcap")
+
+    async def get_plot(self, request: Request) -> Response:
+        run = self._run(request)
+        path = self._artifact(request, run.plot_path, "plot")
+        return FileResponse(path, media_type="image/png")
 
     async def delete_run(self, request: Request) -> Response:
         run = self._run(request)
@@ -476,13 +541,16 @@ class Service:
     async def live_goal(self, request: Request) -> Response:
         live = self._live()
         goal: GoalRequest = _parse(GoalRequest, await _json_body(request), "goal")
-        check_goal(
-            ScenarioConfig(scene=self.stack.world.scene, goal=GoalSpec(x=goal.x, y=goal.y)),
-            self.stack.world.scene,
-            live.hal.obstacles(),
-            live.hal.walls(),
-            source="goal",
-        )
+        try:
+            check_goal(
+                ScenarioConfig(scene=self.stack.world.scene, goal=GoalSpec(x=goal.x, y=goal.y)),
+                self.stack.world.scene,
+                live.hal.obstacles(),
+                live.hal.walls(),
+                source="goal",
+            )
+        except ConfigFileError as exc:  # "goal: goal: (x, y) is ...": say it once
+            raise BadRequest(str(exc).replace("goal: goal: ", "goal ", 1)) from None
         await live.publish_goal(goal.x, goal.y)
         return _json({"goal": {"x": goal.x, "y": goal.y}, "sim_time_s": live.now()}, 202)
 
@@ -607,6 +675,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-live", action="store_true", help="no live robot")
     parser.add_argument("--live-scale", type=float, default=1.0, help="sim s per wall s")
     parser.add_argument("--no-live-record", action="store_true")
+    parser.add_argument(
+        "--live-record-mb",
+        type=float,
+        default=64.0,
+        help="rotate OUT/live.mcap at this size (MB; default 64)",
+    )
+    parser.add_argument(
+        "--live-record-keep",
+        type=int,
+        default=2,
+        help="finished live recordings kept as live.1.mcap, live.2.mcap, ... (default 2)",
+    )
     parser.add_argument("--max-runs", type=int, default=2, help="simulations at once")
     args = parser.parse_args(argv)
     try:
@@ -616,6 +696,10 @@ def main(argv: list[str] | None = None) -> int:
             raise ConfigFileError(problem)
         if not 1 <= args.max_runs <= 64:
             raise ConfigFileError(f"--max-runs {args.max_runs}: must be in [1, 64]")
+        if not args.live_record_mb >= 0.1:
+            raise ConfigFileError(f"--live-record-mb {args.live_record_mb:g}: must be >= 0.1")
+        if args.live_record_keep < 0:
+            raise ConfigFileError(f"--live-record-keep {args.live_record_keep}: must be >= 0")
     except ConfigFileError as exc:
         print(f"otonav: error: {exc}", file=sys.stderr)
         return 2
@@ -626,6 +710,8 @@ def main(argv: list[str] | None = None) -> int:
         live=not args.no_live,
         live_scale=args.live_scale,
         live_record=None if args.no_live_record else out / "live.mcap",
+        live_record_bytes=round(args.live_record_mb * 2**20),
+        live_record_keep=args.live_record_keep,
         max_runs=args.max_runs,
     )
     # Bind first, so the address is known (port 0) before the server starts accepting.
