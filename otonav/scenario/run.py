@@ -38,6 +38,7 @@ from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.session import RealTime, StackSession
 
 VERDICT_TOPIC = "/scenario/verdict"
+RUN_METADATA = "otonav"
 
 
 @dataclass(frozen=True, slots=True)
@@ -149,7 +150,12 @@ def scenario_session(
     except BaseException:
         hal.close()
         raise
-    return StackSession(hal, [*extra_actors, *robot, judge], realtime=realtime, record_to=recording)
+    session = StackSession(
+        hal, [*extra_actors, *robot, judge], realtime=realtime, record_to=recording
+    )
+    if session.writer is not None:
+        session.writer.add_metadata(RUN_METADATA, run_metadata(scenario, stack))
+    return session
 
 
 async def drive(session: StackSession, scenario: ScenarioConfig, judge: Judge) -> None:
@@ -318,16 +324,25 @@ def _append_verdict(
         if k not in ("wall_time_s", "rtf", "recording", "plot")
     }
     writer.add_metadata(
-        "otonav",
+        RUN_METADATA,
         {
-            "scenario": scenario.name,
-            "seed": str(scenario.seed),
-            "otonav_version": otonav_version(),
-            "scenario_config": scenario.model_dump_json(),
-            "stack_config": stack.model_dump_json(),
+            **run_metadata(scenario, stack),
             "verdict": json.dumps(finite_figures(figures), sort_keys=True, default=str),
         },
     )
+
+
+def run_metadata(scenario: ScenarioConfig, stack: StackConfig) -> dict[str, str]:
+    """The ``otonav`` metadata record of a scenario run, without its verdict. Written
+    when the recording opens (a cut-off file keeps it) and again, with the verdict, at
+    the end; readers take the last."""
+    return {
+        "scenario": scenario.name,
+        "seed": str(scenario.seed),
+        "otonav_version": otonav_version(),
+        "scenario_config": scenario.model_dump_json(),
+        "stack_config": stack.model_dump_json(),
+    }
 
 
 def judge_verdict(scenario: ScenarioConfig, judge: Judge, sim_time: float, wall: float) -> Verdict:

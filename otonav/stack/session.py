@@ -38,6 +38,7 @@ from otonav.record.writer import RecordingWriter
 from otonav.runtime import Actor, Clock, RealTimeClock, RestartPolicy, System, TimeSource
 from otonav.runtime.loop import VirtualTimeLoop
 from otonav.stack.rosout import attach_rosout
+from otonav.stack.worldmeta import WORLD_METADATA, world_metadata
 
 __all__ = ("RealTime", "StackSession")
 
@@ -87,6 +88,8 @@ class StackSession:
             self.realtime_clock: RealTimeClock | None = realtime
             if record_to is not None:
                 self.writer = RecordingWriter(record_to)
+                # Before the first message, so a cut-off file still says its world.
+                self.writer.add_metadata(WORLD_METADATA, world_metadata(hal))
                 self.recorder = Recorder(self.writer)
             first = [self.recorder] if self.recorder is not None else []
             self.system = System([*first, *actors], clock=realtime, restart=restart)
@@ -209,6 +212,6 @@ class StackSession:
             loop is not None
             and previous is not None
             and not loop.is_closed()
-            and loop.source is self.hal
+            and (loop.source is self.hal or getattr(loop.source, "failed", None) is self.hal)
         ):
             loop.attach_source(previous)
