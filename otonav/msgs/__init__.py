@@ -13,14 +13,26 @@ from otonav.msgs.geometry import (
     TwistWithCovariance,
     Vector3,
 )
+from otonav.msgs.hardware import (
+    DiagnosticArray,
+    DiagnosticStatus,
+    Frame,
+    HardwareStatus,
+    KeyValue,
+)
 from otonav.msgs.otonav_msgs import NavState, ScenarioVerdict, WheelCommand
 from otonav.msgs.sensors import Imu, LaserScan, Odometry, TFMessage
 from otonav.msgs.std import Clock, Header, Log, Time
 
 __all__ = (
     "Clock",
+    "DiagnosticArray",
+    "DiagnosticStatus",
+    "Frame",
+    "HardwareStatus",
     "Header",
     "Imu",
+    "KeyValue",
     "LaserScan",
     "Log",
     "Message",

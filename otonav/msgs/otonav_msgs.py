@@ -19,7 +19,8 @@ class WheelCommand(Message):
 
 class NavState(Message):
     """What the navigator is doing: ``idle`` (no goal), ``waiting`` (no fresh scan),
-    ``driving``, ``blocked`` (obstacle ahead) or ``reached``."""
+    ``driving``, ``blocked`` (obstacle ahead), ``reached`` or ``fault`` (the hardware
+    reports a fault: it commands zero)."""
 
     ros_type: ClassVar[str] = "otonav_msgs/msg/NavState"
     header: Header = Header()
@@ -29,7 +30,8 @@ class NavState(Message):
     heading_error: float = 0.0
     """rad, wrapped to [-pi, pi]."""
     closest_ahead: float = 0.0
-    """m, closest valid return in the guard's front sector (inf if none)."""
+    """m, closest valid return in the guard's front sector (inf if none; -inf: a return
+    closer than the lidar's range_min, REP 117)."""
 
 
 class ScenarioVerdict(Message):

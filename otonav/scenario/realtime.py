@@ -15,7 +15,8 @@ import anyio
 
 from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
-from otonav.runtime import RealTimeClock
+from otonav.limits import check_scale
+from otonav.runtime import Actor, RealTimeClock
 from otonav.runtime.timesource import tick_rate
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
@@ -36,6 +37,9 @@ __all__ = ["VIEWER_HZ", "run_scenario_realtime"]
 VIEWER_HZ = 60.0
 """Wall-clock rate at which the viewer is shown the world."""
 
+HOLD_POLL_S = 0.05
+"""Wall seconds between looks at whether the user closed the held window."""
+
 MAX_STEP_BATCH = 0.05
 """Most sim seconds stepped at once: a machine slower than the scale makes sim time slip
 behind the wall clock (the verdict's RTF shows it) rather than step in bursts."""
@@ -51,6 +55,16 @@ async def _show(
         await rate.sleep()  # wakes with the world stepped to the wall clock
     closed_at.append(clock.now())
     stop.cancel()
+
+
+def _hold(viewer: ViewerHandle, held: list[Verdict], hold: Callable[[Verdict], None]) -> None:
+    """Keep the window open on the final state until the user closes it (a cleanup of
+    the session: the recording is finished, the world not yet closed)."""
+    if not held or not viewer.is_running():
+        return  # the run did not finish, or the user closed the window during it
+    hold(held[0])
+    while viewer.is_running():  # the viewer's thread draws and takes input meanwhile
+        time.sleep(HOLD_POLL_S)
 
 
 async def _main(
@@ -81,6 +95,8 @@ def run_scenario_realtime(
     scale: float = 1.0,
     gui: bool = False,
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
+    extra_actors: tuple[Actor, ...] = (),
+    hold: Callable[[Verdict], None] | None = None,
 ) -> Verdict:
     """Run ``scenario`` with sim time following the wall clock times ``scale`` and judge
     it, like :func:`~otonav.scenario.run.run_scenario` (same artifacts in ``out_dir``,
@@ -91,9 +107,14 @@ def run_scenario_realtime(
     is none), the window opens before the clock starts, is synced at ~60 Hz wall and
     closed at the end. Closing the window stops the run: the verdict fails and says so.
     ``on_start(loop, task)`` is called on the run's loop once the window (if any) is up.
+    ``extra_actors`` join the system (a live view, monitors).
+    ``hold`` (with ``gui``): once the run is over and its recording finished, call
+    ``hold(verdict)`` (its artifact paths are not set yet) and keep the window open on
+    the final state until the user closes it; Ctrl-C ends the hold too.
     """
-    if not scale > 0:
-        raise ValueError(f"real-time scale must be > 0, got {scale!r}")
+    problem = check_scale(scale, "scale")
+    if problem is not None:
+        raise ValueError(problem)
     if gui:
         check_display()
     stack, hal = scenario_world(scenario, stack)
@@ -104,6 +125,7 @@ def run_scenario_realtime(
         hal,
         judge,
         realtime=RealTime(scale, MAX_STEP_BATCH),
+        extra_actors=extra_actors,
         recording=out_dir / "recording.mcap" if out_dir and record else None,
     )
     viewer: ViewerHandle | None = None
@@ -116,6 +138,10 @@ def run_scenario_realtime(
             session.close()
             raise
         session.add_cleanup(viewer.close)  # after the recording, before the world
+        if hold is not None:  # cleanups run last added first: before the window closes
+            shown = viewer
+            session.add_cleanup(lambda: _hold(shown, held, hold))
+    held: list[Verdict] = []
     closed_at: list[float] = []
     wall_start = time.perf_counter()
     ended = "completed"
@@ -142,6 +168,8 @@ def run_scenario_realtime(
                         f"({judge.distance:.3f} m from the goal)"
                     ),
                 )
+            if ended == "completed":
+                held.append(verdict)
             verdict = save_artifacts(verdict, scenario, stack, judge, session, out_dir, plot)
         finally:
             session.close()  # idempotent: the viewer, then the world, on every path

@@ -17,7 +17,7 @@ pytestmark = pytest.mark.sil
 
 EXPECTED_TOPICS = {
     "/clock", "/odom", "/imu", "/scan", "/tf", "/tf_static", "/cmd_vel", "/wheel_cmd",
-    "/goal", "/nav/state", "/rosout", "/scenario/verdict",
+    "/goal", "/nav/state", "/rosout", "/scenario/verdict", "/hardware/status", "/diagnostics",
 }  # fmt: skip
 
 
