@@ -11,9 +11,13 @@ SCAN = "/scan"
 TF = "/tf"
 TF_STATIC = "/tf_static"
 CMD_VEL = "/cmd_vel"
+#: The planner's command, before the safety layer (Nav2: cmd_vel_nav -> collision monitor).
+CMD_VEL_NAV = "/cmd_vel_nav"
 WHEEL_CMD = "/wheel_cmd"
 GOAL = "/goal"
 NAV_STATE = "/nav/state"
+NAV_DIAGNOSTICS = "/nav/diagnostics"
+SAFETY_STATE = "/safety/state"
 ROSOUT = "/rosout"
 
 #: Sensor streams: best-effort, keep a few (a slow reader sees the newest, never stalls physics).

@@ -13,7 +13,13 @@ from otonav.msgs.geometry import (
     TwistWithCovariance,
     Vector3,
 )
-from otonav.msgs.otonav_msgs import NavState, ScenarioVerdict, WheelCommand
+from otonav.msgs.otonav_msgs import (
+    NavDiagnostics,
+    NavState,
+    SafetyState,
+    ScenarioVerdict,
+    WheelCommand,
+)
 from otonav.msgs.sensors import Imu, LaserScan, Odometry, TFMessage
 from otonav.msgs.std import Clock, Header, Log, Time
 
@@ -24,6 +30,7 @@ __all__ = (
     "LaserScan",
     "Log",
     "Message",
+    "NavDiagnostics",
     "NavState",
     "Odometry",
     "Point",
@@ -31,6 +38,7 @@ __all__ = (
     "PoseStamped",
     "PoseWithCovariance",
     "Quaternion",
+    "SafetyState",
     "ScenarioVerdict",
     "TFMessage",
     "Time",

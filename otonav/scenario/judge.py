@@ -7,18 +7,19 @@ from collections.abc import Callable
 
 from otonav.actors import topics
 from otonav.hal import BoxObstacle, RobotHardwareInterface
-from otonav.msgs import NavState
+from otonav.msgs import NavDiagnostics, NavState
 from otonav.runtime import Actor, Input, QoS, Reliability
 
 
 class Judge(Actor):
     """Samples the true pose at ``rate_hz``: distance to goal, clearance to every
     obstacle and wall (robot centre to box surface), path length, first time within
-    tolerance of the goal. It also keeps the navigator's latest state, and calls
+    tolerance of the goal. It also keeps the navigator's latest state and reason, and calls
     ``progress(judge, sim_time)`` after each sample (a UI's hook; it must not act on
     the robot)."""
 
     nav_state_in = Input(topics.NAV_STATE, NavState, QoS(Reliability.BEST_EFFORT, depth=1))
+    nav_diag_in = Input(topics.NAV_DIAGNOSTICS, NavDiagnostics, QoS(Reliability.BEST_EFFORT, depth=1))
 
     def __init__(
         self,
@@ -33,6 +34,8 @@ class Judge(Actor):
         super().__init__(name)
         self.progress = progress
         self.nav_state = "starting"
+        self.nav_reason = ""
+        """The navigator's latest reason (/nav/diagnostics; empty for the stop planner)."""
         self.hal = hal
         self.goal = goal
         self.tolerance = tolerance
@@ -50,6 +53,11 @@ class Judge(Actor):
     @property
     def reached(self) -> bool:
         return self.time_to_goal is not None
+
+    @property
+    def gave_up(self) -> bool:
+        """The navigator declared the goal unreachable (the run can end)."""
+        return self.nav_state == "unreachable"
 
     def sample(self, now: float) -> None:
         truth = self.hal.ground_truth()
@@ -77,8 +85,11 @@ class Judge(Actor):
             await rate.sleep()
             now = self.clock.now()
             self.sample(now)
+            state = self.nav_state_in.take_latest()
+            if state is not None:
+                self.nav_state = state.state
+            diag = self.nav_diag_in.take_latest()
+            if diag is not None:
+                self.nav_reason = diag.reason
             if self.progress is not None:
-                state = self.nav_state_in.take_latest()
-                if state is not None:
-                    self.nav_state = state.state
                 self.progress(self, now)

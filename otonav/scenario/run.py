@@ -57,6 +57,10 @@ class Verdict:
     rtf: float
     recording: str | None = None
     plot: str | None = None
+    nav_state: str = ""
+    """The navigator's last /nav/state (e.g. reached, unreachable)."""
+    nav_reason: str = ""
+    """The navigator's last reason (/nav/diagnostics), e.g. why it gave up."""
 
     def as_dict(self) -> dict[str, object]:
         return asdict(self)
@@ -132,8 +136,9 @@ async def drive_to_goal(
         )
         # Running out of budget is a verdict (judged below), not an error.
         with contextlib.suppress(SimTimeoutError):
+            # The navigator giving up ends the run too: the verdict says why.
             await until(
-                lambda: judge.reached,
+                lambda: judge.reached or judge.gave_up,
                 within=scenario.sim_budget,
                 observe=lambda: f"{judge.distance:.3f} m from the goal",
                 what=f"reaching the goal within {scenario.goal_tolerance} m",
@@ -287,6 +292,8 @@ def _close_recording(
                 final_distance=verdict.final_distance_m,
                 path_length=verdict.path_length_m,
                 sim_time=verdict.sim_time_s,
+                nav_state=verdict.nav_state,
+                nav_reason=verdict.nav_reason,
             ),
             verdict.sim_time_s,
         )
@@ -313,7 +320,12 @@ def _close_recording(
 def judge_verdict(scenario: ScenarioConfig, judge: Judge, sim_time: float, wall: float) -> Verdict:
     clear = judge.min_clearance >= scenario.min_clearance
     reasons = []
-    if not judge.reached:
+    if not judge.reached and judge.gave_up:
+        reasons.append(
+            f"navigation gave up: unreachable ({judge.nav_reason or 'no reason given'}; "
+            f"ended {judge.distance:.3f} m away)"
+        )
+    elif not judge.reached:
         reasons.append(
             f"did not reach the goal within {scenario.sim_budget:g} s "
             f"(ended {judge.distance:.3f} m away; tolerance {scenario.goal_tolerance} m)"
@@ -335,4 +347,6 @@ def judge_verdict(scenario: ScenarioConfig, judge: Judge, sim_time: float, wall:
         sim_time_s=sim_time,
         wall_time_s=wall,
         rtf=sim_time / wall if wall > 0 else math.inf,
+        nav_state=judge.nav_state,
+        nav_reason=judge.nav_reason,
     )

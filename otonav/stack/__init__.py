@@ -6,6 +6,7 @@ from otonav.stack.config import (
     GuardConfig,
     NavConfig,
     RatesConfig,
+    SafetyConfig,
     StackConfig,
     WorldConfig,
 )
@@ -15,6 +16,7 @@ __all__ = (
     "GuardConfig",
     "NavConfig",
     "RatesConfig",
+    "SafetyConfig",
     "StackConfig",
     "WorldConfig",
     "build_actors",

@@ -1,0 +1,222 @@
+"""Dynamic Window Approach (Fox, Burgard, Thrun 1997), vectorised with numpy.
+
+Frames and units: poses in odom (x, y m; yaw rad CCW, REP 103); commands are body
+twists (v m/s forward, omega rad/s CCW).
+
+One step:
+
+1. **Window.** The (v, omega) reachable within one control period ``period`` under the
+   acceleration limits, intersected with ``[0, max_v] x [-max_omega, max_omega]``; the
+   top of the v range is also capped at ``sqrt(2 * max_accel * goal_distance)`` so the
+   robot arrives instead of overshooting. ``v_samples x omega_samples`` samples,
+   plus the braking command (the window's lowest v, omega toward 0).
+2. **Rollouts.** Each sample held for ``horizon`` s, poses every ``dt`` s (exact arcs).
+3. **Admissible.** With ``clearance(x, y)`` the distance from a point to the nearest
+   return (the costmap's lower bound), the *free length* of a rollout is the arc
+   length driven before the first pose whose clearance is under ``radius`` (or under
+   the clearance at the start, when the robot already is closer than ``radius``: it
+   may then only move away). A sample is admissible when it can stop within its free
+   length: ``v * latency + v**2 / (2 * max_accel) <= free length``.
+4. **Score** (higher is better), each term in [0, 1] or [-1, 1]:
+   ``w_heading * (1 - |bearing error to the target at the end| / pi)
+   + w_progress * (distance to the target gained) / (max_v * horizon)
+   + w_clearance * min(min clearance - radius, clearance_cap) / clearance_cap
+   + w_speed * v / max_v``.
+   The target is a point of the global path ahead of the robot (or the goal).
+
+The best admissible sample is the command. With none admissible the command is the
+braking one and the reason says so.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, fields
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ("ClearanceFn", "DwaParams", "DwaResult", "dwa_step")
+
+ClearanceFn = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float32]]
+"""(x, y) arrays in odom -> distance to the nearest return, m (same shape)."""
+
+
+@dataclass(frozen=True, slots=True)
+class DwaParams:
+    """Settings of :func:`dwa_step`.
+
+    Attributes:
+        max_v: forward speed limit, m/s (> 0).
+        max_omega: yaw-rate limit, rad/s (> 0).
+        max_accel: linear acceleration limit (the base's), m/s^2 (> 0).
+        max_alpha: angular acceleration limit (the base's), rad/s^2 (> 0).
+        period: control period: the window is what the limits reach in it, s (> 0).
+        horizon: rollout length, s (> 0).
+        dt: rollout pose spacing, s (> 0, <= horizon).
+        v_samples: speed samples across the window (>= 1).
+        omega_samples: yaw-rate samples across the window (>= 1).
+        radius: centre clearance to keep (footprint.centre_clearance), m (>= 0).
+        latency: command delay before braking starts, s (>= 0).
+        clearance_cap: clearance beyond which more is not better, m (> 0).
+        w_heading, w_progress, w_clearance, w_speed: score weights (>= 0).
+    """
+
+    max_v: float = 0.4
+    max_omega: float = 1.2
+    max_accel: float = 1.0
+    max_alpha: float = 3.0
+    period: float = 0.05
+    horizon: float = 1.6
+    dt: float = 0.2
+    v_samples: int = 5
+    omega_samples: int = 13
+    radius: float = 0.33
+    latency: float = 0.1
+    clearance_cap: float = 0.25
+    w_heading: float = 1.0
+    w_progress: float = 2.0
+    w_clearance: float = 0.6
+    w_speed: float = 0.3
+
+    def __post_init__(self) -> None:
+        positive = ("max_v", "max_omega", "max_accel", "max_alpha", "period", "horizon", "dt")
+        positive += ("clearance_cap",)
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if f.name in ("v_samples", "omega_samples"):
+                if not (isinstance(value, int) and value >= 1):
+                    raise ValueError(f"DwaParams.{f.name} must be an integer >= 1, got {value!r}")
+                continue
+            low_ok = value > 0.0 if f.name in positive else value >= 0.0
+            if not (math.isfinite(value) and low_ok):
+                bound = "> 0" if f.name in positive else ">= 0"
+                raise ValueError(f"DwaParams.{f.name} must be finite and {bound}, got {value!r}")
+        if self.dt > self.horizon:
+            raise ValueError(f"DwaParams.dt ({self.dt} s) must be <= horizon ({self.horizon} s)")
+
+
+@dataclass(frozen=True, slots=True)
+class DwaResult:
+    """Output of :func:`dwa_step`.
+
+    Attributes:
+        v: forward speed command, m/s.
+        omega: yaw-rate command, rad/s.
+        admissible: how many samples could stop before breaking the clearance.
+        samples: how many samples were rolled out.
+        best_score: the chosen sample's score (-inf when none was admissible).
+        clearance: the chosen rollout's smallest clearance, m.
+        reason: why this command, in a few words.
+    """
+
+    v: float
+    omega: float
+    admissible: int
+    samples: int
+    best_score: float
+    clearance: float
+    reason: str
+
+
+def _window(lo: float, hi: float, n: int) -> NDArray[np.float64]:
+    return np.linspace(lo, hi, n) if n > 1 and hi > lo else np.array([0.5 * (lo + hi)])
+
+
+def dwa_step(
+    pose: tuple[float, float, float],
+    v0: float,
+    omega0: float,
+    target: tuple[float, float],
+    goal_distance: float,
+    clearance: ClearanceFn,
+    params: DwaParams,
+) -> DwaResult:
+    """Choose (v, omega) for the next period (see the module docstring).
+
+    Args:
+        pose: robot pose (x, y, yaw) in odom.
+        v0: current forward speed, m/s.
+        omega0: current yaw rate, rad/s.
+        target: the point to head for (odom, m).
+        goal_distance: distance to the goal, m (caps the speed for arriving).
+        clearance: distance lookup in odom.
+        params: settings.
+    """
+    p = params
+    x0, y0, th0 = pose
+    v_cap = min(p.max_v, math.sqrt(2.0 * p.max_accel * max(goal_distance, 0.0)))
+    v_lo = min(max(v0 - p.max_accel * p.period, 0.0), v_cap)
+    v_hi = min(max(v0 + p.max_accel * p.period, 0.0), v_cap)
+    w_lo = max(omega0 - p.max_alpha * p.period, -p.max_omega)
+    w_hi = min(omega0 + p.max_alpha * p.period, p.max_omega)
+    if w_lo > w_hi:  # omega0 outside the limits: the window is the nearest limit
+        w_lo = w_hi = min(max(omega0, -p.max_omega), p.max_omega)
+    vs = _window(v_lo, v_hi, p.v_samples)
+    ws = _window(w_lo, w_hi, p.omega_samples)
+    brake_w = min(max(0.0, w_lo), w_hi)
+    v = np.concatenate((np.repeat(vs, ws.size), [v_lo]))
+    w = np.concatenate((np.tile(ws, vs.size), [brake_w]))
+    n = v.size
+    steps = max(1, round(p.horizon / p.dt))
+    t = p.dt * np.arange(1, steps + 1, dtype=np.float64)  # (K,)
+    phi = w[:, None] * t[None, :]  # (N, K) heading change
+    small = np.abs(phi) < 1e-6
+    safe = np.where(small, 1.0, phi)
+    s1 = np.where(small, 1.0 - phi * phi / 6.0, np.sin(safe) / safe)  # sin(phi)/phi
+    s2 = np.where(small, 0.5 * phi, (1.0 - np.cos(safe)) / safe)  # (1-cos(phi))/phi
+    arc = v[:, None] * t[None, :]  # (N, K) distance driven
+    c0, sn0 = math.cos(th0), math.sin(th0)
+    xs = x0 + arc * (c0 * s1 - sn0 * s2)
+    ys = y0 + arc * (sn0 * s1 + c0 * s2)
+    clear = clearance(xs.ravel(), ys.ravel()).reshape(n, steps)
+    here = float(clearance(np.array([x0]), np.array([y0]))[0])
+    threshold = min(p.radius, here - 1e-3)
+    hit = clear < threshold
+    any_hit = hit.any(axis=1)
+    first = np.argmax(hit, axis=1)
+    # Arc length before the first pose under the threshold (a pose earlier, to be safe).
+    free = np.where(any_hit, np.where(first > 0, v * t[np.maximum(first - 1, 0)], 0.0), np.inf)
+    stop = v * p.latency + v * v / (2.0 * p.max_accel)
+    admissible = stop <= free
+    # Turning on the spot never moves the centre: admissible unless already too close
+    # and not getting closer (then hit is all False anyway).
+    count = int(admissible.sum())
+    if count == 0:
+        return DwaResult(
+            v=float(v_lo),
+            omega=float(brake_w),
+            admissible=0,
+            samples=n,
+            best_score=-math.inf,
+            clearance=here,
+            reason="no admissible trajectory: braking",
+        )
+    tx, ty = target
+    end_th = th0 + phi[:, -1]
+    ex, ey = xs[:, -1], ys[:, -1]
+    bearing = np.arctan2(ty - ey, tx - ex) - end_th
+    bearing = np.abs(np.remainder(bearing + math.pi, math.tau) - math.pi)
+    d0 = math.hypot(tx - x0, ty - y0)
+    gain = (d0 - np.hypot(tx - ex, ty - ey)) / (p.max_v * p.horizon)
+    min_clear = clear.min(axis=1)
+    room = np.clip(min_clear - p.radius, 0.0, p.clearance_cap) / p.clearance_cap
+    score = (
+        p.w_heading * (1.0 - bearing / math.pi)
+        + p.w_progress * gain
+        + p.w_clearance * room
+        + p.w_speed * v / p.max_v
+    )
+    score = np.where(admissible, score, -np.inf)
+    best = int(np.argmax(score))
+    reason = "toward target" if room[best] >= 1.0 else "avoiding"
+    return DwaResult(
+        v=float(v[best]),
+        omega=float(w[best]),
+        admissible=count,
+        samples=n,
+        best_score=float(score[best]),
+        clearance=float(min_clear[best]),
+        reason=reason,
+    )
