@@ -1,5 +1,6 @@
 """The live progress line of ``otonav run`` on a terminal: sim time, real-time factor,
-distance to goal, nav state and the planner's reason. A callback of the judge: it only prints, so a run's
+distance to goal, nav state and
+the planner's reason. A callback of the judge: it only prints, so a run's
 recording is the same bytes with or without it."""
 
 from __future__ import annotations

@@ -9,7 +9,9 @@ One step:
    acceleration limits, intersected with ``[0, max_v] x [-max_omega, max_omega]``; the
    top of the v range is also capped at ``sqrt(2 * max_accel * goal_distance)`` so the
    robot arrives instead of overshooting. ``v_samples x omega_samples`` samples,
-   plus the braking command (the window's lowest v, omega toward 0).
+   plus the braking command (the window's lowest v, omega toward 0). With the target
+   more than ``rotate_threshold`` off the heading only the lowest v is sampled: the
+   robot slows and turns toward it first.
 2. **Rollouts.** Each sample held for ``horizon`` s, poses every ``dt`` s (exact arcs).
 3. **Admissible.** With ``clearance(x, y)`` the distance from a point to the nearest
    return (the costmap's lower bound), the *free length* of a rollout is the arc
@@ -61,6 +63,9 @@ class DwaParams:
         latency: command delay before braking starts, s (>= 0).
         clearance_cap: clearance beyond which more is not better, m (> 0).
         w_heading, w_progress, w_clearance, w_speed: score weights (>= 0).
+        rotate_threshold: with the target farther off the heading than this, rad, the
+            window's speeds shrink to its lowest (slow down and turn toward it first,
+            like Nav2's rotation shim) (>= 0).
     """
 
     max_v: float = 0.4
@@ -79,10 +84,11 @@ class DwaParams:
     w_progress: float = 2.0
     w_clearance: float = 0.6
     w_speed: float = 0.3
+    rotate_threshold: float = 0.6
 
     def __post_init__(self) -> None:
-        positive = ("max_v", "max_omega", "max_accel", "max_alpha", "period", "horizon", "dt")
-        positive += ("clearance_cap",)
+        positive: tuple[str, ...] = ("max_v", "max_omega", "max_accel", "max_alpha")
+        positive += ("period", "horizon", "dt", "clearance_cap")
         for f in fields(self):
             value = getattr(self, f.name)
             if f.name in ("v_samples", "omega_samples"):
@@ -153,7 +159,9 @@ def dwa_step(
     w_hi = min(omega0 + p.max_alpha * p.period, p.max_omega)
     if w_lo > w_hi:  # omega0 outside the limits: the window is the nearest limit
         w_lo = w_hi = min(max(omega0, -p.max_omega), p.max_omega)
-    vs = _window(v_lo, v_hi, p.v_samples)
+    tx, ty = target
+    off = abs(math.remainder(math.atan2(ty - y0, tx - x0) - th0, math.tau))
+    vs = _window(v_lo, v_lo if off > p.rotate_threshold else v_hi, p.v_samples)
     ws = _window(w_lo, w_hi, p.omega_samples)
     brake_w = min(max(0.0, w_lo), w_hi)
     v = np.concatenate((np.repeat(vs, ws.size), [v_lo]))
@@ -193,7 +201,6 @@ def dwa_step(
             clearance=here,
             reason="no admissible trajectory: braking",
         )
-    tx, ty = target
     end_th = th0 + phi[:, -1]
     ex, ey = xs[:, -1], ys[:, -1]
     bearing = np.arctan2(ty - ey, tx - ex) - end_th

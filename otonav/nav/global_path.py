@@ -91,7 +91,7 @@ def astar(
     def h(cell: int) -> float:
         r, c = divmod(cell, w)
         dr, dc = abs(r - sr), abs(c - sc)
-        return (dr + dc) + (_SQRT2 - 2.0) * min(dr, dc)
+        return float((dr + dc) + (_SQRT2 - 2.0) * min(dr, dc))
 
     open_list: list[tuple[float, float, int]] = [(h(g), 0.0, g)]
     expansions = 0

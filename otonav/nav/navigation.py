@@ -73,7 +73,7 @@ class NavigationParams:
         follow_distance: centre-to-boundary distance while following, m.
     """
 
-    dwa: DwaParams = DwaParams()
+    dwa: DwaParams = field(default_factory=DwaParams)
     tolerance: float = 0.08
     map_half_size: float = 10.0
     map_resolution: float = 0.025
@@ -207,14 +207,18 @@ class Navigation:
             if proven_none:
                 if not self._looked_around:
                     self._looked_around = True
-                    return self._begin("spin", now, pose, distance, heading, points, "no path, looking around")
+                    return self._begin(
+                        "spin", now, pose, distance, heading, points, "no path, looking around"
+                    )
                 return self._give_up("no path to the goal in the observed map", distance, heading)
         stuck = self._checker.update(now, x, y, distance)
         if distance <= self._ladder_best - self.params.progress_distance:
             self._ladder, self._ladder_best = 0, distance
         if stuck is not None:
             if self._ladder >= len(LADDER):
-                return self._give_up(f"no progress after {', '.join(LADDER)} ({stuck})", distance, heading)
+                return self._give_up(
+                    f"no progress after {', '.join(LADDER)} ({stuck})", distance, heading
+                )
             stage = LADDER[self._ladder]
             self._ladder += 1
             return self._begin(stage, now, pose, distance, heading, points, stuck)
@@ -345,8 +349,16 @@ class Navigation:
         out = self._recover(now, pose, distance, heading, points)
         assert out is not None
         return NavOutput(
-            out.v, out.omega, out.state, f"{name}: {why}", distance, heading, None, name,
-            out.path_length, out.replans,
+            out.v,
+            out.omega,
+            out.state,
+            f"{name}: {why}",
+            distance,
+            heading,
+            None,
+            name,
+            out.path_length,
+            out.replans,
         )
 
     def _recover(

@@ -19,7 +19,9 @@ class Judge(Actor):
     the robot)."""
 
     nav_state_in = Input(topics.NAV_STATE, NavState, QoS(Reliability.BEST_EFFORT, depth=1))
-    nav_diag_in = Input(topics.NAV_DIAGNOSTICS, NavDiagnostics, QoS(Reliability.BEST_EFFORT, depth=1))
+    nav_diag_in = Input(
+        topics.NAV_DIAGNOSTICS, NavDiagnostics, QoS(Reliability.BEST_EFFORT, depth=1)
+    )
 
     def __init__(
         self,

@@ -3,6 +3,7 @@
 from otonav.stack.build import build_actors, build_world
 from otonav.stack.config import (
     BaseConfig,
+    DwaConfig,
     GuardConfig,
     NavConfig,
     RatesConfig,
@@ -13,6 +14,7 @@ from otonav.stack.config import (
 
 __all__ = (
     "BaseConfig",
+    "DwaConfig",
     "GuardConfig",
     "NavConfig",
     "RatesConfig",

@@ -140,6 +140,7 @@ def navigation_params(config: StackConfig, geometry: RobotGeometry) -> Navigatio
             w_progress=dwa.w_progress,
             w_clearance=dwa.w_clearance,
             w_speed=dwa.w_speed,
+            rotate_threshold=nav.turn_in_place_threshold,
         ),
         tolerance=nav.tolerance,
         map_half_size=grid.half_size,
