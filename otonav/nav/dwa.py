@@ -24,7 +24,8 @@ One step:
    + w_progress * (distance to the target gained) / (max_v * horizon)
    + w_clearance * min(min clearance - radius, clearance_cap) / clearance_cap
    + w_speed * v / max_v``.
-   The target is a point of the global path ahead of the robot (or the goal).
+   The target is a point of the global path ahead of the robot (or the goal); the
+   rollout's end is its last pose before the first one under the threshold.
 
 The best admissible sample is the command. With none admissible the command is the
 braking one and the reason says so.
@@ -201,8 +202,15 @@ def dwa_step(
             clearance=here,
             reason="no admissible trajectory: braking",
         )
-    end_th = th0 + phi[:, -1]
-    ex, ey = xs[:, -1], ys[:, -1]
+    # A rollout that reaches a pose under the threshold is cut before it: it is scored
+    # where it can get to, not through the obstacle.
+    last = np.where(any_hit, first - 1, steps - 1)
+    rows = np.arange(n)
+    at_start = last < 0
+    idx = np.maximum(last, 0)
+    ex = np.where(at_start, x0, xs[rows, idx])
+    ey = np.where(at_start, y0, ys[rows, idx])
+    end_th = th0 + np.where(at_start, 0.0, phi[rows, idx])
     bearing = np.arctan2(ty - ey, tx - ex) - end_th
     bearing = np.abs(np.remainder(bearing + math.pi, math.tau) - math.pi)
     d0 = math.hypot(tx - x0, ty - y0)
