@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Literal
+
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat
 
 from otonav.hal import BoxObstacle
@@ -58,3 +60,7 @@ class ScenarioConfig(BaseModel):
     min_clearance: PositiveFloat = 0.3
     """m: the robot centre must never come closer than this to an obstacle or wall."""
     seed: int = Field(0, ge=0)
+    expect: Literal["reached", "unreachable"] = "reached"
+    """The outcome that passes: ``reached`` (the goal within tolerance inside the budget)
+    or ``unreachable`` (the navigator reports ``unreachable`` on /nav/state inside the
+    budget, e.g. a walled-in goal). Either way the clearance must hold."""

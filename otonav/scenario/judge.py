@@ -14,11 +14,15 @@ from otonav.runtime import Actor, Input, QoS, Reliability
 class Judge(Actor):
     """Samples the true pose at ``rate_hz``: distance to goal, clearance to every
     obstacle and wall (robot centre to box surface), path length, first time within
-    tolerance of the goal. It also keeps the navigator's latest state and reason, and calls
+    tolerance of the goal. It also follows the navigator's /nav/state (every message
+    since the last sample, so a short-lived state is not missed): the latest state, and
+    the first sim time the navigator declared the goal ``unreachable``. It calls
     ``progress(judge, sim_time)`` after each sample (a UI's hook; it must not act on
     the robot)."""
 
-    nav_state_in = Input(topics.NAV_STATE, NavState, QoS(Reliability.BEST_EFFORT, depth=1))
+    # depth 16: /nav/state comes at 20 Hz and the judge drains it at rate_hz (100 Hz).
+    nav_state_in = Input(topics.NAV_STATE, NavState, QoS(Reliability.BEST_EFFORT, depth=16))
+    # The planner's reason (why it gave up, what it avoids): the latest is enough.
     nav_diag_in = Input(
         topics.NAV_DIAGNOSTICS, NavDiagnostics, QoS(Reliability.BEST_EFFORT, depth=1)
     )
@@ -48,6 +52,8 @@ class Judge(Actor):
         self.path_length = 0.0
         self.distance = math.inf
         self.time_to_goal: float | None = None
+        self.unreachable_at: float | None = None
+        """s of sim time when /nav/state first said ``unreachable``; None if never."""
         self.samples = 0
         self.trajectory: list[tuple[float, float, float]] = []
         self._last: tuple[float, float] | None = None
@@ -58,8 +64,22 @@ class Judge(Actor):
 
     @property
     def gave_up(self) -> bool:
-        """The navigator declared the goal unreachable (the run can end)."""
-        return self.nav_state == "unreachable"
+        """The navigator declared the goal unreachable."""
+        return self.unreachable_at is not None
+
+    @property
+    def finished(self) -> bool:
+        """Nothing more will happen worth waiting for: reached, or given up."""
+        return self.reached or self.gave_up
+
+    def _follow_nav_state(self, now: float) -> None:
+        while (state := self.nav_state_in.try_recv()) is not None:
+            self.nav_state = state.state
+            if self.unreachable_at is None and state.state == "unreachable":
+                self.unreachable_at = now
+        diag = self.nav_diag_in.take_latest()
+        if diag is not None:
+            self.nav_reason = diag.reason
 
     def sample(self, now: float) -> None:
         truth = self.hal.ground_truth()
@@ -86,12 +106,7 @@ class Judge(Actor):
         while True:
             await rate.sleep()
             now = self.clock.now()
+            self._follow_nav_state(now)
             self.sample(now)
-            state = self.nav_state_in.take_latest()
-            if state is not None:
-                self.nav_state = state.state
-            diag = self.nav_diag_in.take_latest()
-            if diag is not None:
-                self.nav_reason = diag.reason
             if self.progress is not None:
                 self.progress(self, now)

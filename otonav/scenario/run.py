@@ -57,6 +57,10 @@ class Verdict:
     rtf: float
     recording: str | None = None
     plot: str | None = None
+    expect: str = "reached"
+    """The scenario's expected outcome: ``reached`` or ``unreachable``."""
+    unreachable_at_s: float | None = None
+    """s of sim time when the navigator reported the goal unreachable; None if never."""
     nav_state: str = ""
     """The navigator's last /nav/state (e.g. reached, unreachable)."""
     nav_reason: str = ""
@@ -134,11 +138,12 @@ async def drive_to_goal(
                 pose=Pose(position=Point(x=scenario.goal.x, y=scenario.goal.y)),
             )
         )
-        # Running out of budget is a verdict (judged below), not an error.
+        # Running out of budget is a verdict (judged below), not an error. The run also
+        # ends when the navigator gives up (/nav/state ``unreachable``): whether that
+        # passes depends on the scenario's ``expect``.
         with contextlib.suppress(SimTimeoutError):
-            # The navigator giving up ends the run too: the verdict says why.
             await until(
-                lambda: judge.reached or judge.gave_up,
+                lambda: judge.finished,
                 within=scenario.sim_budget,
                 observe=lambda: f"{judge.distance:.3f} m from the goal",
                 what=f"reaching the goal within {scenario.goal_tolerance} m",
@@ -318,28 +323,49 @@ def _close_recording(
 
 
 def judge_verdict(scenario: ScenarioConfig, judge: Judge, sim_time: float, wall: float) -> Verdict:
+    """Pass when the scenario's expected outcome happened (``expect``: the goal reached,
+    or the navigator's ``unreachable`` inside the budget) and the clearance held."""
     clear = judge.min_clearance >= scenario.min_clearance
+    gave_up = judge.unreachable_at is not None and judge.unreachable_at <= scenario.sim_budget
     reasons = []
-    if not judge.reached and judge.gave_up:
-        reasons.append(
-            f"navigation gave up: unreachable ({judge.nav_reason or 'no reason given'}; "
-            f"ended {judge.distance:.3f} m away)"
-        )
-    elif not judge.reached:
-        reasons.append(
-            f"did not reach the goal within {scenario.sim_budget:g} s "
-            f"(ended {judge.distance:.3f} m away; tolerance {scenario.goal_tolerance} m)"
-        )
+    if scenario.expect == "reached":
+        outcome = judge.reached
+        if not judge.reached:
+            why = (
+                f"the navigator reported the goal unreachable at {judge.unreachable_at:.1f} s"
+                + (f" ({judge.nav_reason})" if judge.nav_reason else "")
+                if judge.unreachable_at is not None
+                else f"did not reach the goal within {scenario.sim_budget:g} s"
+            )
+            reasons.append(
+                f"{why} (ended {judge.distance:.3f} m away; tolerance {scenario.goal_tolerance} m)"
+            )
+    else:
+        outcome = gave_up and not judge.reached
+        if judge.reached:
+            reasons.append("reached a goal that was expected to be unreachable")
+        elif not gave_up:
+            reasons.append(
+                f"the navigator did not report the goal unreachable within "
+                f"{scenario.sim_budget:g} s (last state: {judge.nav_state})"
+            )
     if not clear:
         reasons.append(
             f"came {judge.min_clearance:.3f} m from an obstacle "
             f"(minimum {scenario.min_clearance} m)"
         )
+    if not reasons:
+        reasons.append(
+            "reached the goal with clearance"
+            if scenario.expect == "reached"
+            else f"reported unreachable at {judge.unreachable_at:.1f} s, as expected, "
+            "with clearance"
+        )
     return Verdict(
         scenario=scenario.name,
-        passed=judge.reached and clear,
+        passed=outcome and clear,
         reached=judge.reached,
-        reason="; ".join(reasons) or "reached the goal with clearance",
+        reason="; ".join(reasons),
         time_to_goal_s=judge.time_to_goal,
         min_clearance_m=judge.min_clearance,
         final_distance_m=judge.distance,
@@ -347,6 +373,8 @@ def judge_verdict(scenario: ScenarioConfig, judge: Judge, sim_time: float, wall:
         sim_time_s=sim_time,
         wall_time_s=wall,
         rtf=sim_time / wall if wall > 0 else math.inf,
+        expect=scenario.expect,
+        unreachable_at_s=judge.unreachable_at,
         nav_state=judge.nav_state,
         nav_reason=judge.nav_reason,
     )

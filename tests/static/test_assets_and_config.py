@@ -8,6 +8,7 @@ import pytest
 
 from otonav.hal.mujoco import compile_scene, scene_names
 from otonav.scenario import ScenarioConfig
+from otonav.scenario.builtin import BUILTIN
 from otonav.stack import StackConfig
 from otonav.stack.files import load_model
 
@@ -34,3 +35,11 @@ def test_every_scenario_file_validates(path: Path) -> None:
 def test_acceptance_scenario_file_is_the_built_in_default() -> None:
     path = ROOT / "config" / "scenarios" / "acceptance.yaml"
     assert load_model(path, ScenarioConfig) == ScenarioConfig()
+
+
+@pytest.mark.parametrize("name", [n for n in BUILTIN if n not in ("acceptance", "empty")])
+def test_every_built_in_course_has_its_file_and_they_agree(name: str) -> None:
+    # The wheel ships the code; config/scenarios/NAME.yaml documents it and can be edited
+    # into a variant: drift between the two is a bug.
+    path = ROOT / "config" / "scenarios" / f"{name}.yaml"
+    assert load_model(path, ScenarioConfig) == BUILTIN[name]
