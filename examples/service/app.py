@@ -49,7 +49,7 @@ from starlette.responses import JSONResponse, Response, StreamingResponse
 from starlette.routing import Route
 
 from otonav.actors import topics
-from otonav.cli.run import load_scenario, load_stack
+from otonav.cli.loading import load_scenario, load_stack
 from otonav.embed import LiveStack, check_run, open_live_stack, run_scenario_async
 from otonav.hal.mujoco import SceneError, scene_names
 from otonav.msgs import Odometry

@@ -6,8 +6,6 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from otonav.bench.report import format_report, run_bench, write_json
-
 
 def add_parser(commands: Any) -> None:
     p = commands.add_parser("bench", help="stack vs bare physics: wall time, RTF, ratios, RSS")
@@ -20,6 +18,8 @@ def add_parser(commands: Any) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    from otonav.bench.report import format_report, run_bench, write_json
+
     duration, reps, scaling = args.duration, args.reps, not args.no_scaling
     if args.quick:
         duration, reps, scaling = 2.0, 1, False

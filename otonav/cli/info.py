@@ -7,14 +7,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from rich.console import Console
-from rich.table import Table
 
-from otonav.record.reader import summarize
-from otonav.record.salvage import salvage
-
-
-def add_parsers(commands: Any) -> None:
+def add_parser(commands: Any) -> None:
     p = commands.add_parser("info", help="topics, types, counts, rates, duration of a recording")
     p.add_argument("file", type=Path)
     p.set_defaults(handler=info_main)
@@ -25,6 +19,11 @@ def add_parsers(commands: Any) -> None:
 
 
 def info_main(args: argparse.Namespace) -> int:
+    from rich.console import Console
+    from rich.table import Table
+
+    from otonav.record.reader import summarize
+
     summary = summarize(args.file)
     console = Console(highlight=False)
     if summary.truncated:
@@ -54,6 +53,8 @@ def info_main(args: argparse.Namespace) -> int:
 
 
 def salvage_main(args: argparse.Namespace) -> int:
+    from otonav.record.salvage import salvage
+
     count = salvage(args.source, args.target)
     print(f"salvaged {count} messages from {args.source} into {args.target}")
     return 0

@@ -6,18 +6,8 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from rich.console import Console
-from rich.table import Table
 
-from otonav.cli.run import load_stack
-from otonav.runtime import System
-from otonav.scenario.builtin import BUILTIN, describe
-from otonav.scenario.replay import plot_recording
-from otonav.stack import build_actors, build_world
-from otonav.stack.rosout import attach_rosout
-
-
-def add_parsers(commands: Any) -> None:
+def add_parser(commands: Any) -> None:
     g = commands.add_parser("graph", help="actors, topics, types and QoS of the configured stack")
     g.add_argument("--config", type=Path, help="stack config YAML (default: built-in)")
     g.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
@@ -31,6 +21,14 @@ def add_parsers(commands: Any) -> None:
 
 
 def graph_main(args: argparse.Namespace) -> int:
+    from rich.console import Console
+    from rich.table import Table
+
+    from otonav.cli.loading import load_stack
+    from otonav.runtime import System
+    from otonav.stack import build_actors, build_world
+    from otonav.stack.rosout import attach_rosout
+
     stack = load_stack(args.config, args.overrides)
     hal = build_world(stack)
     try:
@@ -61,6 +59,11 @@ def graph_main(args: argparse.Namespace) -> int:
 
 
 def scenarios_main(_args: argparse.Namespace) -> int:
+    from rich.console import Console
+    from rich.table import Table
+
+    from otonav.scenario.builtin import BUILTIN, describe
+
     table = Table(title="built-in scenarios (run one: otonav run --scenario NAME)")
     table.add_column("name")
     table.add_column("what")
@@ -71,6 +74,8 @@ def scenarios_main(_args: argparse.Namespace) -> int:
 
 
 def plot_main(args: argparse.Namespace) -> int:
+    from otonav.scenario.replay import plot_recording
+
     png = plot_recording(args.file, args.out)
     print(f"plot: {png}")
     return 0

@@ -3,32 +3,43 @@
 from __future__ import annotations
 
 import argparse
-import asyncio
-import json
-import math
-import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from pydantic import ValidationError
-from rich.console import Console
-from rich.table import Table
+if TYPE_CHECKING:  # the command's imports are in main(): --help stays fast
+    from rich.console import Console
 
-from otonav.cli.progress import ProgressLine
-from otonav.scenario import ScenarioConfig, Verdict, run_scenario
-from otonav.scenario.builtin import BUILTIN
-from otonav.scenario.realtime import run_scenario_realtime
-from otonav.scenario.run import finite_figures
-from otonav.stack import StackConfig
-from otonav.stack.files import ConfigFileError, describe_validation_error, load_model
-from otonav.stack.overrides import apply_overrides
+    from otonav.scenario import Verdict
 
 DEFAULT_OUT = Path("out")
 
 
+class _HelpFormatter(argparse.HelpFormatter):
+    """Fills ``{builtin}`` in a flag's help with the built-in scenario names, only when
+    the help is printed (building the parser must not import the scenarios)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = super()._get_help_string(action)
+        if text is not None and "{builtin}" in text:
+            from otonav.scenario.builtin import BUILTIN
+
+            text = text.replace("{builtin}", ", ".join(BUILTIN))
+        return text
+
+
 def add_parser(commands: Any) -> None:
-    p = commands.add_parser("run", help="run a scenario (default: acceptance) headless")
-    p.add_argument("--scenario", default="acceptance", help="built-in name or YAML path")
+    p = commands.add_parser(
+        "run",
+        help="run a scenario (default: acceptance) headless",
+        formatter_class=_HelpFormatter,
+    )
+    p.add_argument(
+        "--scenario",
+        default="acceptance",
+        metavar="NAME|PATH",
+        help="a built-in scenario ({builtin}; 'otonav scenarios' describes them) "
+        "or a scenario YAML file (default: acceptance)",
+    )
     p.add_argument("--config", type=Path, help="stack config YAML (default: built-in)")
     p.add_argument(
         "--set",
@@ -49,30 +60,16 @@ def add_parser(commands: Any) -> None:
     p.add_argument(
         "--scale",
         type=float,
-        default=1.0,
-        help="with --realtime/--gui: sim seconds per wall second",
+        default=None,
+        help="with --realtime/--gui only: sim seconds per wall second (default 1)",
     )
     p.add_argument("--gui", action="store_true", help="show the run in MuJoCo's viewer (real time)")
     p.set_defaults(handler=main)
 
 
-def load_scenario(spec: str) -> ScenarioConfig:
-    if spec in BUILTIN:
-        return BUILTIN[spec]
-    path = Path(spec)
-    if path.suffix in (".yaml", ".yml") or path.exists():
-        return load_model(path, ScenarioConfig)
-    raise ConfigFileError(
-        f"--scenario {spec!r}: not a built-in scenario ({', '.join(BUILTIN)}) nor a YAML file"
-    )
-
-
-def load_stack(config: Path | None, overrides: list[str]) -> StackConfig:
-    stack = load_model(config, StackConfig) if config is not None else StackConfig()
-    return apply_overrides(stack, overrides) if overrides else stack
-
-
 def print_verdict(verdict: Verdict, console: Console) -> None:
+    from rich.table import Table
+
     table = Table(
         title=f"scenario {verdict.scenario}: " + ("PASSED" if verdict.passed else "FAILED")
     )
@@ -98,6 +95,29 @@ def print_verdict(verdict: Verdict, console: Console) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    import asyncio
+    import json
+    import math
+    import sys
+
+    from pydantic import ValidationError
+    from rich.console import Console
+
+    from otonav.cli.loading import load_scenario, load_stack
+    from otonav.cli.progress import ProgressLine
+    from otonav.scenario import ScenarioConfig, run_scenario
+    from otonav.scenario.builtin import BUILTIN
+    from otonav.scenario.run import finite_figures
+    from otonav.stack.files import ConfigFileError, describe_validation_error
+
+    scale = 1.0 if args.scale is None else args.scale
+    if args.scale is not None and not (args.realtime or args.gui):
+        raise ConfigFileError(
+            f"--scale {args.scale:g}: only with --realtime or --gui "
+            "(a headless run is not paced: it runs as fast as it can)"
+        )
+    if not (scale > 0 and math.isfinite(scale)):
+        raise ConfigFileError(f"--scale {scale}: must be a finite number > 0 (sim s per wall s)")
     scenario = load_scenario(args.scenario)
     if args.seed is not None:  # validated like the file (model_copy would not check it)
         try:
@@ -110,16 +130,14 @@ def main(args: argparse.Namespace) -> int:
     progress = ProgressLine() if sys.stderr.isatty() else None
     try:
         if args.gui or args.realtime:
-            if not (args.scale > 0 and math.isfinite(args.scale)):
-                raise ConfigFileError(
-                    f"--scale {args.scale}: must be a finite number > 0 (sim s per wall s)"
-                )
+            from otonav.scenario.realtime import run_scenario_realtime
+
             verdict = run_scenario_realtime(
                 scenario,
                 stack,
                 out_dir=out,
                 record=not args.no_record,
-                scale=args.scale,
+                scale=scale,
                 gui=args.gui,
             )
         else:

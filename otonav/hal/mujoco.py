@@ -39,7 +39,6 @@ from importlib.resources.abc import Traversable
 from pathlib import Path
 from typing import Any, Final, Literal
 
-import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
@@ -54,6 +53,20 @@ from otonav.hal.types import (
     WheelState,
 )
 from otonav.hal.viewer import NoDisplayError, check_display
+
+# ``import mujoco`` loads GLFW for an offscreen GL context unless MUJOCO_GL says otherwise:
+# a windowing library (and ~25 ms) in every headless run. otonav never renders offscreen,
+# and ``mujoco.viewer`` loads GLFW itself when a window opens. So unless the user chose a
+# backend, mujoco is imported with MUJOCO_GL=disable and the environment is restored
+# (docs/adr: set MUJOCO_GL=glfw|egl|osmesa before importing otonav for mujoco.Renderer).
+_GL_CHOSEN: Final = "MUJOCO_GL" in os.environ
+if not _GL_CHOSEN:
+    os.environ["MUJOCO_GL"] = "disable"
+try:
+    import mujoco
+finally:
+    if not _GL_CHOSEN:
+        del os.environ["MUJOCO_GL"]
 
 __all__ = [
     "BUG_VARIANT_KV",

@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat
 
-from otonav.hal import BoxObstacle
+if TYPE_CHECKING:  # imported in to_obstacle: reading a scenario file needs no numpy
+    from otonav.hal.types import BoxObstacle
 
 
 class BoxSpec(BaseModel):
@@ -21,6 +22,8 @@ class BoxSpec(BaseModel):
     yaw: float = 0.0
 
     def to_obstacle(self) -> BoxObstacle:
+        from otonav.hal.types import BoxObstacle
+
         return BoxObstacle(self.x, self.y, self.size_x / 2, self.size_y / 2, self.yaw)
 
 

@@ -5,12 +5,6 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-# A Figure on an Agg canvas, not pyplot: no global figure registry (runs plot from
-# worker threads at once) and no backend forced on a host process.
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
-from matplotlib.patches import Circle, Polygon
-
 from otonav.hal import BoxObstacle
 
 
@@ -37,6 +31,13 @@ def plot_trajectory(
     title: str,
 ) -> Path:
     """Write a PNG of the run to ``path`` and return it."""
+    # Imported here: matplotlib costs ~0.3 s, and only a drawn plot needs it. A Figure
+    # on an Agg canvas, not pyplot: no global figure registry (runs plot from worker
+    # threads at once) and no backend forced on a host process.
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Circle, Polygon
+
     fig = Figure(figsize=(6.4, 4.8), dpi=100)
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()

@@ -1,6 +1,14 @@
-"""Composition: the robot stack from its config (the launch file)."""
+"""Composition: the robot stack from its config (the launch file).
 
-from otonav.stack.build import build_actors, build_world
+The config models are imported here; ``build_actors`` and ``build_world`` (the actors,
+MuJoCo, numpy) on first use, so reading a config file stays cheap (``otonav --help``).
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING
+
 from otonav.stack.config import (
     BaseConfig,
     DwaConfig,
@@ -11,6 +19,9 @@ from otonav.stack.config import (
     StackConfig,
     WorldConfig,
 )
+
+if TYPE_CHECKING:
+    from otonav.stack.build import build_actors, build_world
 
 __all__ = (
     "BaseConfig",
@@ -24,3 +35,11 @@ __all__ = (
     "build_actors",
     "build_world",
 )
+
+_LAZY = {"build_actors": "otonav.stack.build", "build_world": "otonav.stack.build"}
+
+
+def __getattr__(name: str) -> object:
+    if name in _LAZY:
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

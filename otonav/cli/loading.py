@@ -1,0 +1,31 @@
+"""Scenario and stack config from what a user typed: a built-in name or a YAML path,
+a config file, ``--set`` overrides. Each problem is a ``ConfigFileError`` naming
+``source`` (the CLI flag, or whatever the caller's users typed)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from otonav.scenario.builtin import BUILTIN
+from otonav.scenario.config import ScenarioConfig
+from otonav.stack.config import StackConfig
+from otonav.stack.files import ConfigFileError, load_model
+from otonav.stack.overrides import apply_overrides
+
+
+def load_scenario(spec: str, *, source: str = "--scenario") -> ScenarioConfig:
+    """A built-in scenario by name, or a scenario YAML file."""
+    if spec in BUILTIN:
+        return BUILTIN[spec]
+    path = Path(spec)
+    if path.suffix in (".yaml", ".yml") or path.exists():
+        return load_model(path, ScenarioConfig)
+    raise ConfigFileError(
+        f"{source} {spec!r}: not a built-in scenario ({', '.join(BUILTIN)}) nor a YAML file"
+    )
+
+
+def load_stack(config: Path | None, overrides: list[str]) -> StackConfig:
+    """The built-in stack config, or ``config`` (YAML), with ``--set`` overrides."""
+    stack = load_model(config, StackConfig) if config is not None else StackConfig()
+    return apply_overrides(stack, overrides) if overrides else stack
