@@ -9,6 +9,7 @@ import numpy as np
 
 from otonav.actors import topics
 from otonav.actors.odom_history import OdomHistory
+from otonav.actors.scan_cache import points_of
 from otonav.msgs import (
     Header,
     LaserScan,
@@ -21,7 +22,7 @@ from otonav.msgs import (
     Vector3,
 )
 from otonav.nav.navigation import Navigation, NavigationParams, NavOutput
-from otonav.nav.scan import scan_points, to_frame
+from otonav.nav.scan import to_frame
 from otonav.runtime import Actor, Input, Output
 
 
@@ -85,17 +86,16 @@ class AvoidingNavigator(Actor):
         pose = self._history.pose_at(scan.header.stamp.to_seconds())
         if pose is None:
             return
-        seen = scan_points(
-            np.asarray(scan.ranges, dtype=np.float64),
-            scan.angle_min,
-            scan.angle_increment,
-            scan.range_min,
-            scan.range_max,
-            self.laser_offset_x,
+        seen = points_of(scan, self.laser_offset_x)
+        moved = self._points_pose is None or (
+            abs(pose[0] - self._points_pose[0]) + abs(pose[1] - self._points_pose[1]) > 1e-3
+            or abs(pose[2] - self._points_pose[2]) > 1e-3
         )
         self._points, self._points_pose = seen.xy, pose
         self._scan_time = self.clock.now()
-        self.nav.observe(to_frame(seen.xy, pose))
+        # A static world seen from the same pose marks the same cells: skip the update.
+        if moved:
+            self.nav.observe(to_frame(seen.xy, pose))
 
     async def _step(self) -> None:
         now = self.clock.now()
@@ -110,8 +110,10 @@ class AvoidingNavigator(Actor):
                 out = NavOutput(0.0, 0.0, "waiting", "no fresh scan", out.distance, 0.0)
             await self._publish(out)
             return
-        points = to_frame(self._points, self._points_pose, pose)
-        await self._publish(self.nav.step(now, pose, v0, omega0, points))
+        scan_points_, scan_pose = self._points, self._points_pose
+        await self._publish(
+            self.nav.step(now, pose, v0, omega0, lambda: to_frame(scan_points_, scan_pose, pose))
+        )
 
     async def _publish(self, out: NavOutput) -> None:
         stamp = Time.from_seconds(self.clock.now())

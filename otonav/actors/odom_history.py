@@ -9,30 +9,44 @@ from otonav.msgs import Odometry
 Pose = tuple[float, float, float]
 
 
+def _stamp(odom: Odometry) -> float:
+    t = odom.header.stamp
+    return t.sec + t.nanosec * 1e-9
+
+
+def _pose(odom: Odometry) -> Pose:
+    p = odom.pose.pose
+    return (p.position.x, p.position.y, p.orientation.yaw())
+
+
 class OdomHistory:
-    """The last ``size`` odometry messages as (stamp s, pose (x, y, yaw), v, omega)."""
+    """The last ``size`` odometry messages; decoded only when asked (odometry comes at
+    100 Hz, a pose is wanted at 10-20 Hz)."""
 
     def __init__(self, size: int = 32) -> None:
-        self._items: deque[tuple[float, Pose, float, float]] = deque(maxlen=size)
+        self._items: deque[Odometry] = deque(maxlen=size)
 
     def add(self, odom: Odometry) -> None:
-        p = odom.pose.pose
-        t = odom.twist.twist
-        self._items.append(
-            (
-                odom.header.stamp.to_seconds(),
-                (p.position.x, p.position.y, p.orientation.yaw()),
-                t.linear.x,
-                t.angular.z,
-            )
-        )
+        self._items.append(odom)
 
     @property
     def latest(self) -> tuple[float, Pose, float, float] | None:
-        return self._items[-1] if self._items else None
+        """(stamp s, pose (x, y, yaw), v m/s, omega rad/s) of the newest message."""
+        if not self._items:
+            return None
+        odom = self._items[-1]
+        twist = odom.twist.twist
+        return _stamp(odom), _pose(odom), twist.linear.x, twist.angular.z
 
     def pose_at(self, stamp: float) -> Pose | None:
         """The pose with the stamp nearest ``stamp`` (None with no odometry yet)."""
         if not self._items:
             return None
-        return min(self._items, key=lambda item: abs(item[0] - stamp))[1]
+        # Newest first: stamps only grow, so the gap shrinks until the nearest one.
+        best, gap = self._items[-1], abs(_stamp(self._items[-1]) - stamp)
+        for odom in reversed(self._items):
+            this = abs(_stamp(odom) - stamp)
+            if this > gap:
+                break
+            best, gap = odom, this
+        return _pose(best)

@@ -11,9 +11,10 @@ import numpy as np
 
 from otonav.actors import topics
 from otonav.actors.odom_history import OdomHistory
+from otonav.actors.scan_cache import points_of
 from otonav.msgs import Header, LaserScan, Odometry, SafetyState, Time, Twist, Vector3
 from otonav.nav.safety import SafetyParams, safe_command
-from otonav.nav.scan import scan_points, to_frame
+from otonav.nav.scan import to_frame
 from otonav.runtime import Actor, Input, Output
 
 
@@ -54,6 +55,7 @@ class SafetyLayer(Actor):
         self._history = OdomHistory()
         self._points = np.empty((0, 2))
         self._points_pose: tuple[float, float, float] | None = None
+        self._nearest = math.inf  # centre to the nearest return, at the scan's pose
         self._scan_time = -math.inf
 
     async def run(self) -> None:
@@ -80,15 +82,10 @@ class SafetyLayer(Actor):
         pose = self._history.pose_at(scan.header.stamp.to_seconds())
         if pose is None:
             return
-        seen = scan_points(
-            np.asarray(scan.ranges, dtype=np.float64),
-            scan.angle_min,
-            scan.angle_increment,
-            scan.range_min,
-            scan.range_max,
-            self.laser_offset_x,
-        )
+        seen = points_of(scan, self.laser_offset_x)
         self._points, self._points_pose, self._scan_time = seen.xy, pose, now
+        xy = seen.xy
+        self._nearest = float(np.hypot(xy[:, 0], xy[:, 1]).min()) if xy.shape[0] else math.inf
 
     async def _send(self, now: float, v_in: float, w_in: float) -> None:
         odom = self._history.latest
@@ -98,15 +95,24 @@ class SafetyLayer(Actor):
         else:
             assert odom is not None
             _, pose, v0, w0 = odom
-            points = to_frame(self._points, self._points_pose, pose)
-            result = safe_command(v_in, w_in, v0, w0, points, self.params)
-            v, w, scale, nearest, reason = (
-                result.v,
-                result.omega,
-                result.scale,
-                result.nearest,
-                result.reason,
-            )
+            p, scan_pose = self.params, self._points_pose
+            # The centre moved at most `moved` since the scan: a return that far plus
+            # the longest stopping path out of the radius cannot matter (no transform).
+            moved = math.hypot(pose[0] - scan_pose[0], pose[1] - scan_pose[1])
+            fastest = max(abs(v_in), abs(v0))
+            reach = fastest * p.latency + fastest * fastest / (2.0 * p.max_accel) + 0.05
+            if self._nearest - moved > p.radius + reach:
+                v, w, scale, nearest, reason = v_in, w_in, 1.0, self._nearest - moved, "clear"
+            else:
+                points = to_frame(self._points, scan_pose, pose)
+                result = safe_command(v_in, w_in, v0, w0, points, p)
+                v, w, scale, nearest, reason = (
+                    result.v,
+                    result.omega,
+                    result.scale,
+                    result.nearest,
+                    result.reason,
+                )
         if reason in ("limited", "stopped", "blind") and (v, w) != (v_in, w_in):
             self.limited += 1
         await self.cmd_out.publish(

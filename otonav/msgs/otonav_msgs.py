@@ -76,7 +76,8 @@ class SafetyState(Message):
     scale: float = 1.0
     """The forward-speed scale applied (1: untouched)."""
     nearest: float = 0.0
-    """m, robot centre to the nearest return (inf if none)."""
+    """m, robot centre to the nearest return (inf if none; a lower bound when
+    ``clear``: the last scan's nearest less the distance driven since)."""
     v_in: float = 0.0
     omega_in: float = 0.0
     v_out: float = 0.0

@@ -11,9 +11,9 @@ is known.
 * **Distances, not costs.** :meth:`ClearanceMap.clearance` answers, for any points, a
   lower bound on the distance to the nearest recorded return, capped at
   ``max_distance``: the distance between cell centres minus ``resolution * sqrt(2)``
-  (each of the two points may sit anywhere in its cell). The local planner checks its
-  rollouts against it and the global planner its cells, so both use the one centre
-  clearance of :mod:`otonav.nav.footprint`.
+  (each of the two points may sit anywhere in its cell), stored that way per cell.
+  The local planner checks its rollouts against it and the global planner its cells,
+  so both use the one centre clearance of :mod:`otonav.nav.footprint`.
 * **Incremental.** Marking a new cell stamps a precomputed disk of distances around it
   (``np.minimum`` on a window); a cell already occupied costs nothing. A 20 x 20 m map
   at 2.5 cm is 800 x 800 float32 (2.5 MB); a stamp of 0.6 m costs ~10 us.
@@ -57,14 +57,20 @@ class ClearanceMap:
         self.origin_x = centre_x - half_size
         self.origin_y = centre_y - half_size
         self.occupied = np.zeros((self.size, self.size), dtype=np.bool_)
-        self.distance = np.full((self.size, self.size), max_distance, dtype=np.float32)
+        # Per cell, what clearance() answers: the distance to the nearest occupied cell
+        # less the slack (0 at least; the cap stays the cap). One border row/column all
+        # round stays at the cap: the answer for points outside the map.
+        self._lower = np.full((self.size + 2, self.size + 2), max_distance, dtype=np.float32)
         k = math.ceil(max_distance / resolution)
         offsets = np.arange(-k, k + 1, dtype=np.float64) * resolution
         self._k = k
-        self._kernel = np.minimum(
-            np.hypot(offsets[:, None], offsets[None, :]), max_distance
+        kernel = np.hypot(offsets[:, None], offsets[None, :])
+        slack = resolution * math.sqrt(2.0)
+        # min over returns of max(d - slack, 0) is max(min d - slack, 0): stamping the
+        # slack-reduced disk keeps the lower bound exact under np.minimum.
+        self._kernel = np.where(
+            kernel >= max_distance, max_distance, np.maximum(kernel - slack, 0.0)
         ).astype(np.float32)
-        self._slack = np.float32(resolution * math.sqrt(2.0))
         self.marked = 0
 
     def cell_of(
@@ -93,22 +99,26 @@ class ClearanceMap:
         if new.size == 0:
             return 0
         self.occupied.ravel()[new] = True
-        k, n, kernel, dist = self._k, self.size, self._kernel, self.distance
+        k, n, kernel, lower = self._k, self.size, self._kernel, self._lower
         for cell in new.tolist():
             r, c = divmod(cell, n)
             r0, r1 = max(r - k, 0), min(r + k + 1, n)
             c0, c1 = max(c - k, 0), min(c + k + 1, n)
-            window = dist[r0:r1, c0:c1]
+            window = lower[r0 + 1 : r1 + 1, c0 + 1 : c1 + 1]
             np.minimum(window, kernel[r0 - r + k : r1 - r + k, c0 - c + k : c1 - c + k], out=window)
         self.marked += int(new.size)
         return int(new.size)
 
+    def coarse(self, stride: int) -> NDArray[np.float32]:
+        """clearance() at the centre cell of every ``stride`` x ``stride`` block: the
+        global planner's grid (a view, rows = y)."""
+        start = 1 + stride // 2
+        return self._lower[start : self.size + 1 : stride, start : self.size + 1 : stride]
+
     def clearance(self, x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float32]:
         """Lower bound on the distance from each point to the nearest recorded return,
         m, capped at ``max_distance`` (outside the map: ``max_distance``)."""
-        row, col, inside = self.cell_of(x, y)
-        out = np.full(row.shape, self.max_distance, dtype=np.float32)
-        d = self.distance[row[inside], col[inside]]
-        # Capped cells stay at the cap: the slack only applies to a real distance.
-        out[inside] = np.where(d >= self.max_distance, d, np.maximum(d - self._slack, 0.0))
-        return out
+        inv = 1.0 / self.resolution
+        col = np.clip(np.floor((x - self.origin_x) * inv), -1, self.size) + 1
+        row = np.clip(np.floor((y - self.origin_y) * inv), -1, self.size) + 1
+        return self._lower[row.astype(np.intp), col.astype(np.intp)]

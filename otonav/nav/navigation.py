@@ -30,6 +30,7 @@ Each :meth:`Navigation.step` (at the navigator's rate):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -41,7 +42,15 @@ from otonav.nav.geometry import wrap_angle
 from otonav.nav.global_path import astar
 from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
 
-__all__ = ("LADDER", "NavOutput", "Navigation", "NavigationParams")
+__all__ = ("LADDER", "NavOutput", "Navigation", "NavigationParams", "Points")
+
+Points = NDArray[np.float64] | Callable[[], NDArray[np.float64]]
+"""Scan returns in base_link, ``(N, 2)`` m, or a function that computes them."""
+
+
+def _resolve(points: Points) -> NDArray[np.float64]:
+    return points() if callable(points) else points
+
 
 LADDER = ("spin", "backup", "follow")
 """The recovery stages, in order."""
@@ -131,9 +140,11 @@ class Navigation:
     goal: tuple[float, float] | None = None
     map: ClearanceMap = field(init=False)
     path: NDArray[np.float64] | None = None
+    path_length: float = math.nan
     replans: int = 0
     _checker: ProgressChecker = field(init=False)
     _planned_at: float = -math.inf
+    _checked_at: float = -math.inf
     _looked_around: bool = False
     _ladder: int = 0
     _ladder_best: float = math.inf
@@ -180,10 +191,11 @@ class Navigation:
         pose: tuple[float, float, float],
         v0: float,
         omega0: float,
-        points: NDArray[np.float64],
+        points: Points,
     ) -> NavOutput:
         """One decision. ``points``: the latest scan's returns in the current
-        base_link (for boundary following)."""
+        base_link, or a function that computes them (only boundary following needs
+        them, so the caller's transform is skipped otherwise)."""
         if self.goal is None:
             return NavOutput(0.0, 0.0, "idle", "no goal", math.inf, 0.0)
         x, y, yaw = pose
@@ -199,9 +211,10 @@ class Navigation:
             out = self._recover(now, pose, distance, heading, points)
             if out is not None:
                 return out
-        replan = self.path is None or (
-            now - self._planned_at >= self.params.replan_period and self._path_blocked(pose)
-        )
+        due = now - self._checked_at >= self.params.replan_period
+        if due:
+            self._checked_at = now
+        replan = self.path is None or (due and self._path_blocked(pose))
         if replan:
             proven_none = self._plan(now, pose)
             if proven_none:
@@ -242,9 +255,6 @@ class Navigation:
         heading: float,
         dwa: DwaResult | None = None,
     ) -> NavOutput:
-        length = math.nan
-        if self.path is not None and self.path.shape[0] > 1:
-            length = float(np.hypot(*np.diff(self.path, axis=0).T).sum())
         return NavOutput(
             v,
             omega,
@@ -254,7 +264,7 @@ class Navigation:
             heading,
             dwa,
             self._stage.name if self._stage is not None else "",
-            length,
+            self.path_length if self.path is not None else math.nan,
             self.replans,
         )
 
@@ -264,9 +274,7 @@ class Navigation:
         return self._out(0.0, 0.0, "unreachable", reason, distance, heading)
 
     def _free_grid(self) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
-        s = self._stride
-        coarse = self.map.distance[s // 2 :: s, s // 2 :: s].astype(np.float64)
-        coarse -= self.map.resolution * math.sqrt(2.0)
+        coarse = self.map.coarse(self._stride).astype(np.float64)
         radius = self.params.dwa.radius
         free = coarse >= radius
         room = self.params.dwa.clearance_cap
@@ -277,13 +285,13 @@ class Navigation:
         s, res = self._stride, self.map.resolution
         col = math.floor((x - self.map.origin_x) / (res * s))
         row = math.floor((y - self.map.origin_y) / (res * s))
-        n = self.map.distance[s // 2 :: s, 0].shape[0]
+        n = self.map.coarse(s).shape[0]
         return min(max(row, 0), n - 1), min(max(col, 0), n - 1)
 
     def _plan(self, now: float, pose: tuple[float, float, float]) -> bool:
         """Replan; True when the search proved there is no path."""
         assert self.goal is not None
-        self._planned_at = now
+        self._planned_at = self._checked_at = now
         self.replans += 1
         free, penalty = self._free_grid()
         result = astar(
@@ -304,6 +312,7 @@ class Navigation:
         xy[0] = pose[:2]
         xy[-1] = self.goal
         self.path = xy
+        self.path_length = float(np.hypot(*np.diff(xy, axis=0).T).sum())
         return False
 
     def _path_blocked(self, pose: tuple[float, float, float]) -> bool:
@@ -339,10 +348,13 @@ class Navigation:
         pose: tuple[float, float, float],
         distance: float,
         heading: float,
-        points: NDArray[np.float64],
+        points: Points,
         why: str,
     ) -> NavOutput:
-        side = boundary_side(points, heading) if name == "follow" else (1 if heading >= 0 else -1)
+        if name == "follow":
+            side = boundary_side(_resolve(points), heading)
+        else:
+            side = 1 if heading >= 0 else -1
         self._stage = _Stage(name, now, pose[0], pose[1], pose[2], distance, side)
         if self._ladder_best == math.inf:
             self._ladder_best = distance
@@ -367,7 +379,7 @@ class Navigation:
         pose: tuple[float, float, float],
         distance: float,
         heading: float,
-        points: NDArray[np.float64],
+        points: Points,
     ) -> NavOutput | None:
         """The current stage's command, or None when it is over (then replan, drive)."""
         st, p = self._stage, self.params
@@ -386,7 +398,7 @@ class Navigation:
         else:
             done = elapsed > p.follow_time or distance <= st.goal_distance - p.progress_distance
             v, omega = follow_boundary(
-                points,
+                _resolve(points),
                 st.side,
                 distance=p.follow_distance,
                 speed=p.follow_speed,
