@@ -12,14 +12,12 @@ from pathlib import Path
 from tempfile import TemporaryDirectory
 
 from otonav.actors import topics
-from otonav.actors.recorder import Recorder
 from otonav.bench.bare import run_bare
 from otonav.msgs import LaserScan, Point, Pose, PoseStamped
-from otonav.record.writer import RecordingWriter
-from otonav.runtime import LATCHED_QOS, Actor, Input, System, virtual_loop_factory
+from otonav.runtime import LATCHED_QOS, Actor, Input, virtual_loop_factory
 from otonav.scenario import ScenarioConfig
 from otonav.stack import StackConfig, WorldConfig, build_actors, build_world
-from otonav.stack.rosout import attach_rosout
+from otonav.stack.session import StackSession
 
 
 @dataclass(frozen=True, slots=True)
@@ -59,26 +57,19 @@ class ScanReader(Actor):
 async def _stack(
     case: Case, stack: StackConfig, goal: tuple[float, float], out: Path | None
 ) -> float:
-    loop = asyncio.get_running_loop()
     hal = build_world(stack)
-    loop.attach_source(hal)  # type: ignore[attr-defined]
-    writer = RecordingWriter(out / "bench.mcap") if out is not None else None
-    actors: list[Actor] = [Recorder(writer)] if writer is not None else []
-    actors += build_actors(stack, hal)
+    actors: list[Actor] = [*build_actors(stack, hal)]
     actors += [ScanReader(i) for i in range(case.scan_subscribers)]
-    system = System(actors)
-    attach_rosout(system)
+    session = StackSession(hal, actors, record_to=out / "bench.mcap" if out else None)
     wall = time.perf_counter()
     try:
-        async with system:
+        async with session.running(close=False) as system:
             goal_pub = system.publisher(topics.GOAL, PoseStamped, LATCHED_QOS)
             await goal_pub.publish(PoseStamped(pose=Pose(position=Point(x=goal[0], y=goal[1]))))
             await system.clock.sleep(case.duration)
-        return time.perf_counter() - wall
+        return time.perf_counter() - wall  # the run and its stop, not finishing the file
     finally:
-        if writer is not None:
-            writer.finish()
-        hal.close()
+        session.close()
 
 
 def run_case(case: Case) -> Sample:

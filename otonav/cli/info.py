@@ -3,36 +3,103 @@
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from otonav.record.reader import RecordingSummary
 
 
 def add_parser(commands: Any) -> None:
     p = commands.add_parser("info", help="topics, types, counts, rates, duration of a recording")
     p.add_argument("file", type=Path)
+    p.add_argument("--json", action="store_true", help="print the facts as one JSON object")
     p.set_defaults(handler=info_main)
     s = commands.add_parser("salvage", help="rewrite a cut-off recording as an indexed file")
     s.add_argument("source", type=Path)
     s.add_argument("target", type=Path)
+    s.add_argument("--force", action="store_true", help="overwrite TARGET if it exists")
     s.set_defaults(handler=salvage_main)
 
 
-def info_main(args: argparse.Namespace) -> int:
-    from rich.console import Console
-    from rich.table import Table
+def warn_cut_off(summary: RecordingSummary, doing: str) -> None:
+    """One line on stderr: the file was cut off, what is used, how to fix it."""
+    print(
+        f"otonav: warning: {summary.path} was cut off (no index): {doing} the "
+        f"{summary.message_count} messages of its complete chunks; "
+        f"'otonav salvage {summary.path} FIXED.mcap' rewrites them as an indexed file",
+        file=sys.stderr,
+    )
 
+
+def _decoded(value: str) -> Any:
+    try:
+        return json.loads(value)
+    except ValueError:
+        return value
+
+
+def as_json(summary: RecordingSummary) -> dict[str, Any]:
+    """The facts of ``otonav info`` as plain data (``--json``): JSON-valued metadata
+    fields (configs, the verdict, the world's boxes) are decoded."""
+    run = summary.metadata.get("otonav", {})
+    return {
+        "file": str(summary.path),
+        "size_bytes": summary.size_bytes,
+        "profile": summary.profile,
+        "library": summary.library,
+        "truncated": summary.truncated,
+        "start_s": summary.start_ns / 1e9,
+        "end_s": summary.end_ns / 1e9,
+        "duration_s": summary.duration_s,
+        "message_count": summary.message_count,
+        "topics": [
+            {"topic": t.topic, "type": t.type, "count": t.count, "rate_hz": t.rate_hz}
+            for t in summary.topics
+        ],
+        "scenario": run.get("scenario"),
+        "seed": int(run["seed"]) if run.get("seed", "").isdigit() else None,
+        "metadata": {
+            name: {key: _decoded(value) for key, value in record.items()}
+            for name, record in summary.metadata.items()
+        },
+    }
+
+
+def _fields(values: Any) -> str:
+    """``key=value ...``; a nested value as compact JSON."""
+    if not isinstance(values, dict):
+        return str(values)
+    return " ".join(
+        f"{k}={v if isinstance(v, str | int | float) else json.dumps(v, separators=(',', ':'))}"
+        for k, v in values.items()
+    )
+
+
+def _stack_lines(stack_json: str) -> list[str]:
+    """One line per stack config section: ``section: key=value ...``."""
+    sections = _decoded(stack_json)
+    if not isinstance(sections, dict):
+        return [stack_json]
+    return [f"{name}: {_fields(values)}" for name, values in sections.items()]
+
+
+def info_main(args: argparse.Namespace) -> int:
     from otonav.record.reader import summarize
 
     summary = summarize(args.file)
-    console = Console(highlight=False)
     if summary.truncated:
-        print(
-            f"otonav: warning: {args.file} was cut off (no index): showing the "
-            f"{summary.message_count} messages of its complete chunks; "
-            f"'otonav salvage {args.file} FIXED.mcap' rewrites them as an indexed file",
-            file=sys.stderr,
-        )
+        warn_cut_off(summary, "showing")
+    if args.json:
+        print(json.dumps(as_json(summary), indent=2))
+        return 0
+
+    from rich.console import Console
+    from rich.table import Table
+
+    console = Console(highlight=False)
     console.print(f"file:      {summary.path} ({summary.size_bytes / 1024:.1f} KiB)")
     console.print(f"profile:   {summary.profile or '-'}   library: {summary.library or '-'}")
     console.print(
@@ -46,15 +113,24 @@ def info_main(args: argparse.Namespace) -> int:
     for t in summary.topics:
         table.add_row(t.topic, t.type, str(t.count), f"{t.rate_hz:.1f}")
     console.print(table)
-    verdict = summary.metadata.get("otonav", {}).get("verdict")
-    if verdict:
-        console.print(f"verdict:   {verdict}")
+    run = summary.metadata.get("otonav", {})
+    if "scenario" in run:
+        console.print(f"scenario:  {run['scenario']}   seed: {run.get('seed', '-')}")
+    if "scenario_config" in run:
+        console.print("           " + _fields(_decoded(run["scenario_config"])), soft_wrap=True)
+    if "stack_config" in run:
+        lines = _stack_lines(run["stack_config"])
+        console.print("stack:     " + "\n           ".join(lines), soft_wrap=True)
+    if "verdict" in run:
+        console.print(f"verdict:   {run['verdict']}", soft_wrap=True)
+    elif run:
+        console.print("verdict:   - (the run did not finish: no verdict was recorded)")
     return 0
 
 
 def salvage_main(args: argparse.Namespace) -> int:
     from otonav.record.salvage import salvage
 
-    count = salvage(args.source, args.target)
+    count = salvage(args.source, args.target, overwrite=args.force)
     print(f"salvaged {count} messages from {args.source} into {args.target}")
     return 0

@@ -74,8 +74,13 @@ def scenarios_main(_args: argparse.Namespace) -> int:
 
 
 def plot_main(args: argparse.Namespace) -> int:
+    from otonav.cli.info import warn_cut_off
+    from otonav.record.reader import summarize
     from otonav.scenario.replay import plot_recording
 
+    summary = summarize(args.file)
+    if summary.truncated:
+        warn_cut_off(summary, "drawing")
     png = plot_recording(args.file, args.out)
     print(f"plot: {png}")
     return 0

@@ -128,6 +128,15 @@ def main(args: argparse.Namespace) -> int:
     out: Path = args.out
     source = args.scenario if args.scenario not in BUILTIN else f"scenario '{args.scenario}'"
     progress = ProgressLine() if sys.stderr.isatty() else None
+    stale = [out / "summary.json"] + ([out / "recording.mcap"] if args.no_record else [])
+
+    def on_start(_loop: object, _task: object) -> None:
+        # The run has started (its input is valid, its world built, its recording
+        # opened): the previous run's artifacts must not pass for this one's. Nothing is
+        # deleted on bad input. An interrupted run writes no summary.json.
+        for path in stale:
+            path.unlink(missing_ok=True)
+
     try:
         if args.gui or args.realtime:
             from otonav.scenario.realtime import run_scenario_realtime
@@ -139,6 +148,7 @@ def main(args: argparse.Namespace) -> int:
                 record=not args.no_record,
                 scale=scale,
                 gui=args.gui,
+                on_start=on_start,
             )
         else:
             verdict = run_scenario(
@@ -148,6 +158,7 @@ def main(args: argparse.Namespace) -> int:
                 record=not args.no_record,
                 progress=progress,
                 source=source,
+                on_start=on_start,
             )
     except asyncio.CancelledError:
         print("otonav: terminated; the recording was finished and is readable", file=sys.stderr)

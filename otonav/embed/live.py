@@ -11,12 +11,10 @@ from types import TracebackType
 from typing import Any, Generic, TypeVar
 
 from otonav.actors import topics
-from otonav.actors.recorder import Recorder
 from otonav.embed._wait import _wait_done
 from otonav.embed.paced import PacedClock
 from otonav.hal import RobotHardwareInterface
 from otonav.msgs import Header, Message, Point, Pose, PoseStamped, Time
-from otonav.record.writer import RecordingWriter
 from otonav.runtime import (
     DEFAULT_QOS,
     LATCHED_QOS,
@@ -32,7 +30,7 @@ from otonav.runtime import (
     System,
 )
 from otonav.stack import StackConfig, build_actors, build_world
-from otonav.stack.rosout import attach_rosout
+from otonav.stack.session import StackSession
 
 M = TypeVar("M")
 
@@ -137,17 +135,12 @@ class LiveStack:
     """A robot stack running on the host's loop in real-time mode (see the module
     docstring). Made by :func:`open_live_stack`."""
 
-    def __init__(
-        self,
-        system: System,
-        hal: RobotHardwareInterface,
-        clock: PacedClock,
-        writer: RecordingWriter | None,
-    ) -> None:
-        self._system = system
-        self._hal = hal
+    def __init__(self, session: StackSession, clock: PacedClock) -> None:
+        self._session = session
+        self._system = session.system
+        self._hal = session.hal
         self._clock = clock
-        self._writer = writer
+        self._writer = session.writer
         self._task: asyncio.Task[None] | None = None
         self._subscriptions: list[LiveSubscription[Any]] = []
         self._publishers: dict[tuple[str, type[Any], QoS], Publisher[Any]] = {}
@@ -258,16 +251,14 @@ class LiveStack:
         # crashing actor stops the stack, not the host.
         if self._closing:
             return
-        pacer = asyncio.get_running_loop().create_task(self._clock.pace(), name="otonav-live-pacer")
         try:
-            await self._system.run()
+            # The session runs the pacer; close() tears it down once this task ended.
+            await self._session.run(close=False)
         except Exception as exc:
             self._failure = exc
         finally:
-            pacer.cancel()
             for sub in tuple(self._subscriptions):
                 sub.close()
-            await asyncio.wait((pacer,))
 
     def _forget(self, sub: Subscription[Any]) -> None:
         self._subscriptions = [s for s in self._subscriptions if s._sub is not sub]
@@ -281,8 +272,9 @@ class LiveStack:
 
     async def close(self) -> None:
         """Stop every actor (each ``on_stop`` runs), finish the recording, release the
-        world. Idempotent. If the host cancels the caller meanwhile, the close still
-        completes before the cancellation propagates."""
+        world, in the one teardown order of :mod:`otonav.stack.session`. Idempotent.
+        If the host cancels the caller meanwhile, the close still completes before the
+        cancellation propagates."""
         if self._close_done is not None:  # closed, or being closed by another task
             if await _wait_done(self._close_done):
                 raise asyncio.CancelledError
@@ -299,10 +291,8 @@ class LiveStack:
         finally:
             self._closed = True
             try:
-                if self._writer is not None:
-                    self._writer.finish()
+                self._session.close()
             finally:
-                self._hal.close()
                 self._close_done.set_result(None)
         if cancelled:
             raise asyncio.CancelledError
@@ -331,24 +321,17 @@ async def open_live_stack(
     hal = build_world(stack)
     live: LiveStack | None = None
     try:
-        writer = RecordingWriter(record_to) if record_to is not None else None
         try:
             clock = PacedClock(hal, scale=scale, max_step_batch=max_step_batch)
-            actors: list[Actor] = [Recorder(writer)] if writer is not None else []
-            actors += [*build_actors(stack, hal, navigator=navigator, goal=goal), *extra_actors]
-            system = System(actors, clock=clock)
-            attach_rosout(system)
+            actors = [*build_actors(stack, hal, navigator=navigator, goal=goal), *extra_actors]
         except BaseException:
-            if writer is not None:
-                writer.finish()
+            hal.close()
             raise
-        live = LiveStack(system, hal, clock, writer)
+        live = LiveStack(StackSession(hal, actors, realtime=clock, record_to=record_to), clock)
         live._start()
         yield live
     finally:
         if live is not None:
             await live.close()
-        else:
-            hal.close()
     if live.failure is not None:
         raise live.failure

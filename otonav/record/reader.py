@@ -11,6 +11,8 @@ from typing import Any
 
 from mcap.exceptions import McapError
 from mcap.reader import NonSeekingReader, make_reader
+from mcap.records import Channel, Message, Metadata, Schema
+from mcap.stream_reader import StreamReader
 from mcap_ros2.decoder import DecoderFactory
 
 MAGIC = b"\x89MCAP0\r\n"
@@ -119,6 +121,19 @@ def summarize(path: str | Path) -> RecordingSummary:
     return _scan_truncated(path, size)
 
 
+def iter_readable(path: Path) -> Iterator[Schema | Channel | Message | Metadata]:
+    """The schema, channel, message and metadata records of ``path`` in file order, up to
+    where it was cut off (a cut-off file ends mid-record: the rest is not readable).
+    Works on a complete file too (it is read front to back, index ignored)."""
+    with path.open("rb") as f:
+        try:
+            for record in StreamReader(f).records:
+                if isinstance(record, Schema | Channel | Message | Metadata):
+                    yield record
+        except CUT_OFF_ERRORS:
+            return  # the cut: everything before it has been yielded
+
+
 def _scan_truncated(path: Path, size: int) -> RecordingSummary:
     topics: dict[str, TopicSummary] = {}
     profile = library = ""
@@ -129,24 +144,26 @@ def _scan_truncated(path: Path, size: int) -> RecordingSummary:
             profile, library = header.profile, header.library
         except CUT_OFF_ERRORS:
             pass
-    with path.open("rb") as f:
-        reader = NonSeekingReader(f)
-        try:
-            for schema, channel, message in reader.iter_messages(log_time_order=False):
-                t = topics.get(channel.topic)
-                if t is None:
-                    t = topics[channel.topic] = TopicSummary(
-                        channel.topic, schema.name if schema else "?", 0
-                    )
-                t.count += 1
-                t.first_ns = (
-                    message.log_time if t.first_ns is None else min(t.first_ns, message.log_time)
+    schemas: dict[int, str] = {}
+    channels: dict[int, TopicSummary] = {}
+    metadata: dict[str, dict[str, str]] = {}
+    for record in iter_readable(path):
+        if isinstance(record, Schema):
+            schemas[record.id] = record.name
+        elif isinstance(record, Channel):
+            t = topics.get(record.topic)
+            if t is None:
+                t = topics[record.topic] = TopicSummary(
+                    record.topic, schemas.get(record.schema_id, "?"), 0
                 )
-                t.last_ns = (
-                    message.log_time if t.last_ns is None else max(t.last_ns, message.log_time)
-                )
-        except CUT_OFF_ERRORS:
-            pass  # the cut: everything before it has been counted
+            channels[record.id] = t
+        elif isinstance(record, Metadata):
+            metadata[record.name] = dict(record.metadata)
+        elif record.channel_id in channels:
+            t = channels[record.channel_id]
+            t.count += 1
+            t.first_ns = record.log_time if t.first_ns is None else min(t.first_ns, record.log_time)
+            t.last_ns = record.log_time if t.last_ns is None else max(t.last_ns, record.log_time)
     firsts = [t.first_ns for t in topics.values() if t.first_ns is not None]
     lasts = [t.last_ns for t in topics.values() if t.last_ns is not None]
     if firsts:
@@ -159,7 +176,7 @@ def _scan_truncated(path: Path, size: int) -> RecordingSummary:
         start,
         end,
         sorted(topics.values(), key=lambda t: t.topic),
-        {},
+        metadata,
         truncated=True,
     )
 
@@ -172,14 +189,47 @@ def read_messages(
     end: float | None = None,
 ) -> Iterator[tuple[str, float, Any]]:
     """Yield ``(topic, sim_time_s, decoded_message)`` in log-time order, for ``topics``
-    (all when None) with ``start <= t < end`` (seconds of sim time)."""
+    (all when None) with ``start <= t < end`` (seconds of sim time). A cut-off file
+    yields the messages of its complete chunks, in file order."""
     path = Path(path)
     _check_file(path)
     with path.open("rb") as f:
         reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        try:
+            indexed = reader.get_summary() is not None
+        except CUT_OFF_ERRORS:
+            indexed = False
+        if not indexed:
+            yield from _read_cut_off(path, topics, start, end)
+            return
         for _schema, channel, message, decoded in reader.iter_decoded_messages(
             topics=list(topics) if topics is not None else None,
             starting_at=None if start is None else round(start * 1e9),
             ending_before=None if end is None else round(end * 1e9),
         ):
             yield channel.topic, message.log_time / 1e9, decoded
+
+
+def _read_cut_off(
+    path: Path, topics: Sequence[str] | None, start: float | None, end: float | None
+) -> Iterator[tuple[str, float, Any]]:
+    factory = DecoderFactory()
+    schemas: dict[int, Schema] = {}
+    channels: dict[int, tuple[Channel, Any]] = {}
+    wanted = None if topics is None else set(topics)
+    first = None if start is None else round(start * 1e9)
+    last = None if end is None else round(end * 1e9)
+    for record in iter_readable(path):
+        if isinstance(record, Schema):
+            schemas[record.id] = record
+        elif isinstance(record, Channel):
+            if wanted is None or record.topic in wanted:
+                schema = schemas.get(record.schema_id)
+                channels[record.id] = (record, factory.decoder_for(record.message_encoding, schema))
+        elif isinstance(record, Message) and record.channel_id in channels:
+            if (first is not None and record.log_time < first) or (
+                last is not None and record.log_time >= last
+            ):
+                continue
+            channel, decode = channels[record.channel_id]
+            yield channel.topic, record.log_time / 1e9, decode(record.data)

@@ -1,41 +1,57 @@
 """Salvage: rewrite the readable part of a cut-off recording as an indexed file (what
 ``mcap recover`` does): every message of every complete chunk, same schemas and
-channels. Metadata records (written at the end by ``finish``) are not in a cut-off
-file, so there are none to copy."""
+channels, and every metadata record that was written before the cut (``otonav``'s
+world and run records are written when the recording starts; the verdict's record at
+the end is lost with the end of the file)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from mcap.reader import NonSeekingReader
+from mcap.records import Channel, Metadata, Schema
 from mcap.writer import CompressionType, Writer
 
-from otonav.record.reader import CUT_OFF_ERRORS, RecordingError, _check_file
+from otonav.record.reader import CUT_OFF_ERRORS, RecordingError, _check_file, iter_readable
 from otonav.record.writer import CHUNK_SIZE
 
 
-def salvage(source: str | Path, target: str | Path) -> int:
-    """Copy what can be read of ``source`` into ``target``; returns the message count."""
+def salvage(source: str | Path, target: str | Path, *, overwrite: bool = False) -> int:
+    """Copy what can be read of ``source`` into ``target``; returns the message count.
+    An existing ``target`` is a :class:`RecordingError` unless ``overwrite``."""
     source, target = Path(source), Path(target)
     _check_file(source)
     if source.resolve() == target.resolve():
         raise RecordingError(f"{target}: salvage writes a new file; choose another path")
-    count = 0
+    if target.is_dir():
+        raise RecordingError(f"{target}: is a directory; name the new .mcap file")
+    if target.exists() and not overwrite:
+        raise RecordingError(f"{target}: already exists; choose another path or pass --force")
     with source.open("rb") as f:
         try:
             header = NonSeekingReader(f).get_header()
         except CUT_OFF_ERRORS as exc:
             raise RecordingError(f"{source}: no readable MCAP header ({exc})") from None
-    with source.open("rb") as f, target.open("wb") as out:
-        reader = NonSeekingReader(f)
+    count = 0
+    with target.open("wb") as out:
         writer = Writer(out, chunk_size=CHUNK_SIZE, compression=CompressionType.ZSTD)
         writer.start(profile=header.profile, library=header.library)
+        schemas: dict[int, Schema] = {}
+        channels: dict[int, Channel] = {}
         schema_ids: dict[int, int] = {}
         channel_ids: dict[int, int] = {}
-        try:
-            for schema, channel, message in reader.iter_messages(log_time_order=False):
-                if channel.id not in channel_ids:
+        for record in iter_readable(source):
+            if isinstance(record, Schema):
+                schemas[record.id] = record
+            elif isinstance(record, Channel):
+                channels[record.id] = record
+            elif isinstance(record, Metadata):
+                writer.add_metadata(record.name, dict(record.metadata))
+            elif record.channel_id in channels:
+                if record.channel_id not in channel_ids:
+                    channel = channels[record.channel_id]
                     schema_id = 0
+                    schema = schemas.get(channel.schema_id)
                     if schema is not None:
                         if schema.id not in schema_ids:
                             schema_ids[schema.id] = writer.register_schema(
@@ -46,14 +62,12 @@ def salvage(source: str | Path, target: str | Path) -> int:
                         channel.topic, channel.message_encoding, schema_id, dict(channel.metadata)
                     )
                 writer.add_message(
-                    channel_ids[channel.id],
-                    log_time=message.log_time,
-                    data=message.data,
-                    publish_time=message.publish_time,
-                    sequence=message.sequence,
+                    channel_ids[record.channel_id],
+                    log_time=record.log_time,
+                    data=record.data,
+                    publish_time=record.publish_time,
+                    sequence=record.sequence,
                 )
                 count += 1
-        except CUT_OFF_ERRORS:
-            pass  # the cut-off point
         writer.finish()  # type: ignore[no-untyped-call]
     return count

@@ -83,7 +83,7 @@ class Funnel:
             return
         tap = _Tap(self, topic, Endpoint(self._owner, topic.name))
         self.taps[topic.name] = tap
-        topic.subscriptions.append(tap)
+        topic.add_subscription(tap)
         # A transient-local publisher may already hold history: record it too.
         for publisher in topic.publishers:
             for message in publisher._history or ():

@@ -248,6 +248,13 @@ class Topic(Generic[M]):
         self.publishers: list[Publisher[M]] = []
         self.subscriptions: list[Subscription[M]] = []
 
+    def add_subscription(self, subscription: Subscription[M]) -> None:
+        """Join the topic. The list is replaced, never changed in place: a publisher
+        blocked mid-delivery keeps iterating the list it started with, so a joiner
+        that already got the message from transient-local history is not offered it a
+        second time when that publisher resumes."""
+        self.subscriptions = [*self.subscriptions, subscription]
+
 
 class Bus:
     """All topics of a system. Wiring checks types and QoS here, once."""
@@ -320,7 +327,7 @@ class Bus:
             kept = [m for p in topic.publishers for m in (p._history or ())]
             for message in kept[-qos.depth :]:
                 subscription._offer(message)
-        topic.subscriptions.append(subscription)
+        topic.add_subscription(subscription)
         return subscription
 
 

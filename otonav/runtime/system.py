@@ -70,6 +70,8 @@ class _ActorState:
     crash_times: list[float] = field(default_factory=list)
     status: str = "created"
     scope: anyio.CancelScope | None = None
+    stop_requested: bool = False
+    done: anyio.Event | None = None  # set when its supervisor has returned
 
 
 class System:
@@ -92,6 +94,8 @@ class System:
         self._all_done: anyio.Event | None = None
         self._failure: ActorCrashedError | None = None
         self._tg: TaskGroup | None = None
+        self._stop_started = False
+        self._stopped: anyio.Event | None = None
         self._clock_token: contextvars.Token[Clock] | None = None
         for actor in actors:
             if actor.name in self._states:
@@ -190,9 +194,12 @@ class System:
     async def _supervise(self, state: _ActorState) -> None:
         state.scope = anyio.CancelScope()
         try:
-            with state.scope:
-                await self._supervise_in_scope(state)
+            if not state.stop_requested:  # stopped before it ever started: nothing to do
+                with state.scope:
+                    await self._supervise_in_scope(state)
         finally:
+            assert state.done is not None
+            state.done.set()
             self._running -= 1
             if not self._running and self._all_done is not None:
                 self._all_done.set()
@@ -201,7 +208,7 @@ class System:
         actor = state.actor
         started = False
         try:
-            while True:
+            while not state.stop_requested:
                 try:
                     await actor.on_start()
                     started = True
@@ -256,6 +263,11 @@ class System:
         self._clock_token = set_current_clock(self.clock)
         self._give_clocks()
         self._all_done = anyio.Event()
+        self._stopped = anyio.Event()
+        self._stop_started = False
+        for state in self._states.values():
+            state.done = anyio.Event()
+            state.stop_requested = False
         self._running = len(self._states)
         if not self._running:
             self._all_done.set()
@@ -272,7 +284,12 @@ class System:
         tb: TracebackType | None,
     ) -> bool:
         assert self._tg is not None
-        self.stop()
+        assert self._stopped is not None
+        self._stop_started = True
+        if not self._stopped.is_set():
+            # Here, not in a task: a task started in a cancelled group may never run.
+            # (If a crash already started the stopper, both wait on the same events.)
+            await self._stop_in_order()
         try:
             suppressed = await self._tg.__aexit__(exc_type, exc, tb)
         except BaseExceptionGroup as group:
@@ -296,23 +313,44 @@ class System:
     def stop(self) -> None:
         """Stop every actor (each ``on_stop`` runs); ``run()`` then returns.
 
-        Actors are cancelled one by one in reverse start order, like a launch file
-        shutting down, and only then the task group: anyio cancels a group's tasks in
-        set order (memory addresses), which made two identical runs log their stops
-        in different orders.
+        Actors stop one after another in reverse start order, like a launch file
+        shutting down: each is cancelled only once the one after it has finished its
+        ``on_stop``, so the first actor (the recorder) stops last and sees everything the
+        others published while stopping. Only then is the task group (and the body of
+        the ``async with``) cancelled. (anyio cancels a group's tasks in set order,
+        memory addresses, which made two identical runs log their stops in different
+        orders; cancelling all scopes at once let a recorder drain before the others'
+        last messages.)
         """
-        if self._tg is None:
+        if self._tg is None or self._stop_started:
             return
-        for state in reversed(self._states.values()):
-            if state.scope is not None:
-                state.scope.cancel()
-        self._tg.cancel_scope.cancel()
+        self._stop_started = True
+        self._tg.start_soon(self._stop_in_order, name="otonav-stop")
+
+    async def _stop_in_order(self) -> None:
+        with anyio.CancelScope(shield=True):
+            for state in reversed(self._states.values()):
+                state.stop_requested = True
+                if state.scope is not None:
+                    state.scope.cancel()
+                assert state.done is not None
+                await state.done.wait()
+        assert self._stopped is not None
+        self._stopped.set()
+        if self._tg is not None:
+            self._tg.cancel_scope.cancel()
+
+    async def wait_finished(self) -> None:
+        """Inside ``async with system``: wait until every actor's ``run`` returned or
+        the system was stopped (:meth:`stop`, a crash)."""
+        if self._all_done is None:
+            raise RuntimeError("wait_finished() is for a running system (async with system)")
+        await self._all_done.wait()
 
     async def run(self) -> None:
         """Run until every actor's ``run`` returned, :meth:`stop` is called, or a crash."""
         async with self:
-            assert self._all_done is not None
-            await self._all_done.wait()
+            await self.wait_finished()
 
 
 def _reset_clock(token: contextvars.Token[Clock] | None) -> None:

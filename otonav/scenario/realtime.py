@@ -13,24 +13,23 @@ from pathlib import Path
 
 import anyio
 
-from otonav.actors.recorder import Recorder
-from otonav.hal import RobotHardwareInterface
 from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
-from otonav.record.writer import RecordingWriter
-from otonav.runtime import Actor, RealTimeClock
+from otonav.runtime import RealTimeClock
 from otonav.runtime.timesource import tick_rate
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
 from otonav.scenario.run import (
     Verdict,
-    drive_to_goal,
+    drive,
     judge_verdict,
     run_task,
     save_artifacts,
+    scenario_session,
     scenario_world,
 )
 from otonav.stack import StackConfig
+from otonav.stack.session import RealTime, StackSession
 
 __all__ = ["VIEWER_HZ", "run_scenario_realtime"]
 
@@ -56,21 +55,19 @@ async def _show(
 
 async def _main(
     scenario: ScenarioConfig,
-    stack: StackConfig,
-    hal: RobotHardwareInterface,
+    session: StackSession,
     judge: Judge,
-    before: tuple[Actor, ...],
-    scale: float,
     viewer: ViewerHandle | None,
     closed_at: list[float],
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None,
 ) -> None:
     with run_task(on_start):
-        clock = RealTimeClock(hal, scale=scale, max_step_batch=MAX_STEP_BATCH)
+        clock = session.realtime_clock
+        assert clock is not None
         async with anyio.create_task_group() as tg:
             if viewer is not None:
                 tg.start_soon(_show, viewer, clock, closed_at, tg.cancel_scope)
-            await drive_to_goal(scenario, stack, hal, judge, before=before, clock=clock)
+            await drive(session, scenario, judge)
             tg.cancel_scope.cancel()
 
 
@@ -100,29 +97,31 @@ def run_scenario_realtime(
     if gui:
         check_display()
     stack, hal = scenario_world(scenario, stack)
+    judge = Judge(hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance)
+    session = scenario_session(
+        scenario,
+        stack,
+        hal,
+        judge,
+        realtime=RealTime(scale, MAX_STEP_BATCH),
+        recording=out_dir / "recording.mcap" if out_dir and record else None,
+    )
     viewer: ViewerHandle | None = None
-    try:
-        if gui:
+    if gui:
+        try:
             if not isinstance(hal, MujocoInterface):
                 raise TypeError(f"gui=True needs the MuJoCo world, got {type(hal).__name__}")
             viewer = hal.open_viewer()
-        judge = Judge(hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance)
-        writer = RecordingWriter(out_dir / "recording.mcap") if out_dir and record else None
-    except BaseException:
-        if viewer is not None:
-            viewer.close()
-        hal.close()
-        raise
-    recorder = Recorder(writer) if writer else None
+        except BaseException:
+            session.close()
+            raise
+        session.add_cleanup(viewer.close)  # after the recording, before the world
     closed_at: list[float] = []
     wall_start = time.perf_counter()
     ended = "completed"
     try:
-        before = (recorder,) if recorder else ()
         with asyncio.Runner() as runner:
-            runner.run(
-                _main(scenario, stack, hal, judge, before, scale, viewer, closed_at, on_start)
-            )
+            runner.run(_main(scenario, session, judge, viewer, closed_at, on_start))
     except BaseException as exc:
         sim = hal.ticks / tick_rate(hal.tick)
         ended = f"{type(exc).__name__} at sim time {sim:.3f} s: {exc}".strip().rstrip(":")
@@ -143,12 +142,7 @@ def run_scenario_realtime(
                         f"({judge.distance:.3f} m from the goal)"
                     ),
                 )
-            # Finish the recording and draw the plot before the viewer and world go.
-            verdict = save_artifacts(
-                verdict, scenario, stack, judge, writer, recorder, out_dir, plot
-            )
+            verdict = save_artifacts(verdict, scenario, stack, judge, session, out_dir, plot)
         finally:
-            if viewer is not None:
-                viewer.close()
-            hal.close()
+            session.close()  # idempotent: the viewer, then the world, on every path
     return verdict

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +16,7 @@ from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.plot import plot_trajectory
 from otonav.scenario.run import effective_stack
 from otonav.stack import StackConfig, build_world
+from otonav.stack.worldmeta import WORLD_METADATA, boxes_from_metadata
 
 
 def recorded_path(recording: Path) -> list[tuple[float, float, float]]:
@@ -31,37 +33,84 @@ def recorded_verdict(recording: Path) -> dict[str, Any] | None:
     return json.loads(meta["verdict"]) if "verdict" in meta else None
 
 
-def plot_recording(recording: Path, png: Path | None = None) -> Path:
-    """Draw the recorded path (odometry), the goal and the extra obstacles of the
-    recorded scenario into ``png`` (default: next to the recording)."""
-    meta = summarize(recording).metadata.get("otonav", {})
+def recorded_goal(recording: Path) -> tuple[float, float] | None:
+    """The last goal published on /goal, (x, y) in the world frame; None if none was."""
+    goal = None
+    for _topic, _t, m in read_messages(recording, [topics.GOAL]):
+        goal = (m.pose.position.x, m.pose.position.y)
+    return goal
+
+
+@dataclass(frozen=True, slots=True)
+class RecordedPlot:
+    """What a recording alone says about its run, as the plot draws it."""
+
+    trajectory: list[tuple[float, float, float]]
+    obstacles: tuple[BoxObstacle, ...] | None
+    """None: the recording does not say where they are."""
+    goal: tuple[float, float] | None
+    tolerance: float | None
+    title: str
+    truncated: bool
+
+
+def recorded_plot(recording: Path) -> RecordedPlot:
+    """The path from /odom, the goal from /goal (or the scenario's), the obstacles and
+    walls from the recording's ``otonav.world`` record (or, for older recordings, the
+    world rebuilt from its scenario). A cut-off file gives what its complete chunks hold."""
+    summary = summarize(recording)
+    meta = summary.metadata.get("otonav", {})
     scenario = (
         ScenarioConfig.model_validate_json(meta["scenario_config"])
         if "scenario_config" in meta
         else None
     )
-    obstacles: tuple[BoxObstacle, ...] = ()
-    goal = (0.0, 0.0)
-    tolerance = 0.15
-    if scenario is not None:
-        goal, tolerance = (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance
-        extra = [b.to_obstacle() for b in scenario.obstacles]
-        try:
-            world = build_world(effective_stack(scenario, StackConfig()), extra_obstacles=extra)
-        except (SceneError, OSError):  # the scene file moved: draw what the file says
-            obstacles = tuple(extra)
-        else:
-            obstacles = world.obstacles() + world.walls()
-            world.close()
+    goal = recorded_goal(recording)
+    if goal is None and scenario is not None:
+        goal = (scenario.goal.x, scenario.goal.y)
+    obstacles: tuple[BoxObstacle, ...] | None = None
+    if WORLD_METADATA in summary.metadata:
+        obstacles = boxes_from_metadata(summary.metadata[WORLD_METADATA])
+    elif scenario is not None:
+        obstacles = _rebuilt_world(scenario)
+    title = f"{recording.name} (odometry)"
+    if summary.truncated:
+        title += ", cut off: complete chunks only"
+    return RecordedPlot(
+        recorded_path(recording),
+        obstacles,
+        goal,
+        scenario.goal_tolerance if scenario is not None else None,
+        title,
+        summary.truncated,
+    )
+
+
+def _rebuilt_world(scenario: ScenarioConfig) -> tuple[BoxObstacle, ...]:
+    extra = [b.to_obstacle() for b in scenario.obstacles]
+    try:
+        world = build_world(effective_stack(scenario, StackConfig()), extra_obstacles=extra)
+    except (SceneError, OSError):  # the scene file moved: draw what the scenario says
+        return tuple(extra)
+    try:
+        return world.obstacles() + world.walls()
+    finally:
+        world.close()
+
+
+def plot_recording(recording: Path, png: Path | None = None) -> Path:
+    """Draw :func:`recorded_plot` into ``png`` (default: next to the recording)."""
+    plot = recorded_plot(recording)
     target = png or recording.with_suffix(".png")
     if target.suffix.lower() != ".png":  # matplotlib would append it: say the real name
         target = target.with_name(target.name + ".png")
     return plot_trajectory(
         target,
-        recorded_path(recording),
-        obstacles,
-        goal,
-        tolerance,
+        plot.trajectory,
+        plot.obstacles,
+        plot.goal,
+        plot.tolerance,
         None,
-        f"{recording.name} (odometry)",
+        plot.title,
+        path_label="path (odometry)",
     )

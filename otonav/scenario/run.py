@@ -17,7 +17,6 @@ from pathlib import Path
 from typing import Any
 
 from otonav.actors import topics
-from otonav.actors.recorder import Recorder
 from otonav.hal import RobotHardwareInterface
 from otonav.msgs import Header, Point, Pose, PoseStamped, ScenarioVerdict, Time
 from otonav.record.writer import RecordingWriter
@@ -25,6 +24,7 @@ from otonav.runtime import (
     LATCHED_QOS,
     Actor,
     Clock,
+    RealTimeClock,
     SimTimeoutError,
     System,
     until,
@@ -35,9 +35,10 @@ from otonav.scenario.judge import Judge
 from otonav.scenario.plot import plot_trajectory
 from otonav.scenario.validate import check_goal
 from otonav.stack import StackConfig, build_actors, build_world
-from otonav.stack.rosout import attach_rosout
+from otonav.stack.session import RealTime, StackSession
 
 VERDICT_TOPIC = "/scenario/verdict"
+RUN_METADATA = "otonav"
 
 
 @dataclass(frozen=True, slots=True)
@@ -123,14 +124,48 @@ async def drive_to_goal(
     before: tuple[Actor, ...] = (),
     clock: Clock | None = None,
 ) -> System:
-    """Bring the stack up on ``hal`` (after the ``before`` actors, e.g. a recorder),
-    publish the goal on /goal, and wait in sim time until the judge says the robot is
-    there or the budget is spent. Returns the stopped system. ``clock``: a
-    :class:`RealTimeClock` for real-time mode (default: the virtual loop's time)."""
+    """Bring the stack up on ``hal`` (after the ``before`` actors), publish the goal on
+    /goal, and wait in sim time until the judge's arrival check settles or the budget
+    is spent. Returns the stopped system; ``hal`` stays open (the caller's). ``clock``:
+    a :class:`RealTimeClock` for real-time mode (default: the virtual loop's time).
+    The runners use :class:`~otonav.stack.session.StackSession` directly."""
+    if clock is not None and not isinstance(clock, RealTimeClock):
+        raise TypeError(f"drive_to_goal: clock must be a RealTimeClock, got {type(clock)}")
     actors = build_actors(stack, hal, initial_pose=scenario.start.as_tuple())
-    system = System([*before, *actors, judge], clock=clock)
-    attach_rosout(system)
-    async with system:
+    session = StackSession(hal, [*before, *actors, judge], realtime=clock)
+    await drive(session, scenario, judge)
+    return session.system
+
+
+def scenario_session(
+    scenario: ScenarioConfig,
+    stack: StackConfig,
+    hal: RobotHardwareInterface,
+    judge: Judge,
+    *,
+    extra_actors: tuple[Actor, ...] = (),
+    realtime: RealTime | None = None,
+    recording: Path | None = None,
+) -> StackSession:
+    """The session of a scenario run: the recorder (with ``recording``), the extra
+    actors, the robot stack starting at the scenario's start pose, and the judge."""
+    try:
+        robot = build_actors(stack, hal, initial_pose=scenario.start.as_tuple())
+    except BaseException:
+        hal.close()
+        raise
+    session = StackSession(
+        hal, [*extra_actors, *robot, judge], realtime=realtime, record_to=recording
+    )
+    if session.writer is not None:
+        session.writer.add_metadata(RUN_METADATA, run_metadata(scenario, stack))
+    return session
+
+
+async def drive(session: StackSession, scenario: ScenarioConfig, judge: Judge) -> None:
+    """Run ``session`` (not closing it): publish the goal on /goal, then wait in sim time
+    until the judge is done or the budget is spent (a verdict, not an error)."""
+    async with session.running(close=False) as system:
         goal = system.publisher(topics.GOAL, PoseStamped, LATCHED_QOS, name="scenario")
         await goal.publish(
             PoseStamped(
@@ -148,19 +183,16 @@ async def drive_to_goal(
                 observe=lambda: f"{judge.distance:.3f} m from the goal",
                 what=f"reaching the goal within {scenario.goal_tolerance} m",
             )
-    return system
 
 
 async def _main(
     scenario: ScenarioConfig,
-    stack: StackConfig,
-    hal: RobotHardwareInterface,
+    session: StackSession,
     judge: Judge,
-    before: tuple[Actor, ...],
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None,
 ) -> None:
     with run_task(on_start):
-        await drive_to_goal(scenario, stack, hal, judge, before=before)
+        await drive(session, scenario, judge)
 
 
 @contextlib.contextmanager
@@ -206,24 +238,26 @@ def run_scenario(
     thread cancels the run with ``loop.call_soon_threadsafe(task.cancel)``. A goal
     outside the arena or on an obstacle raises ``ConfigFileError`` naming ``source``."""
     stack, hal = scenario_world(scenario, stack, source=source)
-    try:
-        writer = RecordingWriter(out_dir / "recording.mcap") if out_dir and record else None
-    except BaseException:
-        hal.close()
-        raise
     judge = Judge(
         hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance, progress=progress
     )
-    recorder = Recorder(writer) if writer else None
+    session = scenario_session(
+        scenario,
+        stack,
+        hal,
+        judge,
+        extra_actors=tuple(extra_actors),
+        recording=out_dir / "recording.mcap" if out_dir and record else None,
+    )
     wall_start = time.perf_counter()
     sim_time = 0.0
     ended = "completed"
     try:
-        factory = virtual_loop_factory(hal, wall_ceiling=wall_ceiling)
+        # The session makes the world the loop's time source when the run starts.
+        factory = virtual_loop_factory(wall_ceiling=wall_ceiling)
         with asyncio.Runner(loop_factory=factory) as runner:
             try:
-                before = ((recorder,) if recorder else ()) + tuple(extra_actors)
-                runner.run(_main(scenario, stack, hal, judge, before, on_start))
+                runner.run(_main(scenario, session, judge, on_start))
             finally:
                 sim_time = runner.get_loop().time()
     except BaseException as exc:
@@ -234,13 +268,9 @@ def run_scenario(
             verdict = judge_verdict(scenario, judge, sim_time, time.perf_counter() - wall_start)
             if ended != "completed":
                 verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
-            verdict = save_artifacts(
-                verdict, scenario, stack, judge, writer, recorder, out_dir, plot
-            )
+            verdict = save_artifacts(verdict, scenario, stack, judge, session, out_dir, plot)
         finally:
-            if writer is not None:
-                writer.finish()  # idempotent: reached even if the verdict or plot failed
-            hal.close()
+            session.close()  # idempotent: reached even if the verdict or plot failed
     return verdict
 
 
@@ -249,16 +279,15 @@ def save_artifacts(
     scenario: ScenarioConfig,
     stack: StackConfig,
     judge: Judge,
-    writer: RecordingWriter | None,
-    recorder: Recorder | None,
+    session: StackSession,
     out_dir: Path | None,
     plot: bool,
 ) -> Verdict:
-    """Finish the recording (with the verdict appended) and draw the trajectory; the
-    verdict names both files."""
-    if writer is not None:
-        _close_recording(writer, recorder, scenario, stack, verdict)
-        verdict = replace(verdict, recording=str(writer.path))
+    """Tear ``session`` down with the verdict appended to its recording, and draw the
+    trajectory; the verdict names both files."""
+    session.close(epilogue=lambda writer: _append_verdict(writer, scenario, stack, verdict))
+    if session.writer is not None:
+        verdict = replace(verdict, recording=str(session.writer.path))
     if out_dir is not None and plot:
         png = plot_trajectory(
             out_dir / "trajectory.png",
@@ -273,53 +302,53 @@ def save_artifacts(
     return verdict
 
 
-def _close_recording(
-    writer: RecordingWriter,
-    recorder: Recorder | None,
-    scenario: ScenarioConfig,
-    stack: StackConfig,
-    verdict: Verdict,
+def _append_verdict(
+    writer: RecordingWriter, scenario: ScenarioConfig, stack: StackConfig, verdict: Verdict
 ) -> None:
-    """Append the verdict (a message and a metadata record) and finish the file."""
-    try:
-        if recorder is not None and recorder._funnel is not None:
-            recorder.drain()
-        writer.write(
-            VERDICT_TOPIC,
-            ScenarioVerdict(
-                header=Header(stamp=Time.from_seconds(verdict.sim_time_s)),
-                scenario=verdict.scenario,
-                passed=verdict.passed,
-                reached=verdict.reached,
-                reason=verdict.reason,
-                time_to_goal=verdict.time_to_goal_s if verdict.time_to_goal_s is not None else -1.0,
-                min_clearance=verdict.min_clearance_m,
-                final_distance=verdict.final_distance_m,
-                path_length=verdict.path_length_m,
-                sim_time=verdict.sim_time_s,
-                nav_state=verdict.nav_state,
-                nav_reason=verdict.nav_reason,
-            ),
-            verdict.sim_time_s,
-        )
-        figures = {
-            k: v
-            for k, v in verdict.as_dict().items()
-            if k not in ("wall_time_s", "rtf", "recording", "plot")
-        }
-        writer.add_metadata(
-            "otonav",
-            {
-                "scenario": scenario.name,
-                "seed": str(scenario.seed),
-                "otonav_version": otonav_version(),
-                "scenario_config": scenario.model_dump_json(),
-                "stack_config": stack.model_dump_json(),
-                "verdict": json.dumps(finite_figures(figures), sort_keys=True, default=str),
-            },
-        )
-    finally:
-        writer.finish()
+    """The verdict as a message and a metadata record (the session finishes the file)."""
+    writer.write(
+        VERDICT_TOPIC,
+        ScenarioVerdict(
+            header=Header(stamp=Time.from_seconds(verdict.sim_time_s)),
+            scenario=verdict.scenario,
+            passed=verdict.passed,
+            reached=verdict.reached,
+            reason=verdict.reason,
+            time_to_goal=verdict.time_to_goal_s if verdict.time_to_goal_s is not None else -1.0,
+            min_clearance=verdict.min_clearance_m,
+            final_distance=verdict.final_distance_m,
+            path_length=verdict.path_length_m,
+            sim_time=verdict.sim_time_s,
+            nav_state=verdict.nav_state,
+            nav_reason=verdict.nav_reason,
+        ),
+        verdict.sim_time_s,
+    )
+    figures = {
+        k: v
+        for k, v in verdict.as_dict().items()
+        if k not in ("wall_time_s", "rtf", "recording", "plot")
+    }
+    writer.add_metadata(
+        RUN_METADATA,
+        {
+            **run_metadata(scenario, stack),
+            "verdict": json.dumps(finite_figures(figures), sort_keys=True, default=str),
+        },
+    )
+
+
+def run_metadata(scenario: ScenarioConfig, stack: StackConfig) -> dict[str, str]:
+    """The ``otonav`` metadata record of a scenario run, without its verdict. Written
+    when the recording opens (a cut-off file keeps it) and again, with the verdict, at
+    the end; readers take the last."""
+    return {
+        "scenario": scenario.name,
+        "seed": str(scenario.seed),
+        "otonav_version": otonav_version(),
+        "scenario_config": scenario.model_dump_json(),
+        "stack_config": stack.model_dump_json(),
+    }
 
 
 def judge_verdict(scenario: ScenarioConfig, judge: Judge, sim_time: float, wall: float) -> Verdict:

@@ -1,7 +1,8 @@
-"""Composition: the robot stack from its config (the launch file).
+"""Composition: the robot stack from its config (the launch file), and the session
+that runs it (time mode, recording, one teardown: ``otonav.stack.session``).
 
-The config models are imported here; ``build_actors`` and ``build_world`` (the actors,
-MuJoCo, numpy) on first use, so reading a config file stays cheap (``otonav --help``).
+The config models are imported here; ``build_actors``, ``build_world`` and the session
+(the actors, MuJoCo, numpy) on first use, so reading a config file stays cheap (``otonav --help``).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from otonav.stack.config import (
 
 if TYPE_CHECKING:
     from otonav.stack.build import build_actors, build_world
+    from otonav.stack.session import RealTime, StackSession
 
 __all__ = (
     "BaseConfig",
@@ -29,14 +31,21 @@ __all__ = (
     "GuardConfig",
     "NavConfig",
     "RatesConfig",
+    "RealTime",
     "SafetyConfig",
     "StackConfig",
+    "StackSession",
     "WorldConfig",
     "build_actors",
     "build_world",
 )
 
-_LAZY = {"build_actors": "otonav.stack.build", "build_world": "otonav.stack.build"}
+_LAZY = {
+    "build_actors": "otonav.stack.build",
+    "build_world": "otonav.stack.build",
+    "RealTime": "otonav.stack.session",
+    "StackSession": "otonav.stack.session",
+}
 
 
 def __getattr__(name: str) -> object:

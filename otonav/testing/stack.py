@@ -2,19 +2,16 @@
 
 from __future__ import annotations
 
-import asyncio
 from collections.abc import AsyncIterator, Sequence
 from contextlib import asynccontextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from otonav.actors.recorder import Recorder
 from otonav.hal import BoxObstacle, RobotHardwareInterface
 from otonav.hal.mujoco import Variant
-from otonav.record.writer import RecordingWriter
-from otonav.runtime import Actor, RealTimeClock, System, VirtualTimeLoop
+from otonav.runtime import Actor, System
 from otonav.stack import StackConfig, build_actors, build_world
-from otonav.stack.rosout import attach_rosout
+from otonav.stack.session import RealTime, StackSession
 
 
 @dataclass(slots=True)
@@ -42,28 +39,20 @@ async def running_stack(
     source: sim time is loop time. With ``realtime_scale`` set, the stack runs on the
     current (stock) loop, the world paced to the wall clock times that scale. With
     ``record_to`` every topic is recorded to that MCAP file, finished on every exit.
+    On exit the stack is torn down as every runner's is (:mod:`otonav.stack.session`):
+    the loop gets its previous time source back, so the test can go on sleeping.
     """
     hal = build_world(config, extra_obstacles=extra_obstacles, variant=variant)
-    writer = RecordingWriter(record_to) if record_to is not None else None
     try:
-        loop = asyncio.get_running_loop()
-        actors: list[Actor] = [Recorder(writer)] if writer is not None else []
-        actors += [*build_actors(config, hal, navigator=navigator), *extra_actors]
-        if realtime_scale is not None:
-            clock = RealTimeClock(hal, scale=realtime_scale, max_step_batch=0.05)
-            system = System(actors, clock=clock)
-        elif isinstance(loop, VirtualTimeLoop):
-            loop.attach_source(hal)
-            system = System(actors)
-        else:
-            raise RuntimeError(
-                "running_stack needs a VirtualTimeLoop (mark the test @pytest.mark.sim) "
-                "or realtime_scale= for real-time mode on this loop"
-            )
-        attach_rosout(system)
-        async with system:
-            yield RunningStack(system, hal)
-    finally:
-        if writer is not None:
-            writer.finish()
+        actors = [*build_actors(config, hal, navigator=navigator), *extra_actors]
+    except BaseException:
         hal.close()
+        raise
+    session = StackSession(
+        hal,
+        actors,
+        realtime=RealTime(realtime_scale) if realtime_scale is not None else None,
+        record_to=record_to,
+    )
+    async with session.running() as system:
+        yield RunningStack(system, hal)

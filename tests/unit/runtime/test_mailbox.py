@@ -267,3 +267,40 @@ def test_a_publisher_cancelled_after_being_given_room_hands_it_on() -> None:
         assert sub.try_recv() == Ping(2)
 
     _run(main)
+
+
+@pytest.mark.parametrize("late", ["subscription", "funnel tap"])
+def test_a_late_transient_local_joiner_mid_delivery_gets_the_message_once(late: str) -> None:
+    """A publisher blocked mid-delivery (a full reliable mailbox) has already kept the
+    message in its history; a transient-local subscriber (or a recorder's tap) joining
+    now gets it from the history and must not get it again when the publisher resumes.
+    (It did: the joiner was appended to the very list the publisher was iterating.)"""
+    from otonav.runtime.funnel import Funnel
+
+    bus = Bus()
+    kept = QoS(depth=5, durability=Durability.TRANSIENT_LOCAL)
+    pub = bus.publisher("/goal", Ping, kept, endpoint=Endpoint("a", "o"))
+    stuck = bus.subscribe("/goal", Ping, QoS(depth=1), endpoint=Endpoint("stuck", "i"))
+
+    async def main() -> None:
+        await pub.publish(Ping(0))  # 'stuck' is full now
+        async with anyio.create_task_group() as tg:
+            tg.start_soon(pub.publish, Ping(1))  # kept in history, then blocks on 'stuck'
+            await anyio.sleep(0.1)
+            if late == "subscription":
+                joiner = bus.subscribe("/goal", Ping, kept, endpoint=Endpoint("late", "i"))
+            else:
+                funnel = Funnel(Bus(), "recorder", lambda: 0.0)
+                funnel._tap(bus.topics["/goal"])
+            assert stuck.try_recv() == Ping(0)  # room: the publisher resumes
+        if late == "subscription":
+            got = []
+            while (message := joiner.try_recv()) is not None:
+                got.append(message)
+        else:
+            got = []
+            while (delivery := funnel.try_recv()) is not None:
+                got.append(delivery.message)
+        assert got == [Ping(0), Ping(1)]
+
+    _run(main)

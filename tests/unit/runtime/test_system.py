@@ -233,3 +233,56 @@ def test_real_time_mode_runs_the_same_actors_on_a_stock_loop() -> None:
 
     anyio.run(main)
     assert counter.stopped
+
+
+class _Slow(Actor):
+    """An actor whose on_stop takes sim time (it publishes a last message, say)."""
+
+    def __init__(self, name: str, log: list[tuple[str, str, float]], stop_takes: float) -> None:
+        super().__init__(name)
+        self.log = log
+        self.stop_takes = stop_takes
+
+    async def run(self) -> None:
+        await anyio.sleep_forever()
+
+    async def on_stop(self) -> None:
+        self.log.append((self.name, "on_stop begins", self.clock.now()))
+        await self.clock.sleep(self.stop_takes)
+        self.log.append((self.name, "on_stop ends", self.clock.now()))
+
+
+@pytest.mark.parametrize("how", ["exit", "crash"])
+def test_actors_stop_one_after_another_in_reverse_start_order(how: str) -> None:
+    """ADR 0007: the first actor (the recorder) stops last, after every later actor's
+    on_stop has finished, whatever those take (they used to be cancelled together, so a
+    recorder listed first drained before the others' last messages)."""
+    log: list[tuple[str, str, float]] = []
+    first = _Slow("first", log, 0.0)
+    second = _Slow("second", log, 0.5)
+    third = _Slow("third", log, 0.25)
+    actors: list[Actor] = [first, second, third]
+    if how == "crash":
+        actors.append(Counter(hz=10.0))
+        actors.append(Crasher(at=3))  # crashes at sim time 0.3
+
+    async def main() -> None:
+        async with System(actors):
+            await anyio.sleep(1.0 if how == "exit" else 10.0)
+
+    if how == "crash":
+        with pytest.raises(ActorCrashedError):
+            _run(main)
+    else:
+        _run(main)
+    t0 = 1.0 if how == "exit" else 0.3
+    assert [(name, what) for name, what, _ in log] == [
+        ("third", "on_stop begins"),
+        ("third", "on_stop ends"),
+        ("second", "on_stop begins"),
+        ("second", "on_stop ends"),
+        ("first", "on_stop begins"),
+        ("first", "on_stop ends"),
+    ]
+    expected = [t0, t0 + 0.25, t0 + 0.25, t0 + 0.75, t0 + 0.75, t0 + 0.75]
+    assert [t for *_, t in log] == pytest.approx(expected)

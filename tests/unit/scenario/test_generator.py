@@ -4,6 +4,8 @@ budgets, and properties every generated world must have."""
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 from dataclasses import replace
 from typing import Any
 
@@ -270,3 +272,16 @@ def test_barn_metric_is_clipped_between_an_eighth_and_a_half(optimal: float, fac
 def test_bad_params_name_the_field(field: str, value: Any) -> None:
     with pytest.raises(ValueError, match=f"WorldParams.{field}"):
         replace(SPARSE, **{field: value})
+
+
+def test_the_generator_does_not_load_the_simulator() -> None:
+    # A fresh interpreter: this one has imported everything already.
+    code = (
+        "import sys, otonav.scenario.generator as g; g.generate_world(0); "
+        "print(sorted({m.split('.')[0] for m in sys.modules} & {'mujoco', 'anyio'}))"
+    )
+    child = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=False
+    )
+    assert child.returncode == 0, child.stderr
+    assert child.stdout.strip() == "[]"

@@ -1,0 +1,128 @@
+"""``otonav plot`` and the pytest plugin's kept ``trajectory.png`` draw a recording as it
+is: the goal from /goal, the obstacles the recording says are there, "unknown" where
+it says nothing, odometry called odometry, and a cut-off file drawn from its complete
+chunks. The figure is checked through its artists, not its pixels."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from otonav.cli import main
+from otonav.hal import BoxObstacle
+from otonav.msgs import Header, Odometry, Point, Pose, PoseStamped, PoseWithCovariance, Time
+from otonav.record.writer import RecordingWriter
+from otonav.scenario.plot import draw_trajectory
+from otonav.scenario.replay import plot_recording, recorded_plot
+from otonav.stack.worldmeta import WORLD_METADATA
+
+pytestmark = pytest.mark.unit
+
+GOAL = (2.5, -1.25)
+BOXES = "[[1.0, 0.5, 0.2, 0.3, 0.0], [2.0, -0.5, 0.25, 0.25, 0.4]]"
+WALLS = "[[0.0, 5.1, 5.2, 0.1, 0.0]]"
+
+
+def _odom(x: float, y: float, t: float) -> Odometry:
+    return Odometry(
+        header=Header(stamp=Time.from_seconds(t), frame_id="odom"),
+        pose=PoseWithCovariance(pose=Pose(position=Point(x=x, y=y))),
+    )
+
+
+def _recording(path: Path, *, goal: bool = True, world: bool = False, seconds: float = 2.0) -> Path:
+    """A recording like the pytest plugin's: /goal, then /odom at 100 Hz; no scenario."""
+    with RecordingWriter(path, chunk_size=4096) as writer:
+        if world:
+            writer.add_metadata(WORLD_METADATA, {"obstacles": BOXES, "walls": WALLS})
+        if goal:
+            writer.write("/goal", PoseStamped(pose=Pose(position=Point(x=GOAL[0], y=GOAL[1]))), 0.0)
+        for i in range(round(seconds * 100)):
+            t = i / 100
+            writer.write("/odom", _odom(t, -t / 2, t), t)
+    return path
+
+
+def _legend(fig: object) -> list[str]:
+    (ax,) = fig.axes  # type: ignore[attr-defined]
+    return [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+def _notes(fig: object) -> str:
+    (ax,) = fig.axes  # type: ignore[attr-defined]
+    return " ".join(t.get_text() for t in ax.texts)
+
+
+def _figure(recording: Path) -> object:
+    p = recorded_plot(recording)
+    return draw_trajectory(
+        p.trajectory, p.obstacles, p.goal, p.tolerance, None, p.title, path_label="path (odometry)"
+    )
+
+
+def test_the_goal_comes_from_the_goal_topic(tmp_path: Path) -> None:
+    plot = recorded_plot(_recording(tmp_path / "r.mcap"))
+    assert plot.goal == GOAL
+    assert len(plot.trajectory) == 200
+
+
+def test_no_goal_and_no_world_are_said_not_drawn_at_the_origin(tmp_path: Path) -> None:
+    recording = _recording(tmp_path / "r.mcap", goal=False)
+    plot = recorded_plot(recording)
+    assert plot.goal is None
+    assert plot.obstacles is None
+    fig = _figure(recording)
+    assert "goal" not in _legend(fig)
+    assert "goal unknown" in _notes(fig)
+    assert "obstacles unknown" in _notes(fig)
+
+
+def test_the_legend_says_odometry_like_the_title(tmp_path: Path) -> None:
+    recording = _recording(tmp_path / "r.mcap")
+    fig = _figure(recording)
+    assert "path (odometry)" in _legend(fig)
+    assert not any("ground truth" in label for label in _legend(fig))
+    assert "(odometry)" in recorded_plot(recording).title
+
+
+def test_obstacles_and_walls_are_drawn_where_the_recording_says(tmp_path: Path) -> None:
+    recording = _recording(tmp_path / "r.mcap", world=True)
+    plot = recorded_plot(recording)
+    assert plot.obstacles == (
+        BoxObstacle(1.0, 0.5, 0.2, 0.3, 0.0),
+        BoxObstacle(2.0, -0.5, 0.25, 0.25, 0.4),
+        BoxObstacle(0.0, 5.1, 5.2, 0.1, 0.0),
+    )
+    fig = _figure(recording)
+    (ax,) = fig.axes  # type: ignore[attr-defined]
+    assert sum(type(p).__name__ == "Polygon" for p in ax.patches) == 3
+    assert "unknown" not in _notes(fig)
+
+
+def test_plot_of_a_cut_off_recording_draws_the_complete_chunks_with_a_warning(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    whole = _recording(tmp_path / "whole.mcap", world=True, seconds=10.0)
+    cut = tmp_path / "cut.mcap"
+    data = whole.read_bytes()
+    cut.write_bytes(data[: len(data) * 2 // 3])  # a SIGKILL mid-run: no footer, no index
+    png = tmp_path / "cut.png"
+    assert main(["plot", str(cut), "--out", str(png)]) == 0
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert err.startswith(f"otonav: warning: {cut} was cut off"), err
+    assert png.stat().st_size > 10_000
+    plot = recorded_plot(cut)
+    assert plot.truncated
+    assert "cut off" in plot.title
+    assert plot.goal == GOAL
+    assert plot.obstacles is not None
+    assert len(plot.obstacles) == 3
+    assert 0 < len(plot.trajectory) < 1000
+    assert [t for t, _x, _y in plot.trajectory] == sorted(t for t, _x, _y in plot.trajectory)
+
+
+def test_plot_recording_writes_a_png(tmp_path: Path) -> None:
+    png = plot_recording(_recording(tmp_path / "r.mcap"), tmp_path / "out.png")
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
