@@ -25,6 +25,8 @@ from otonav.nav.navigation import Navigation, NavigationParams, NavOutput
 from otonav.nav.scan import to_frame
 from otonav.runtime import Actor, Input, Output
 
+_AT_REST = frozenset({"idle", "waiting", "reached", "unreachable"})
+
 
 class AvoidingNavigator(Actor):
     """At ``rate_hz``: record each new scan in the map (at the odometry pose of its
@@ -33,7 +35,8 @@ class AvoidingNavigator(Actor):
     sim time, it does not drive (state ``waiting``).
 
     Publishes its command on /cmd_vel (remapped to /cmd_vel_nav behind the safety
-    layer), /nav/state and /nav/diagnostics."""
+    layer) and /nav/state every step, /nav/diagnostics every step while moving (at
+    rest: when the state or reason change)."""
 
     odom = Input(topics.ODOM, Odometry, topics.SENSOR_QOS)
     scan = Input(topics.SCAN, LaserScan, topics.SENSOR_QOS)
@@ -67,6 +70,7 @@ class AvoidingNavigator(Actor):
         self._points = np.empty((0, 2))
         self._points_pose: tuple[float, float, float] | None = None
         self._scan_time = -math.inf
+        self._last_diag: tuple[str, str] | None = None
 
     async def run(self) -> None:
         rate = self.clock.rate(self.rate_hz)
@@ -135,6 +139,12 @@ class AvoidingNavigator(Actor):
                 closest_ahead=closest,
             )
         )
+        # Diagnostics every step while it moves (driving, avoiding, recovering, blocked);
+        # at rest (idle, waiting, reached, unreachable) when the state or reason change.
+        key = (out.state, out.reason)
+        if out.state in _AT_REST and key == self._last_diag:
+            return
+        self._last_diag = key
         await self.diagnostics.publish(
             NavDiagnostics.fast(
                 header=header,
