@@ -16,8 +16,9 @@ from collections.abc import Callable
 
 import anyio
 
+from otonav.runtime.errors import TimeSourceError
 from otonav.runtime.loop import VirtualTimeLoop
-from otonav.runtime.timesource import TimeSource, tick_rate
+from otonav.runtime.timesource import FrozenSource, TimeSource, tick_rate
 
 _current: contextvars.ContextVar[Clock] = contextvars.ContextVar("otonav_clock")
 
@@ -136,6 +137,8 @@ class RealTimeClock(Clock):
         self._ticks = 0
         self._wall0: float | None = None
         self._watchers: list[Callable[[], bool]] = []
+        self._failure_listeners: list[Callable[[BaseException], None]] = []
+        self.failure: BaseException | None = None
         self.max_batch_ticks = (
             max(1, math.floor(max_step_batch * self._rate + 1e-9)) if max_step_batch else None
         )
@@ -152,12 +155,46 @@ class RealTimeClock(Clock):
             self._wall0 = loop.time()
         return loop.time()
 
+    @property
+    def source(self) -> TimeSource:
+        """What is stepped (a :class:`FrozenSource` once the world's advance raised)."""
+        return self._source
+
+    def add_failure_listener(self, listener: Callable[[BaseException], None]) -> None:
+        """Call ``listener(error)`` when the world's ``advance()`` (a
+        :class:`TimeSourceError`) or a watcher raises. A System listens and stops with
+        it; without listeners the error is raised to whoever asked for the time."""
+        self._failure_listeners.append(listener)
+
+    def _failed(self, error: BaseException) -> None:
+        if self.failure is None:
+            self.failure = error
+        if not self._failure_listeners:
+            raise error
+        for listener in tuple(self._failure_listeners):
+            listener(error)
+
     def _advance_to(self, ticks: int) -> None:
         if ticks > self._ticks:
-            self._source.advance(ticks - self._ticks)
+            try:
+                self._source.advance(ticks - self._ticks)
+            except Exception as exc:
+                # Not the actor's fault that asked for the time: freeze the world (time
+                # runs on so the system can stop) and report the world's failure.
+                error = TimeSourceError(self._ticks / self._rate, exc)
+                error.__cause__ = exc
+                self._source = FrozenSource(self._source)
+                self._source.advance(ticks - self._ticks)
+                self._ticks = ticks
+                self._failed(error)
             self._ticks = ticks
             for watcher in tuple(self._watchers):
-                if watcher() and watcher in self._watchers:
+                try:
+                    done = watcher()
+                except Exception as exc:
+                    done = True
+                    self._failed(exc)
+                if done and watcher in self._watchers:
                     self._watchers.remove(watcher)
 
     def _follow_wall(self) -> None:

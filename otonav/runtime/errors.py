@@ -50,6 +50,19 @@ class SimTimeoutError(TimeoutError, OtonavRuntimeError):
         self.last = last
 
 
+class TimeSourceError(OtonavRuntimeError):
+    """The time source (the world) raised while being advanced. The original exception
+    is the ``__cause__``. From then on the world is frozen: sim time runs on without
+    stepping it, so the run can still shut down (every ``on_stop``, the recording)."""
+
+    def __init__(self, sim_time: float, cause: BaseException) -> None:
+        super().__init__(
+            f"the time source's advance() raised at sim time {sim_time:.3f} s: {cause!r}; "
+            "the world is frozen from here and the run was stopped"
+        )
+        self.sim_time = sim_time
+
+
 class DeadlockError(OtonavRuntimeError):
     """The virtual-time loop had nothing that could ever wake it: no timer, no ready
     callback, no I/O, no thread running."""

@@ -4,16 +4,42 @@ A recorder wants every message of every topic in the order it was published, sta
 with the instant it was published. Each topic gets an ordinary-looking subscription (it
 shows in the graph with its counters) whose deliveries go into the funnel's one queue.
 Reliable: when the funnel is full, publishers wait (backpressure); nothing is lost.
+
+The reader (the recorder) drains on its own period, and asks to be woken when the queue
+reaches its high-water mark (half the depth): it then drains in the same instant, so in
+virtual time a publisher never waits while sim time (and the world) runs on. Only a
+burst larger than the room left waits, within its instant; such waits are counted
+(:meth:`Funnel.statistics`) and the first on each topic is logged.
 """
 
 from __future__ import annotations
 
+import logging
 from collections import deque
 from collections.abc import Callable
 from typing import Any, NamedTuple
 
 from otonav.runtime.mailbox import Bus, Endpoint, Subscription, Topic
 from otonav.runtime.qos import QoS, Reliability
+
+log = logging.getLogger("otonav.runtime.funnel")
+
+
+class FunnelStatistics(NamedTuple):
+    """Counters of a funnel."""
+
+    queued: int
+    """Deliveries waiting now."""
+    depth: int
+    """Capacity; a publisher waits when the queue is this long."""
+    high_water: int
+    """Queue length at which the reader is woken."""
+    high_water_wakes: int
+    """Times the reader was woken early by the high-water mark."""
+    blocked_publishes: int
+    """Publishes that found the funnel full and waited for room."""
+    blocked_topics: tuple[str, ...]
+    """Topics of those publishes, sorted."""
 
 
 class Delivery(NamedTuple):
@@ -37,18 +63,21 @@ class _Tap(Subscription[Any]):
 
     def _offer(self, message: Any) -> bool:
         funnel = self._funnel
-        if len(funnel._queue) >= funnel.depth:
+        queue = funnel._queue
+        if len(queue) >= funnel.depth:
             # Full: the publisher waits. Remember when it published, so the message is
             # stamped with that instant, not with the instant room was found.
             if self._blocked_at is None:
                 self._blocked_at = funnel._now()
+                funnel._note_blocked(self.topic, self._blocked_at)
             funnel._blocked.append(self)  # one entry per waiting publisher
+            funnel._wake_reader()
             return False
         stamp, self._blocked_at = self._blocked_at, None
-        funnel._queue.append(
-            Delivery(self.topic, funnel._now() if stamp is None else stamp, message)
-        )
+        queue.append(Delivery(self.topic, funnel._now() if stamp is None else stamp, message))
         self.received += 1
+        if len(queue) >= funnel.high_water and funnel._on_high_water is not None:
+            funnel._wake_reader()
         return True
 
     def _full(self) -> bool:
@@ -66,8 +95,18 @@ class Funnel:
         *,
         wanted: Callable[[str], bool] = lambda _name: True,
         depth: int = 10_000,
+        high_water: int | None = None,
     ) -> None:
+        if depth < 1:
+            raise ValueError(f"funnel depth must be >= 1, got {depth}")
         self.depth = depth
+        self.high_water = max(1, depth // 2) if high_water is None else high_water
+        if not 1 <= self.high_water <= depth:
+            raise ValueError(f"high_water must be in 1..depth ({depth}), got {high_water}")
+        self._on_high_water: Callable[[], object] | None = None
+        self.high_water_wakes = 0
+        self.blocked_publishes = 0
+        self._blocked_topics: set[str] = set()
         self._owner = owner
         self._now = now
         self._wanted = wanted
@@ -88,6 +127,45 @@ class Funnel:
         for publisher in topic.publishers:
             for message in publisher._history or ():
                 tap._offer(message)
+
+    def wake_at_high_water(self, callback: Callable[[], object] | None) -> None:
+        """Call ``callback()`` once, as soon as the queue reaches the high-water mark (or
+        a publisher finds it full); ``None`` cancels. The reader sets it before it
+        sleeps until its next drain."""
+        self._on_high_water = callback
+        if callback is not None and len(self._queue) >= self.high_water:
+            self._wake_reader()
+
+    def _wake_reader(self) -> None:
+        callback = self._on_high_water
+        if callback is not None:
+            self._on_high_water = None
+            self.high_water_wakes += 1
+            callback()
+
+    def _note_blocked(self, topic: str, now: float) -> None:
+        self.blocked_publishes += 1
+        if topic not in self._blocked_topics:
+            self._blocked_topics.add(topic)
+            log.warning(
+                "%s: a publisher on '%s' waited for room at sim time %.3f s (the funnel "
+                "holds %d; its reader is woken at %d): a burst larger than the room left",
+                self._owner,
+                topic,
+                now,
+                self.depth,
+                self.high_water,
+            )
+
+    def statistics(self) -> FunnelStatistics:
+        return FunnelStatistics(
+            len(self._queue),
+            self.depth,
+            self.high_water,
+            self.high_water_wakes,
+            self.blocked_publishes,
+            tuple(sorted(self._blocked_topics)),
+        )
 
     def _took(self) -> None:
         # Room again: wake the blocked publishers in the order they blocked (FIFO).

@@ -24,8 +24,8 @@ from collections.abc import Callable, Coroutine, Generator
 from concurrent.futures import Executor
 from typing import Any, TypeVar, TypeVarTuple
 
-from otonav.runtime.errors import DeadlockError, WallClockCeilingError
-from otonav.runtime.timesource import JumpSource, TimeSource, tick_rate
+from otonav.runtime.errors import DeadlockError, TimeSourceError, WallClockCeilingError
+from otonav.runtime.timesource import FrozenSource, JumpSource, TimeSource, tick_rate
 
 _T = TypeVar("_T")
 _Ts = TypeVarTuple("_Ts")
@@ -169,7 +169,14 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         # Iterate a snapshot in registration order: deterministic, and safe if a watcher
         # registers or removes others.
         for watcher in tuple(self._watchers):
-            if watcher():
+            try:
+                done = watcher()
+            except Exception as exc:
+                # Never let it escape the selector (it would leave the loop mid-step):
+                # the run fails with it. (until() hands its own to the awaiting task.)
+                done = True
+                self._fail(exc)
+            if done and watcher in self._watchers:
                 self._watchers.remove(watcher)
 
     # -- blocking work: the one way to run it while sim time holds still ----------------
@@ -239,7 +246,16 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         target = max(self._ticks + 1, math.ceil((when - self._base) * self._rate - 1.0))
         while self._time_at(target) + self._clock_resolution <= when:
             target += 1
-        self._source.advance(target - self._ticks)
+        try:
+            self._source.advance(target - self._ticks)
+        except Exception as exc:
+            # Not out of the selector: fail the run with it, freeze the world and let
+            # time run on so the run's cleanup (on_stop, the recording) still gets it.
+            error = TimeSourceError(self.time(), exc)
+            error.__cause__ = exc
+            self._source = FrozenSource(self._source)
+            self._source.advance(target - self._ticks)
+            self._fail(error)
         self._ticks = target
         self.wakes += 1
 
@@ -305,6 +321,8 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
             if failure is None:
                 raise
             # Whatever the run turned the cancellation into, the cause is the failure.
+            if failure.__cause__ is not None:  # it names its own cause
+                raise failure  # noqa: B904
             raise failure from (None if isinstance(exc, asyncio.CancelledError) else exc)
         finally:
             self._owner = None

@@ -26,8 +26,14 @@ import anyio
 from anyio.abc import TaskGroup
 
 from otonav.runtime.actor import Actor
-from otonav.runtime.clock import Clock, VirtualClock, reset_current_clock, set_current_clock
-from otonav.runtime.errors import ActorCrashedError, WiringError
+from otonav.runtime.clock import (
+    Clock,
+    RealTimeClock,
+    VirtualClock,
+    reset_current_clock,
+    set_current_clock,
+)
+from otonav.runtime.errors import ActorCrashedError, OtonavRuntimeError, WiringError
 from otonav.runtime.graph import Graph, build_graph
 from otonav.runtime.loop import VirtualTimeLoop
 from otonav.runtime.mailbox import Bus, Endpoint, Publisher, Subscription
@@ -92,7 +98,7 @@ class System:
         self._event_listeners: list[Callable[[SystemEvent], None]] = []
         self._running = 0  # supervisors still running; _all_done is set when none are
         self._all_done: anyio.Event | None = None
-        self._failure: ActorCrashedError | None = None
+        self._failure: OtonavRuntimeError | None = None
         self._tg: TaskGroup | None = None
         self._stop_started = False
         self._stopped: anyio.Event | None = None
@@ -112,6 +118,8 @@ class System:
                 self._wire(state.actor, direction)
         for state in self._states.values():
             state.actor.on_wired(self.bus)
+        if isinstance(clock, RealTimeClock):
+            clock.add_failure_listener(self._clock_failed)
 
     def _wire(self, actor: Actor, direction: str) -> None:
         for port in actor.ports():
@@ -236,6 +244,19 @@ class System:
         finally:
             if started or state.status == "crashed":
                 await self._stop_actor(state)
+
+    def _clock_failed(self, error: BaseException) -> None:
+        """The real-time clock's world (or a watcher) raised inside someone's ``now()``:
+        stop the system with it rather than crash the actor that asked for the time."""
+        text = "".join(traceback.format_exception(error))
+        self._event("clock", "crashed", text)
+        if self._failure is None:
+            if isinstance(error, OtonavRuntimeError):
+                self._failure = error
+            else:
+                self._failure = ActorCrashedError("clock (a sim-time watcher)", 0.0, text)
+                self._failure.__cause__ = error
+        self.stop()
 
     def _may_restart(self, state: _ActorState, now: float) -> bool:
         policy = state.policy

@@ -43,6 +43,17 @@ class JumpSource:
         self.ticks += n
 
 
+class FrozenSource(JumpSource):
+    """Stands in for a time source whose ``advance()`` raised: time runs on with the
+    same tick, the world (``failed``) is no longer stepped."""
+
+    __slots__ = ("failed",)
+
+    def __init__(self, failed: TimeSource) -> None:
+        super().__init__(failed.tick)
+        self.failed = failed
+
+
 def tick_rate(tick: float) -> float:
     """Ticks per second, snapped to an integer when ``1 / tick`` is one (0.002 s -> 500).
 

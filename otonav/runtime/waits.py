@@ -53,10 +53,16 @@ async def until(
     def watcher() -> bool:
         if done.done():
             return True
-        if check():
-            done.set_result(None)
+        try:
+            if not check():
+                return False
+        except Exception as exc:
+            # Raised where time moves (the loop's idle path, or a real-time clock's
+            # advance inside someone's now()): hand it to the task awaiting until().
+            done.set_exception(exc)
             return True
-        return False
+        done.set_result(None)
+        return True
 
     unwatch = clock.watch(watcher)
     try:

@@ -212,6 +212,6 @@ class StackSession:
             loop is not None
             and previous is not None
             and not loop.is_closed()
-            and loop.source is self.hal
+            and (loop.source is self.hal or getattr(loop.source, "failed", None) is self.hal)
         ):
             loop.attach_source(previous)

@@ -3,8 +3,10 @@
 - The pytest plugin (the ``otonav`` pytest entry point): ``@pytest.mark.sim`` runs an
   async test on a virtual-time loop.
 - :func:`running_stack`: the robot stack up for the body of an ``async with``.
+- :func:`replay`: re-simulate an actor against a recording; its divergences.
 """
 
+from otonav.testing.replay import ReplayCrashError, replay
 from otonav.testing.stack import RunningStack, running_stack
 
-__all__ = ("RunningStack", "running_stack")
+__all__ = ("ReplayCrashError", "RunningStack", "replay", "running_stack")

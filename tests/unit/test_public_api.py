@@ -20,6 +20,7 @@ PACKAGES = [
     "otonav.scenario",
     "otonav.testing",
     "otonav.embed",
+    "otonav.replay",
 ]
 
 

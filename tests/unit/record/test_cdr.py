@@ -46,6 +46,7 @@ from otonav.msgs import (
     WheelCommand,
 )
 from otonav.record.cdr import encode
+from otonav.record.cdr_decode import decode as decode_cdr
 from otonav.record.schemas import schema_for
 
 pytestmark = pytest.mark.unit
@@ -155,9 +156,16 @@ def assert_same(decoded: Any, original: Message, where: str = "") -> None:
 
 
 def check(message: Message) -> None:
-    """Decoded fields equal the original, and the bytes equal mcap_ros2's own."""
+    """Decoded fields equal the original, and the bytes equal mcap_ros2's own; our own
+    decoder (replay's) gives the same fields back, as the same types, and bytes that
+    encode identically."""
     assert_same(decode(message), message)
-    assert encode(message) == reference_bytes(message)
+    data = encode(message)
+    assert data == reference_bytes(message)
+    ours = decode_cdr(type(message), data)
+    assert type(ours) is type(message)
+    assert_same(ours, message)
+    assert encode(ours) == data
 
 
 # --- samples ------------------------------------------------------------------------
@@ -640,3 +648,16 @@ def test_property_odometry(
         ),
     )
     check(odometry)
+
+
+# --- our decoder (replay) on what is not CDR of the type ----------------------------
+
+
+def test_decoder_refuses_big_endian_and_short_data() -> None:
+    data = encode(Odometry())
+    with pytest.raises(ValueError, match="little-endian"):
+        decode_cdr(Odometry, b"\x00\x00\x00\x00" + data[4:])
+    with pytest.raises(ValueError, match="cannot decode nav_msgs/msg/Odometry"):
+        decode_cdr(Odometry, data[: len(data) // 2])
+    with pytest.raises(ValueError, match="cannot decode"):
+        decode_cdr(NavState, encode(NavState(state="driving"))[:10] + b"\xff" * 4)

@@ -1,0 +1,225 @@
+"""CDR decoding back into otonav messages: the inverse of :mod:`otonav.record.cdr`.
+
+Replay feeds recorded messages to actors, so it needs the same pydantic objects the
+stack published, bit for bit (a float64 comes back as the same double, a float32 scan
+range as the same float32 value). The decoder is compiled per message class from the
+same layouts (:func:`~otonav.record.schemas.layout_for`) and the same leaf flattening as
+the encoder: each run of fixed-size fields is one precompiled ``unpack_from`` (one per
+start offset mod 8, since the padding inside a run depends on where it starts);
+strings and sequences are read one by one; then the flat values are built back into
+the nested messages with ``Message.fast``. ``decode(type(m), encode(m)) == m`` for every
+message (a property test), and the values agree with ``mcap_ros2``'s generic decoder on
+recordings (a test), which is the independent oracle.
+
+Only little-endian plain CDR (what ROS 2 writes and what we record) is read; anything
+else is a ``ValueError`` naming the type.
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Callable
+from typing import Any, Final, TypeVar
+
+from otonav.msgs import Message
+from otonav.record.cdr import ENCAPSULATION, _Fixed, _leaves, _run_format, _Var
+from otonav.record.schemas import SEQUENCE, layout_for
+
+__all__ = ("decode",)
+
+M = TypeVar("M", bound=Message)
+
+ReadStep = Callable[[bytes, int, list[Any]], int]
+"""Read one part of a message from ``data`` at ``pos``, append its value(s), return
+the new position (``pos`` counts the 4-byte encapsulation header)."""
+Builder = Callable[[list[Any], int], tuple[Any, int]]
+"""Build one message from the flat values starting at index ``i``."""
+
+_U32: Final = struct.Struct("<I")
+
+
+def _aligned(pos: int, size: int) -> int:
+    """``pos`` moved up to a multiple of ``size`` counted from the payload start."""
+    return pos + (-(pos - 4) % size)
+
+
+def _fixed_run(run: list[_Fixed]) -> ReadStep:
+    structs = tuple(struct.Struct(_run_format(run, start)) for start in range(8))
+
+    def read(data: bytes, pos: int, out: list[Any]) -> int:
+        unpacker = structs[(pos - 4) & 7]
+        out.extend(unpacker.unpack_from(data, pos))
+        return pos + unpacker.size
+
+    return read
+
+
+def _read_string(data: bytes, pos: int) -> tuple[str, int]:
+    pos = _aligned(pos, 4)
+    (length,) = _U32.unpack_from(data, pos)
+    pos += 4
+    if length == 0:  # not what ROS writes, but an empty string is the only reading
+        return "", pos
+    end = pos + length
+    if end > len(data):
+        raise ValueError("string runs past the end of the message")
+    return data[pos : end - 1].decode(), end
+
+
+def _string(data: bytes, pos: int, out: list[Any]) -> int:
+    text, pos = _read_string(data, pos)
+    out.append(text)
+    return pos
+
+
+def _count(data: bytes, pos: int, count: int) -> tuple[int, int]:
+    """A sequence's element count (read) or a fixed array's (known)."""
+    if count != SEQUENCE:
+        return count, pos
+    pos = _aligned(pos, 4)
+    (n,) = _U32.unpack_from(data, pos)
+    return n, pos + 4
+
+
+def _sequence(code: str, count: int) -> ReadStep:
+    size = struct.calcsize(code)
+
+    def read(data: bytes, pos: int, out: list[Any]) -> int:
+        n, pos = _count(data, pos, count)
+        if not n:
+            out.append(())
+            return pos
+        pos = _aligned(pos, size)
+        out.append(struct.unpack_from(f"<{n}{code}", data, pos))
+        return pos + n * size
+
+    return read
+
+
+def _strings(count: int) -> ReadStep:
+    def read(data: bytes, pos: int, out: list[Any]) -> int:
+        n, pos = _count(data, pos, count)
+        items = []
+        for _ in range(n):
+            text, pos = _read_string(data, pos)
+            items.append(text)
+        out.append(tuple(items))
+        return pos
+
+    return read
+
+
+def _messages(message: type[Message], count: int) -> ReadStep:
+    def read(data: bytes, pos: int, out: list[Any]) -> int:
+        n, pos = _count(data, pos, count)
+        steps, build = _plan(message)
+        items = []
+        for _ in range(n):
+            values: list[Any] = []
+            for step in steps:
+                pos = step(data, pos, values)
+            items.append(build(values, 0)[0])
+        out.append(tuple(items))
+        return pos
+
+    return read
+
+
+def _empty(data: bytes, pos: int, out: list[Any]) -> int:
+    out.append(None)  # the one uint8 rosidl adds to a message with no fields
+    return pos + 1
+
+
+def _var(leaf: _Var) -> ReadStep:
+    if leaf.kind == "string":
+        return _string
+    if leaf.kind == "sequence":
+        return _sequence(leaf.code, SEQUENCE)
+    if leaf.kind == "strings":
+        return _strings(leaf.count)
+    if leaf.kind == "messages":
+        assert leaf.message is not None
+        return _messages(leaf.message, leaf.count)
+    return _empty
+
+
+def _compile_steps(message: type[Message]) -> tuple[ReadStep, ...]:
+    steps: list[ReadStep] = []
+    run: list[_Fixed] = []
+    for leaf in _leaves(message):
+        if isinstance(leaf, _Fixed):
+            run.append(leaf)
+            continue
+        if run:
+            steps.append(_fixed_run(run))
+            run = []
+        steps.append(_var(leaf))
+    if run:
+        steps.append(_fixed_run(run))
+    return tuple(steps)
+
+
+def _compile_builder(message: type[Message]) -> Builder:
+    """The inverse of the leaf flattening: one generated expression per class that
+    reads the flat values at fixed indices (every field takes one value, a fixed
+    primitive array n) and nests ``Message.fast`` calls. Generated rather than looped:
+    an Odometry took 15 µs through a generic loop over fields, 4 µs this way."""
+    classes: dict[str, type[Message]] = {}
+
+    def expr(current: type[Message], i: int) -> tuple[str, int]:
+        name = f"_c{len(classes)}"
+        classes[name] = current
+        layout = layout_for(current)
+        if not layout.fields:
+            return f"{name}.fast()", i + 1
+        parts = []
+        for field in layout.fields:
+            if not isinstance(field.type, str) and field.array is None:
+                code, i = expr(field.type, i)
+            elif isinstance(field.type, str) and field.type != "string" and (field.array or 0) > 0:
+                n = field.array or 0
+                code, i = f"tuple(v[{i}:{i + n}])", i + n
+            else:  # one value: a scalar, a string, a sequence, an array of messages/strings
+                code, i = f"v[{i}]", i + 1
+            parts.append(f"{field.name}={code}")
+        return f"{name}.fast({', '.join(parts)})", i
+
+    body, used = expr(message, 0)
+    source = f"lambda v, i: ({body}, {used})"
+    build: Builder = eval(source, dict(classes))  # generated from our own layouts only
+    return build
+
+
+_PLANS: dict[type[Message], tuple[tuple[ReadStep, ...], Builder]] = {}
+
+
+def _plan(message: type[Message]) -> tuple[tuple[ReadStep, ...], Builder]:
+    plan = _PLANS.get(message)
+    if plan is None:
+        plan = _PLANS[message] = (_compile_steps(message), _compile_builder(message))
+    return plan
+
+
+def decode(message: type[M], data: bytes) -> M:
+    """The ``message`` encoded in ``data`` (CDR with its encapsulation header).
+
+    Raises ValueError for data that is not little-endian CDR of that type (too short,
+    a string past the end, trailing garbage is tolerated as ROS 2 pads to 4 bytes).
+    """
+    if data[:4] != ENCAPSULATION:
+        raise ValueError(
+            f"cannot decode {message.ros_type}: not little-endian plain CDR "
+            f"(encapsulation {data[:4].hex() or 'missing'}, expected {ENCAPSULATION.hex()})"
+        )
+    steps, build = _PLANS.get(message) or _plan(message)
+    values: list[Any] = []
+    pos = 4
+    try:
+        for step in steps:
+            pos = step(data, pos, values)
+    except (struct.error, UnicodeDecodeError) as error:
+        raise ValueError(f"cannot decode {message.ros_type}: {error}") from error
+    if pos > len(data):
+        raise ValueError(f"cannot decode {message.ros_type}: the data ends early")
+    result: M = build(values, 0)[0]
+    return result

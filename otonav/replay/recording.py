@@ -1,0 +1,131 @@
+"""What replay reads from a recording: the stack config it ran with, each topic's
+type, and the messages of the topics in play, in recorded order.
+
+The recorded order is the order the messages were published in: the recorder funnels
+every topic into one queue as messages are published, and the file keeps that order.
+Replay depends on it (``otonav.replay.feed``), so messages are read in file order and
+only then sorted by time, stably (a publisher held up by backpressure is stamped with
+the instant it published, and may sit later in the file).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from mcap.reader import make_reader
+from pydantic import ValidationError
+
+from otonav.record.fastreader import iter_raw_messages
+from otonav.record.reader import CUT_OFF_ERRORS, MAGIC
+from otonav.stack import StackConfig
+
+
+class ReplayInputError(ValueError):
+    """Bad input to a replay (a file, a node name, a topic): one line, what is valid."""
+
+
+@dataclass(frozen=True, slots=True)
+class RecordedMessage:
+    """One recorded message, still encoded (CDR)."""
+
+    topic: str
+    time_ns: int
+    data: bytes
+
+
+@dataclass(frozen=True, slots=True)
+class RecordedSchema:
+    name: str
+    encoding: str
+    data: bytes
+
+
+@dataclass(slots=True)
+class Recording:
+    """The parts of a recording that replay uses."""
+
+    path: Path
+    stack: StackConfig | None
+    """The stack config stored in the ``otonav`` metadata (None: not an otonav scenario
+    recording, e.g. one made with ``running_stack(record_to=...)``)."""
+    types: dict[str, str]
+    """topic -> ROS type name (the schema name), for every recorded topic."""
+    schemas: dict[str, RecordedSchema]
+    """topic -> its schema record (to copy topics into a new file)."""
+    messages: list[RecordedMessage]
+    """The messages of the topics asked for, in recorded order (sorted by time, stably)."""
+    metadata: dict[str, dict[str, str]] = field(default_factory=dict)
+
+
+def _cut_off(path: Path) -> ReplayInputError:
+    return ReplayInputError(
+        f"{path}: the recording is cut off (no footer or index: the process was killed); "
+        f"recover its complete chunks with 'otonav salvage {path} RECOVERED.mcap' and "
+        "replay that file"
+    )
+
+
+def load_recording(path: Path, topics: Collection[str] | None) -> Recording:
+    """Read ``path``: metadata, every topic's type, and the messages of ``topics`` (all
+    when None; none, without reading a chunk, when empty). Raises
+    :class:`ReplayInputError` for a missing, non-MCAP or cut-off file."""
+    if not path.exists():
+        raise ReplayInputError(f"{path}: no such file")
+    if path.is_dir():
+        raise ReplayInputError(f"{path}: is a directory, not an MCAP recording")
+    with path.open("rb") as f:
+        if f.read(len(MAGIC)) != MAGIC:
+            raise ReplayInputError(f"{path}: not an MCAP file (no MCAP magic at its start)")
+        f.seek(0)
+        try:
+            reader = make_reader(f)
+            summary = reader.get_summary()
+            if summary is None or summary.statistics is None:
+                raise _cut_off(path)
+            types: dict[str, str] = {}
+            schemas: dict[str, RecordedSchema] = {}
+            for channel in summary.channels.values():
+                schema = summary.schemas.get(channel.schema_id)
+                types[channel.topic] = schema.name if schema is not None else "?"
+                if schema is not None:
+                    schemas[channel.topic] = RecordedSchema(
+                        schema.name, schema.encoding, schema.data
+                    )
+            wanted = None if topics is None else [t for t in topics if t in types]
+            topic_of = {c.id: c.topic for c in summary.channels.values()}
+            ids = (
+                None
+                if wanted is None
+                else [i for i, topic in topic_of.items() if topic in set(wanted)]
+            )
+            messages = (
+                []
+                if ids == []
+                else [
+                    RecordedMessage(topic_of[channel], log_time, data)
+                    for channel, log_time, data in iter_raw_messages(f, summary, ids)
+                ]
+            )
+            metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
+        except CUT_OFF_ERRORS as exc:
+            if isinstance(exc, ReplayInputError):
+                raise
+            raise _cut_off(path) from None
+    messages.sort(key=lambda m: m.time_ns)  # stable: equal instants keep the file order
+    return Recording(path, _stack_of(path, metadata), types, schemas, messages, metadata)
+
+
+def _stack_of(path: Path, metadata: dict[str, dict[str, str]]) -> StackConfig | None:
+    text = metadata.get("otonav", {}).get("stack_config")
+    if text is None:
+        return None
+    try:
+        return StackConfig.model_validate_json(text)
+    except ValidationError as exc:
+        raise ReplayInputError(
+            f"{path}: its stored stack config does not validate with this otonav "
+            f"({exc.error_count()} error(s), first: {exc.errors()[0]['msg']}); it was "
+            "recorded by another version"
+        ) from None

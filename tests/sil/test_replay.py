@@ -1,0 +1,138 @@
+"""Replay against the acceptance run: unchanged code gives byte-identical outputs for
+every replayable actor (the contract); a deliberate change is reported at its first
+divergence, and the CLI exits 1; bad input is one line and exit 2."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import pytest
+
+from otonav.cli import main as cli_main
+from otonav.msgs import Message, Odometry, PoseStamped, Twist
+from otonav.nav import GoalCommand, go_to_goal
+from otonav.record.cdr_decode import decode
+from otonav.record.reader import read_messages, summarize
+from otonav.record.writer import RecordingWriter
+from otonav.replay import replay_recording
+from otonav.replay.nodes import stack_actor_names
+from otonav.replay.recording import load_recording
+from otonav.scenario import run_scenario
+from otonav.stack import StackConfig
+from otonav.testing import replay
+
+pytestmark = pytest.mark.sil
+
+
+@pytest.fixture(scope="module")
+def acceptance(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("acceptance")
+    verdict = run_scenario(out_dir=out, plot=False)
+    assert verdict.passed
+    return out / "recording.mcap"
+
+
+def test_every_replayable_actor_is_byte_identical_on_the_acceptance_run(
+    acceptance: Path,
+) -> None:
+    names = stack_actor_names(StackConfig())
+    assert {"nav", "base"} <= set(names)
+    assert "bridge" not in names
+    for nodes in [[name] for name in names] + [names]:
+        result = replay_recording(acceptance, nodes)
+        assert result.byte_identical, (nodes, result.first_divergence, result.crash)
+        assert all(t.recorded > 100 for t in result.topics), result.topics
+        assert result.sim_time_s == pytest.approx(summarize(acceptance).duration_s, abs=0.02)
+
+
+def test_the_pytest_helper_and_a_user_actor_by_import_path(acceptance: Path) -> None:
+    assert replay(acceptance, "nav") == []
+    assert replay(acceptance, "replay_user_actor:make_navigator") == []
+
+
+def test_a_deliberate_change_is_reported_at_its_first_divergence(
+    acceptance: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def sluggish(*args: object, **kwargs: object) -> GoalCommand:
+        command = go_to_goal(*args, **kwargs)  # type: ignore[arg-type]
+        return dataclasses.replace(command, omega=command.omega * 0.9)
+
+    monkeypatch.setattr("otonav.actors.navigator.go_to_goal", sluggish)
+    divergences = replay(acceptance, "nav")
+    assert divergences
+    first = divergences[0]
+    assert (first.topic, first.kind, first.field) == ("/cmd_vel", "content", "angular.z")
+    assert first.replayed == pytest.approx(0.9 * first.recorded)
+    # The first commanded turn is the first output that can differ (before it: zeros).
+    recorded = [m for _t, _s, m in read_messages(acceptance, ["/cmd_vel"])]
+    turning = next(i for i, m in enumerate(recorded) if m.angular.z != 0.0)
+    assert first.index == turning
+    # /nav/state only reports the recorded inputs: it does not diverge.
+    assert {d.topic for d in divergences} == {"/cmd_vel"}
+
+
+def test_cli_exit_codes_summary_and_out(
+    acceptance: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert cli_main(["replay", str(acceptance), "--node", "nav,base"]) == 0
+    assert "SAME: every output byte-identical" in capsys.readouterr().out
+
+    out = tmp_path / "replayed.mcap"
+    code = cli_main(
+        ["replay", str(acceptance), "--node", "nav", "--set", "nav.kp_ang=3.0", "--out", str(out)]
+    )
+    printed = capsys.readouterr().out
+    assert code == 1
+    assert "first divergence: /cmd_vel at sim time" in printed
+    assert "angular.z" in printed
+    assert "DIVERGED" in printed
+    topics = {t.topic: t.count for t in summarize(out).topics}
+    assert topics["/cmd_vel"] == topics["/recorded/cmd_vel"] == 226
+    assert topics["/odom"] == 1130  # the inputs, copied
+    assert "/scenario/verdict" not in topics
+    # Within a tolerance as large as the change, the same run passes.
+    assert cli_main(["replay", str(acceptance), "--node", "nav", "--tolerance", "10"]) == 0
+
+
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [
+        (["--node", "navv"], "--node navv: no such node; replayable nodes: base, nav"),
+        (["--node", "bridge"], "--node bridge: cannot be replayed (it owns the hardware"),
+        (["--node", "nosuchmodule:Thing"], "cannot import 'nosuchmodule'"),
+        (["--node", "nav", "--set", "nav.kp_angg=3"], "unknown key 'kp_angg'"),
+        (["--node", "nav", "--tolerance", "-1"], "--tolerance -1.0: must be"),
+        ([], "--node: name a node to replay"),
+    ],
+)
+def test_cli_bad_input_is_one_line_and_exit_2(
+    acceptance: Path, args: list[str], expected: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert cli_main(["replay", str(acceptance), *args]) == 2
+    err = capsys.readouterr().err
+    assert expected in err
+    assert len(err.strip().splitlines()) == 1
+    assert "Traceback" not in err
+
+
+def test_cli_bad_files_are_exit_2(
+    acceptance: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(acceptance.read_bytes()[: acceptance.stat().st_size // 2])
+    no_scan = tmp_path / "no_scan.mcap"
+    kinds: dict[str, type[Message]] = {"/odom": Odometry, "/goal": PoseStamped, "/cmd_vel": Twist}
+    with RecordingWriter(no_scan) as writer:
+        for m in load_recording(acceptance, list(kinds)).messages:
+            writer.write(m.topic, decode(kinds[m.topic], m.data), m.time_ns / 1e9)
+    for path, expected in [
+        (cut, f"otonav salvage {cut} RECOVERED.mcap"),
+        (no_scan, "has no /scan, which nav reads (sensor_msgs/msg/LaserScan)"),
+        (tmp_path / "missing.mcap", "no such file"),
+        (acceptance.parent, "is a directory"),
+    ]:
+        assert cli_main(["replay", str(path), "--node", "nav"]) == 2
+        err = capsys.readouterr().err
+        assert expected in err, err
+        assert len(err.strip().splitlines()) == 1
