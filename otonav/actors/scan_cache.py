@@ -17,12 +17,15 @@ def points_of(scan: LaserScan, laser_offset_x: float) -> ScanPoints:
     global _last
     if _last is not None and _last[0] is scan and _last[1] == laser_offset_x:
         return _last[2]
+    # The LaserScan's angles and limits are float32 on the wire (ROS 2): use them as
+    # float32 here too, so a replay from the recording computes the same points.
+    f32 = np.float32
     seen = scan_points(
         np.asarray(scan.ranges, dtype=np.float64),
-        scan.angle_min,
-        scan.angle_increment,
-        scan.range_min,
-        scan.range_max,
+        float(f32(scan.angle_min)),
+        float(f32(scan.angle_increment)),
+        float(f32(scan.range_min)),
+        float(f32(scan.range_max)),
         laser_offset_x,
     )
     _last = (scan, laser_offset_x, seen)

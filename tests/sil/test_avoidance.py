@@ -8,6 +8,8 @@ from pathlib import Path
 
 import pytest
 
+from otonav.replay import replay_recording
+from otonav.replay.nodes import stack_actor_names
 from otonav.scenario import GoalSpec, ScenarioConfig, StartSpec, run_scenario
 from otonav.scenario.config import BoxSpec
 from otonav.stack import DwaConfig, NavConfig, StackConfig
@@ -69,3 +71,16 @@ def test_gate_has_teeth_a_planner_that_ignores_the_goal_fails(otonav_artifacts: 
     assert not verdict.reached
     assert verdict.recording is not None
     assert Path(verdict.recording).stat().st_size > 100_000
+
+
+def test_the_default_stack_replays_byte_identical(tmp_path: Path) -> None:
+    """The avoiding navigator and the safety layer are replayable: fed the recorded
+    /odom, /scan and /goal, each computes exactly what it published (the scan's float32
+    angles are used as float32, as the recording holds them)."""
+    verdict = run_scenario(out_dir=tmp_path, plot=False)
+    assert verdict.passed
+    names = stack_actor_names(StackConfig())
+    assert {"nav", "safety", "base"} <= set(names)
+    for nodes in [["nav"], ["safety"], names]:
+        result = replay_recording(tmp_path / "recording.mcap", nodes)
+        assert result.byte_identical, (nodes, result.first_divergence, result.crash)
