@@ -11,6 +11,7 @@ from otonav.actors import topics
 from otonav.actors.odom_history import OdomHistory
 from otonav.actors.scan_cache import points_of
 from otonav.msgs import (
+    HardwareStatus,
     Header,
     LaserScan,
     NavDiagnostics,
@@ -25,7 +26,7 @@ from otonav.nav.navigation import Navigation, NavigationParams, NavOutput
 from otonav.nav.scan import to_frame
 from otonav.runtime import Actor, Input, Output
 
-_AT_REST = frozenset({"idle", "waiting", "reached", "unreachable"})
+_AT_REST = frozenset({"idle", "waiting", "reached", "unreachable", "fault"})
 
 
 class AvoidingNavigator(Actor):
@@ -36,11 +37,13 @@ class AvoidingNavigator(Actor):
 
     Publishes its command on /cmd_vel (remapped to /cmd_vel_nav behind the safety
     layer) and /nav/state every step, /nav/diagnostics every step while moving (at
-    rest: when the state or reason change)."""
+    rest: when the state or reason change). While /hardware/status reports a fault it
+    commands zero and its state is ``fault``."""
 
     odom = Input(topics.ODOM, Odometry, topics.SENSOR_QOS)
     scan = Input(topics.SCAN, LaserScan, topics.SENSOR_QOS)
     goal_in = Input(topics.GOAL, PoseStamped, topics.LATCHED)
+    hardware = Input(topics.HARDWARE_STATUS, HardwareStatus, topics.HARDWARE_QOS)
     cmd_vel = Output(topics.CMD_VEL, Twist, topics.COMMAND_QOS)
     state = Output(topics.NAV_STATE, NavState, topics.COMMAND_QOS)
     diagnostics = Output(topics.NAV_DIAGNOSTICS, NavDiagnostics, topics.COMMAND_QOS)
@@ -71,6 +74,7 @@ class AvoidingNavigator(Actor):
         self._points_pose: tuple[float, float, float] | None = None
         self._scan_time = -math.inf
         self._last_diag: tuple[str, str] | None = None
+        self._hardware_fault = False
 
     async def run(self) -> None:
         rate = self.clock.rate(self.rate_hz)
@@ -81,6 +85,9 @@ class AvoidingNavigator(Actor):
             goal_msg = self.goal_in.take_latest()
             if goal_msg is not None:
                 self.nav.set_goal((goal_msg.pose.position.x, goal_msg.pose.position.y))
+            status = self.hardware.take_latest()
+            if status is not None:
+                self._hardware_fault = status.faulted
             scan = self.scan.take_latest()
             if scan is not None:
                 self._take_scan(scan)
@@ -108,6 +115,9 @@ class AvoidingNavigator(Actor):
             await self._publish(NavOutput(0.0, 0.0, "idle", "no odometry", math.inf, 0.0))
             return
         _, pose, v0, omega0 = latest
+        if self._hardware_fault:
+            await self._publish(NavOutput(0.0, 0.0, "fault", "hardware fault", math.inf, 0.0))
+            return
         if self._points_pose is None or now - self._scan_time > self.scan_timeout:
             out = self.nav.step(now, pose, v0, omega0, np.empty((0, 2)))
             if out.state not in ("idle", "reached", "unreachable"):

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from otonav.actors import topics
 from otonav.control import DiffDriveGeometry, limit_twist, twist_to_wheels
-from otonav.msgs import Header, Time, Twist, WheelCommand
+from otonav.msgs import HardwareStatus, Header, Time, Twist, WheelCommand
 from otonav.runtime import Actor, Input, Output
 
 
@@ -24,10 +24,15 @@ class BaseLimits:
 class BaseController(Actor):
     """At ``rate_hz``: take the newest /cmd_vel, clamp it to velocity and acceleration
     limits, convert to wheel speeds, publish /wheel_cmd. With no /cmd_vel for
-    ``cmd_timeout`` s of sim time the target falls to zero (the watchdog)."""
+    ``cmd_timeout`` s of sim time the target falls to zero (the watchdog).
+
+    While /hardware/status says the hardware is not drivable (a fault, or starting or
+    recovering), it commands zero at once, bypassing the acceleration limits, and
+    counts it in ``hardware_stops``; when it is drivable again it ramps up from rest."""
 
     cmd_vel = Input(topics.CMD_VEL, Twist, topics.COMMAND_QOS)
     wheel_cmd = Output(topics.WHEEL_CMD, WheelCommand, topics.COMMAND_QOS)
+    hardware = Input(topics.HARDWARE_STATUS, HardwareStatus, topics.HARDWARE_QOS)
 
     def __init__(
         self,
@@ -48,6 +53,7 @@ class BaseController(Actor):
         self.rate_hz = rate_hz
         self.cmd_timeout = cmd_timeout
         self.watchdog_trips = 0
+        self.hardware_stops = 0
 
     async def run(self) -> None:
         rate = self.clock.rate(self.rate_hz)
@@ -56,9 +62,15 @@ class BaseController(Actor):
         target: Twist | None = None
         received_at = -math.inf
         timed_out = False
+        drivable = True
         while True:
             await rate.sleep()
             now = self.clock.now()
+            status = self.hardware.take_latest()
+            if status is not None:
+                if drivable and not status.drivable:
+                    self.hardware_stops += 1
+                drivable = status.drivable
             latest = self.cmd_vel.take_latest()
             if latest is not None:
                 target, received_at, timed_out = latest, now, False
@@ -74,6 +86,8 @@ class BaseController(Actor):
                 if target is not None and not timed_out
                 else (0.0, 0.0)
             )
+            if not drivable:
+                v = omega = want_v = want_omega = 0.0
             v, omega = limit_twist(
                 want_v,
                 want_omega,

@@ -3,17 +3,25 @@ rates, applies wheel commands. The only actor that touches the HAL."""
 
 from __future__ import annotations
 
+import contextlib
+import logging
+
 import anyio
 
 from otonav.actors import topics
 from otonav.control import Pose2D, integrate_odometry
-from otonav.hal import ImuSample, RobotHardwareInterface
+from otonav.hal import HardwareHealth, HealthLevel, ImuSample, RobotHardwareInterface
 from otonav.hal import WheelCommand as HalWheelCommand
 from otonav.msgs import (
     Clock,
+    DiagnosticArray,
+    DiagnosticStatus,
+    HardwareStatus,
     Header,
     Imu,
+    KeyValue,
     LaserScan,
+    Log,
     Odometry,
     Point,
     Pose,
@@ -29,6 +37,15 @@ from otonav.msgs import (
     WheelCommand,
 )
 from otonav.runtime import Actor, Input, Output
+
+log = logging.getLogger("otonav.hal")
+
+_LOG_LEVELS = {
+    HealthLevel.OK: (Log.INFO, logging.INFO),
+    HealthLevel.WARN: (Log.WARN, logging.WARNING),
+    HealthLevel.ERROR: (Log.ERROR, logging.ERROR),
+    HealthLevel.STALE: (Log.ERROR, logging.ERROR),
+}
 
 
 def _diag6(*variances: float) -> tuple[float, ...]:
@@ -47,6 +64,11 @@ class Bridge(Actor):
 
     Odometry: wheel encoders for distance, the gyro for heading (it does not scrub
     in turns; notes/mujoco-model.md: ~2 cm and 0.2 deg over a circle vs 7 cm and 8 deg).
+
+    Hardware health (:meth:`RobotHardwareInterface.health`, whatever the HAL): checked at
+    every publishing instant; a change is published on /hardware/status (latched, for
+    the base and the navigator) and /diagnostics, and logged on /rosout. /diagnostics
+    also repeats at ``diagnostics_hz``.
     """
 
     clock_out = Output(topics.CLOCK, Clock, topics.CLOCK_QOS)
@@ -56,6 +78,9 @@ class Bridge(Actor):
     tf = Output(topics.TF, TFMessage, topics.TF_QOS)
     tf_static = Output(topics.TF_STATIC, TFMessage, topics.LATCHED)
     wheel_cmd = Input(topics.WHEEL_CMD, WheelCommand, topics.COMMAND_QOS)
+    hardware_status = Output(topics.HARDWARE_STATUS, HardwareStatus, topics.HARDWARE_QOS)
+    diagnostics = Output(topics.DIAGNOSTICS, DiagnosticArray, topics.DIAGNOSTICS_QOS)
+    rosout = Output(topics.ROSOUT, Log, topics.ROSOUT_QOS)
 
     def __init__(
         self,
@@ -65,6 +90,7 @@ class Bridge(Actor):
         odom_hz: float = 100.0,
         imu_hz: float = 100.0,
         scan_hz: float = 10.0,
+        diagnostics_hz: float = 1.0,
         initial_pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
         name: str = "bridge",
     ) -> None:
@@ -74,6 +100,7 @@ class Bridge(Actor):
             ("odom_hz", odom_hz),
             ("imu_hz", imu_hz),
             ("scan_hz", scan_hz),
+            ("diagnostics_hz", diagnostics_hz),
         ):
             if not hz > 0:
                 raise ValueError(f"bridge.{field} must be > 0 Hz, got {hz}")
@@ -83,7 +110,9 @@ class Bridge(Actor):
             "odom": 1.0 / odom_hz,
             "imu": 1.0 / imu_hz,
             "scan": 1.0 / scan_hz,
+            "diagnostics": 1.0 / diagnostics_hz,
         }
+        self._health: HardwareHealth | None = None
         self._pose = Pose2D(*initial_pose)
         self._last_wheels = (0.0, 0.0)
         self._v = 0.0
@@ -106,6 +135,7 @@ class Bridge(Actor):
                 ),
             )
 
+        await self._check_health(self.clock.now())
         await self.tf_static.publish(
             TFMessage.fast(
                 transforms=(
@@ -134,6 +164,7 @@ class Bridge(Actor):
             (self._periods["odom"], self._publish_odom),
             (self._periods["imu"], self._publish_imu),
             (self._periods["scan"], self._publish_scan),
+            (self._periods["diagnostics"], self._publish_diagnostics),
         )
         counts = [1] * len(publishers)
         due = [start + period for period, _ in publishers]
@@ -147,6 +178,8 @@ class Bridge(Actor):
             # A period that is not a whole number of ticks wakes at the next tick: stamp
             # (and integrate) with the instant the data is actually read at.
             now = clock.now()
+            if self.hal.health() is not self._health:
+                await self._check_health(now)
             stamp = Time.from_seconds(now)
             for i, (period, publish) in enumerate(publishers):
                 if due[i] <= instant + 1e-12:
@@ -251,5 +284,68 @@ class Bridge(Actor):
                 range_max=scan.range_max,
                 ranges=tuple(scan.ranges.tolist()),
                 intensities=(),
+            )
+        )
+
+    # -- hardware health -----------------------------------------------------------------
+
+    async def _check_health(self, now: float) -> None:
+        """Publish and log the HAL's health if it changed (the first one always, but
+        logged only when it is not a plain OK)."""
+        health = self.hal.health()
+        first = self._health is None
+        if health is self._health:
+            return
+        self._health = health
+        stamp = Time.from_seconds(now)
+        await self.hardware_status.publish(
+            HardwareStatus.fast(
+                header=Header.fast(stamp=stamp, frame_id=""),
+                level=int(health.level),
+                ready=health.ready,
+                fault=health.fault,
+                message=health.message,
+            )
+        )
+        await self._publish_diagnostics(stamp, now)
+        if first and health.level == HealthLevel.OK and health.ready:
+            return
+        # Starting and recovered are news, not warnings; recovering is a warning.
+        level = health.level if health.faulted or health.fault else HealthLevel.OK
+        ros_level, py_level = _LOG_LEVELS[level]
+        log.log(py_level, "[%.3f] hardware: %s", now, health.message)
+        with contextlib.suppress(anyio.WouldBlock):
+            self.rosout.publish_nowait(
+                Log.fast(
+                    stamp=stamp,
+                    level=ros_level,
+                    name=self.name,
+                    msg=f"hardware {health.fault or 'status'}: {health.message}",
+                    file="",
+                    function="",
+                    line=0,
+                )
+            )
+
+    async def _publish_diagnostics(self, stamp: Time, _now: float) -> None:
+        health = self._health if self._health is not None else self.hal.health()
+        values = (
+            ("ready", "true" if health.ready else "false"),
+            ("fault", health.fault),
+            ("since", f"{health.since:.3f}"),
+            *health.values,
+        )
+        await self.diagnostics.publish(
+            DiagnosticArray.fast(
+                header=Header.fast(stamp=stamp, frame_id=""),
+                status=(
+                    DiagnosticStatus.fast(
+                        level=int(min(health.level, HealthLevel.STALE)),
+                        name=f"{self.name}: hardware",
+                        message=health.message,
+                        hardware_id=type(self.hal).__name__,
+                        values=tuple(KeyValue.fast(key=k, value=v) for k, v in values),
+                    ),
+                ),
             )
         )

@@ -9,7 +9,17 @@ from numpy.typing import NDArray
 
 from otonav.actors import topics
 from otonav.control import Pose2D
-from otonav.msgs import Header, LaserScan, NavState, Odometry, PoseStamped, Time, Twist, Vector3
+from otonav.msgs import (
+    HardwareStatus,
+    Header,
+    LaserScan,
+    NavState,
+    Odometry,
+    PoseStamped,
+    Time,
+    Twist,
+    Vector3,
+)
 from otonav.nav import GoToGoalParams, GuardParams, go_to_goal, guard_blocked
 from otonav.runtime import Actor, Input, Output
 
@@ -21,12 +31,14 @@ class Navigator(Actor):
     The goal comes from ``/goal`` (latched) or ``goal=(x, y)``; the newest wins. With no
     scan yet, or none for ``scan_timeout`` s of sim time, it will not drive forward
     (the guard fails safe): its state is then ``waiting``.
-    Publishes /cmd_vel and /nav/state (idle | driving | blocked | reached).
+    Publishes /cmd_vel and /nav/state (idle | driving | blocked | reached | fault).
+    While /hardware/status reports a fault it commands zero and its state is ``fault``.
     """
 
     odom = Input(topics.ODOM, Odometry, topics.SENSOR_QOS)
     scan = Input(topics.SCAN, LaserScan, topics.SENSOR_QOS)
     goal_in = Input(topics.GOAL, PoseStamped, topics.LATCHED)
+    hardware = Input(topics.HARDWARE_STATUS, HardwareStatus, topics.HARDWARE_QOS)
     cmd_vel = Output(topics.CMD_VEL, Twist, topics.COMMAND_QOS)
     state = Output(topics.NAV_STATE, NavState, topics.COMMAND_QOS)
 
@@ -52,6 +64,7 @@ class Navigator(Actor):
         self._scan: LaserScan | None = None
         self._scan_time = -math.inf
         self._ranges: NDArray[np.float32] = np.empty(0, np.float32)
+        self._hardware_fault = False
 
     async def run(self) -> None:
         rate = self.clock.rate(self.rate_hz)
@@ -62,6 +75,9 @@ class Navigator(Actor):
             goal_msg = self.goal_in.take_latest()
             if goal_msg is not None:
                 self.goal = (goal_msg.pose.position.x, goal_msg.pose.position.y)
+            status = self.hardware.take_latest()
+            if status is not None:
+                self._hardware_fault = status.faulted
             scan = self.scan.take_latest()
             if scan is not None:
                 self._scan = scan
@@ -71,6 +87,9 @@ class Navigator(Actor):
 
     async def _step(self, odom: Odometry | None) -> None:
         stamp = Time.from_seconds(self.clock.now())
+        if self._hardware_fault:
+            await self._publish(stamp, 0.0, 0.0, "fault", math.inf, 0.0, math.inf)
+            return
         if odom is None or self.goal is None:
             await self._publish(stamp, 0.0, 0.0, "idle", math.inf, 0.0, math.inf)
             return

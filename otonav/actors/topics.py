@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from otonav.runtime import LATCHED_QOS, SENSOR_DATA_QOS, QoS, Reliability
+from otonav.runtime import LATCHED_QOS, SENSOR_DATA_QOS, Durability, QoS, Reliability
 
 CLOCK = "/clock"
 ODOM = "/odom"
@@ -19,6 +19,8 @@ NAV_STATE = "/nav/state"
 NAV_DIAGNOSTICS = "/nav/diagnostics"
 SAFETY_STATE = "/safety/state"
 ROSOUT = "/rosout"
+HARDWARE_STATUS = "/hardware/status"
+DIAGNOSTICS = "/diagnostics"
 
 #: Sensor streams: best-effort, keep a few (a slow reader sees the newest, never stalls physics).
 SENSOR_QOS = SENSOR_DATA_QOS
@@ -30,3 +32,9 @@ COMMAND_QOS = QoS(depth=10)
 TF_QOS = QoS(depth=100)
 #: Goals and static transforms: latched (a late subscriber gets the last one).
 LATCHED = LATCHED_QOS
+#: /hardware/status: reliable, latched, a few deep (published on change only).
+HARDWARE_QOS = QoS(depth=10, durability=Durability.TRANSIENT_LOCAL)
+#: /diagnostics: periodic and for people: best-effort, never holds the bridge back.
+DIAGNOSTICS_QOS = QoS(Reliability.BEST_EFFORT, depth=10)
+#: /rosout: as in ROS 2, reliable, keep the last 1000.
+ROSOUT_QOS = QoS(depth=1000)

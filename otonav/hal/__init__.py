@@ -5,6 +5,7 @@ types, interface and fake does not load MuJoCo.
 """
 
 from otonav.hal.fake import FakeHardware
+from otonav.hal.health import HardwareHealth, HealthLevel
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.types import (
     BoxObstacle,
@@ -20,6 +21,8 @@ __all__ = (
     "BoxObstacle",
     "FakeHardware",
     "GroundTruth",
+    "HardwareHealth",
+    "HealthLevel",
     "ImuSample",
     "RangeScan",
     "RobotGeometry",

@@ -232,7 +232,9 @@ class FakeHardware(RobotHardwareInterface):
         world_angles = np.asarray(self._beam_angles + self._yaw, dtype=np.float64)
         dist = cast_rays_2d(ox, oy, world_angles, self._boxes)
         valid = (dist >= self._range_min) & (dist <= self._range_max)
-        ranges = np.where(valid, dist, np.inf).astype(np.float32)
+        # REP 117: a miss is +inf, a return closer than range_min is -inf.
+        too_close = dist < self._range_min
+        ranges = np.where(valid, dist, np.where(too_close, -np.inf, np.inf)).astype(np.float32)
         ranges.flags.writeable = False
         return RangeScan(
             angle_min=self._angle_min,

@@ -12,6 +12,7 @@ import abc
 from types import TracebackType
 from typing import Self
 
+from otonav.hal.health import HardwareHealth
 from otonav.hal.types import (
     BoxObstacle,
     GroundTruth,
@@ -23,6 +24,8 @@ from otonav.hal.types import (
 )
 
 __all__ = ["RobotHardwareInterface"]
+
+_OK = HardwareHealth()
 
 
 class RobotHardwareInterface(abc.ABC):
@@ -86,6 +89,12 @@ class RobotHardwareInterface(abc.ABC):
     def clearance_boxes(self) -> tuple[BoxObstacle, ...]:
         """Everything the robot must keep clear of: obstacles and walls."""
         return self.obstacles() + self.walls()
+
+    def health(self) -> HardwareHealth:
+        """The hardware's health now. A simulated world is always OK (the default);
+        real hardware reports starting, faults and recoveries. Cheap: the same object
+        is returned until something changes."""
+        return _OK
 
     @abc.abstractmethod
     def close(self) -> None:

@@ -599,8 +599,12 @@ class MujocoInterface(RobotHardwareInterface):
             self._range_max,
         )
         dist = self._ray_dist
-        valid = (self._ray_geom >= 0) & (dist >= self._range_min) & (dist <= self._range_max)
-        ranges = np.where(valid, dist, np.inf).astype(np.float32)
+        hit = self._ray_geom >= 0
+        valid = hit & (dist >= self._range_min) & (dist <= self._range_max)
+        # REP 117: no return within range_max is +inf; a return closer than range_min
+        # (too close to measure) is -inf, so nobody reads it as free space.
+        too_close = hit & (dist < self._range_min)
+        ranges = np.where(valid, dist, np.where(too_close, -np.inf, np.inf)).astype(np.float32)
         ranges.flags.writeable = False
         return RangeScan(
             angle_min=self._angle_min,

@@ -61,8 +61,8 @@ class RangeScan:
 
     Angles are CCW from +x of the laser frame; beam ``i`` points at
     ``angle_min + i * angle_increment`` and ``angle_max`` is the angle of the last beam.
-    ``ranges`` are metres, float32; an invalid return (no hit within ``range_max``, or
-    closer than ``range_min``) is ``+inf`` (REP 117).
+    ``ranges`` are metres, float32 (REP 117): no hit within ``range_max`` is ``+inf``;
+    a hit closer than ``range_min`` (too close to measure) is ``-inf``.
     """
 
     angle_min: float

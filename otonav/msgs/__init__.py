@@ -13,6 +13,13 @@ from otonav.msgs.geometry import (
     TwistWithCovariance,
     Vector3,
 )
+from otonav.msgs.hardware import (
+    DiagnosticArray,
+    DiagnosticStatus,
+    Frame,
+    HardwareStatus,
+    KeyValue,
+)
 from otonav.msgs.otonav_msgs import (
     NavDiagnostics,
     NavState,
@@ -25,8 +32,13 @@ from otonav.msgs.std import Clock, Header, Log, Time
 
 __all__ = (
     "Clock",
+    "DiagnosticArray",
+    "DiagnosticStatus",
+    "Frame",
+    "HardwareStatus",
     "Header",
     "Imu",
+    "KeyValue",
     "LaserScan",
     "Log",
     "Message",

@@ -21,7 +21,8 @@ class NavState(Message):
     """What the navigator is doing: ``idle`` (no goal), ``waiting`` (no fresh scan),
     ``driving``, ``avoiding`` (steering around a return), ``blocked`` (obstacle ahead,
     no way to move on), ``recovering`` (a recovery behaviour), ``unreachable`` (gave
-    up: the reason is in /nav/diagnostics) or ``reached``."""
+    up: the reason is in /nav/diagnostics), ``reached`` or ``fault`` (the hardware
+    reports a fault: it commands zero)."""
 
     ros_type: ClassVar[str] = "otonav_msgs/msg/NavState"
     header: Header = Header()
@@ -31,7 +32,8 @@ class NavState(Message):
     heading_error: float = 0.0
     """rad, wrapped to [-pi, pi]."""
     closest_ahead: float = 0.0
-    """m, closest valid return in the guard's front sector (inf if none)."""
+    """m, closest valid return in the guard's front sector (inf if none; -inf: a return
+    closer than the lidar's range_min, REP 117)."""
 
 
 class NavDiagnostics(Message):

@@ -68,7 +68,9 @@ def guard_blocked(
 
     A beam counts only if its angle is inside the front sector and its range is a
     valid return: finite, > 0, and within ``[range_min, range_max]`` (the LaserScan
-    fields; by default no extra bound). So -1 (no hit), 0, inf and NaN are ignored.
+    fields; by default no extra bound). So -1 (no hit), 0, +inf and NaN are ignored.
+    ``-inf`` in the sector (REP 117: a return too close to measure) blocks, with
+    ``closest`` = ``-inf``.
 
     Args:
         ranges: 1-D array of ranges, m.
@@ -80,7 +82,8 @@ def guard_blocked(
 
     Returns:
         ``(blocked, closest)``: ``closest`` is the smallest valid range in the sector
-        in m (``inf`` if none); ``blocked`` is ``closest <= params.stop_distance``.
+        in m (``inf`` if none, ``-inf`` if a return was too close to measure);
+        ``blocked`` is ``closest <= params.stop_distance``.
 
     Raises:
         ValueError: if ``ranges`` is not 1-D or an angle is not finite.
@@ -98,6 +101,8 @@ def guard_blocked(
     # Compare only finite entries so NaN never reaches a comparison.
     finite = np.where(valid, ranges, 0.0)
     valid &= (finite > 0.0) & (finite >= range_min) & (finite <= range_max)
+    if np.isneginf(ranges[sector]).any():
+        return True, -math.inf  # something is closer than the sensor can measure
     candidates = ranges[sector & valid]
     if candidates.size == 0:
         return False, math.inf

@@ -25,8 +25,13 @@ from typing import Final
 
 from otonav.msgs import (
     Clock,
+    DiagnosticArray,
+    DiagnosticStatus,
+    Frame,
+    HardwareStatus,
     Header,
     Imu,
+    KeyValue,
     LaserScan,
     Log,
     Message,
@@ -246,6 +251,43 @@ _KNOWN: Final[dict[type[Message], tuple[tuple[Field, ...], tuple[Constant, ...]]
             _F("omega_in", "float64"),
             _F("v_out", "float64"),
             _F("omega_out", "float64"),
+        ),
+        (),
+    ),
+    Frame: (
+        (
+            _HEADER,
+            _F("id", "uint32"),
+            _F("is_rtr", "bool"),
+            _F("is_extended", "bool"),
+            _F("is_error", "bool"),
+            _F("dlc", "uint8"),
+            _F("data", "uint8", 8),
+        ),
+        (),
+    ),
+    KeyValue: ((_F("key", "string"), _F("value", "string")), ()),
+    DiagnosticStatus: (
+        (
+            _F("level", "byte"),
+            _F("name", "string"),
+            _F("message", "string"),
+            _F("hardware_id", "string"),
+            _F("values", KeyValue, SEQUENCE),
+        ),
+        tuple(
+            Constant("byte", name, value)
+            for name, value in (("OK", 0), ("WARN", 1), ("ERROR", 2), ("STALE", 3))
+        ),
+    ),
+    DiagnosticArray: ((_HEADER, _F("status", DiagnosticStatus, SEQUENCE)), ()),
+    HardwareStatus: (
+        (
+            _HEADER,
+            _F("level", "uint8"),
+            _F("ready", "bool"),
+            _F("fault", "string"),
+            _F("message", "string"),
         ),
         (),
     ),

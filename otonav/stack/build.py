@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from otonav.actors import (
     AvoidingNavigator,
@@ -23,6 +25,13 @@ from otonav.nav.navigation import NavigationParams
 from otonav.nav.safety import SafetyParams
 from otonav.runtime import Actor
 from otonav.stack.config import StackConfig
+from otonav.stack.files import ConfigFileError
+
+if TYPE_CHECKING:
+    from otonav.hal.can import CanBusInterface
+
+_VIRTUAL_BUSES = itertools.count()
+"""Each stack's virtual CAN channel is private: concurrent stacks never hear each other."""
 
 
 def build_world(
@@ -32,9 +41,10 @@ def build_world(
     variant: Variant = "shipped",
     start: tuple[float, float, float] = (0.0, 0.0, 0.0),
 ) -> RobotHardwareInterface:
-    """The simulated robot (MuJoCo) for ``config.world``, placed at ``start``."""
+    """The robot for ``config``, placed at ``start``: the MuJoCo world, or with
+    ``hal.kind: can`` the wheels over a CAN bus with the world as sensor source."""
     world = config.world
-    return MujocoInterface(
+    sim = MujocoInterface(
         world.scene,
         lidar_beams=world.lidar_beams,
         lidar_range_min=world.lidar_range_min,
@@ -44,6 +54,81 @@ def build_world(
         variant=variant,
         start=start,
     )
+    if config.hal.kind == "mujoco":
+        return sim
+    try:
+        return _can_world(config, sim)
+    except BaseException:
+        sim.close()
+        raise
+
+
+def _can_world(config: StackConfig, world: MujocoInterface) -> CanBusInterface:
+    """The CAN bus interface over ``world``, with the drive emulator when asked."""
+    try:
+        from otonav.hal.can import (
+            BusError,
+            CanBusInterface,
+            MonitorLimits,
+            WheelAxis,
+            open_endpoint,
+        )
+        from otonav.hal.sim import AxisParams, DriveEmulator, DriveMount
+    except ImportError as exc:  # python-can is an extra
+        raise ConfigFileError(
+            f"hal.kind: can needs python-can ({exc.name} is missing): pip install 'otonav[can]'"
+        ) from None
+    can, sim = config.hal.can, config.hal.sim
+    channel = can.channel
+    if can.interface == "virtual":
+        channel = f"otonav-{can.channel}-{next(_VIRTUAL_BUSES)}"
+    try:
+        host = open_endpoint(can.interface, channel, label=can.channel)
+    except BusError as exc:
+        raise ConfigFileError(f"hal.can: {exc}") from None
+    peer = None
+    try:
+        if can.emulate:
+            params = {
+                "vel_limit": sim.vel_limit,
+                "vel_ramp_rate": sim.vel_ramp_rate,
+                "watchdog_timeout": sim.watchdog_timeout,
+                "arm_time": sim.arm_time,
+            }
+            peer = DriveEmulator(
+                open_endpoint(can.interface, channel, label=can.channel),
+                world,
+                AxisParams(sim.left_node_id, **params),
+                AxisParams(sim.right_node_id, **params),
+                left_mount=DriveMount(can.left.sign, can.left.gear_ratio),
+                right_mount=DriveMount(can.right.sign, can.right.gear_ratio),
+                heartbeat_period=sim.heartbeat_period,
+                encoder_period=sim.encoder_period,
+                seed=sim.seed,
+            )
+        limits = MonitorLimits(
+            startup_timeout=can.startup_timeout,
+            heartbeat_timeout=can.heartbeat_timeout,
+            encoder_timeout=can.encoder_timeout,
+            encoder_period=can.encoder_period,
+            max_frame_loss=can.max_frame_loss,
+            loss_window=can.loss_window,
+            recovery_delay=can.recovery_delay,
+            max_recovery_attempts=can.max_recovery_attempts,
+        )
+        return CanBusInterface(
+            host,
+            world,
+            WheelAxis(can.left.node_id, can.left.sign, can.left.gear_ratio, "left wheel"),
+            WheelAxis(can.right.node_id, can.right.sign, can.right.gear_ratio, "right wheel"),
+            limits,
+            peer=peer,
+        )
+    except BaseException:
+        host.close()
+        if peer is not None:
+            peer.close()
+        raise
 
 
 def build_actors(
@@ -74,6 +159,12 @@ def build_actors(
             cmd_timeout=base.cmd_timeout,
         ),
     ]
+    if config.hal.kind == "can" and config.hal.can.record_frames:
+        from otonav.hal.can import CanBusInterface
+        from otonav.hal.can.tap import CanFrameTap
+
+        if isinstance(hal, CanBusInterface):
+            actors.append(CanFrameTap(hal))
     if navigator:
         remap = {topics.CMD_VEL: topics.CMD_VEL_NAV} if config.safety.enabled else None
         if nav.planner == "stop":

@@ -182,6 +182,86 @@ class GuardConfig(_Section):
     stop_distance: PositiveFloat = 0.35
 
 
+class CanAxisConfig(_Section):
+    """One wheel's drive as the host sees it: CAN node id, direction sign, gearing."""
+
+    node_id: int = Field(0, ge=0, le=63)
+    sign: Literal[1, -1] = 1
+    """+1 if positive motor turns drive the wheel forward, -1 if the motor is mirrored."""
+    gear_ratio: PositiveFloat = 1.0
+    """Motor turns per wheel revolution (wheel rad = sign * 2 pi * turns / gear_ratio)."""
+
+
+class CanConfig(_Section):
+    """The wheel bus (``hal.kind: can``): python-can interface and channel, the two
+    ODrive axes, and the fault-detection limits (s of sim time)."""
+
+    interface: str = "virtual"
+    """python-can interface: ``virtual`` (in-process, with the drive emulator) or
+    ``socketcan`` (a Linux CAN link such as ``can0`` or ``vcan0``)."""
+    channel: str = "can0"
+    emulate: bool = True
+    """Run the drive emulator at the far end of the bus (false: real drives)."""
+    left: CanAxisConfig = CanAxisConfig(node_id=0, sign=-1)
+    right: CanAxisConfig = CanAxisConfig(node_id=1, sign=1)
+    encoder_period: PositiveFloat = 0.01
+    """The drives' Get_Encoder_Estimates period (ODrive ``encoder_msg_rate_ms``)."""
+    startup_timeout: PositiveFloat = 1.0
+    heartbeat_timeout: PositiveFloat = 0.25
+    encoder_timeout: PositiveFloat = 0.05
+    max_frame_loss: float = Field(0.2, ge=0.0, le=1.0)
+    """Fraction of encoder frames that may be lost over ``loss_window`` s."""
+    loss_window: PositiveFloat = 0.5
+    recovery_delay: float = Field(0.3, ge=0.0)
+    """s a fault's cause must stay clear before recovery starts."""
+    max_recovery_attempts: int = Field(3, ge=0)
+    record_frames: bool = True
+    """Publish every frame on /can/frames (and so into the recording)."""
+
+    @model_validator(mode="after")
+    def _distinct(self) -> CanConfig:
+        if self.left.node_id == self.right.node_id:
+            raise ValueError(
+                f"hal.can.left.node_id and hal.can.right.node_id must differ "
+                f"(both {self.left.node_id})"
+            )
+        return self
+
+
+class DriveSimConfig(_Section):
+    """The emulated drives (``otonav.hal.sim``): how they are configured, which can
+    differ from what the host expects (a wrong node id is a fault to detect)."""
+
+    left_node_id: int = Field(0, ge=0, le=63)
+    right_node_id: int = Field(1, ge=0, le=63)
+    heartbeat_period: PositiveFloat = 0.1
+    encoder_period: PositiveFloat = 0.01
+    vel_limit: PositiveFloat = 20.0
+    """turns/s."""
+    vel_ramp_rate: PositiveFloat = 200.0
+    """turns/s^2."""
+    watchdog_timeout: float = Field(0.2, ge=0.0)
+    """s without Set_Input_Vel before the axis stops (0: off)."""
+    arm_time: float = Field(0.01, ge=0.0)
+    seed: int = Field(0, ge=0)
+    """Seeds the injected faults' random numbers."""
+
+    @model_validator(mode="after")
+    def _distinct(self) -> DriveSimConfig:
+        if self.left_node_id == self.right_node_id:
+            raise ValueError("hal.sim.left_node_id and hal.sim.right_node_id must differ")
+        return self
+
+
+class HalConfig(_Section):
+    """Which hardware is under the HAL: the MuJoCo world directly, or the wheels over a
+    CAN bus (drives emulated on MuJoCo's wheels, or real drives)."""
+
+    kind: Literal["mujoco", "can"] = "mujoco"
+    can: CanConfig = CanConfig()
+    sim: DriveSimConfig = DriveSimConfig()
+
+
 class StackConfig(_Section):
     """Everything needed to bring the robot stack up."""
 
@@ -191,6 +271,7 @@ class StackConfig(_Section):
     nav: NavConfig = NavConfig()
     guard: GuardConfig = GuardConfig()
     safety: SafetyConfig = SafetyConfig()
+    hal: HalConfig = HalConfig()
 
     @model_validator(mode="after")
     def _consistent(self) -> StackConfig:

@@ -70,9 +70,20 @@ def test_ignores_invalid_returns() -> None:
     assert blocked is False
     assert closest == pytest.approx(2.0)
     # Only invalid returns in the sector: nothing seen.
-    invalid = np.array([-1.0, math.inf, 0.0, math.nan, -math.inf], dtype=np.float32)
+    invalid = np.array([-1.0, math.inf, 0.0, math.nan], dtype=np.float32)
     narrow = 0.01
     assert guard_blocked(invalid, -2 * narrow, narrow, PARAMS) == (False, math.inf)
+
+
+def test_too_close_to_measure_is_blocked() -> None:
+    """REP 117: -inf is a return closer than range_min. In the sector it blocks (it used
+    to be dropped as invalid: an obstacle touching the lidar read as free space)."""
+    ranges = scan(dtype=np.float32)
+    ranges[3] = -math.inf
+    assert guard_blocked(ranges, 0.0, DEG, PARAMS) == (True, -math.inf)
+    ranges[3] = 5.0
+    ranges[90] = -math.inf  # beside the robot, outside the sector: not in the way
+    assert guard_blocked(ranges, 0.0, DEG, PARAMS) == (False, 5.0)
 
 
 def test_respects_scan_range_limits() -> None:
@@ -112,6 +123,8 @@ def reference(
     closest = math.inf
     for i, r in enumerate(ranges):
         angle = math.atan2(math.sin(angle_min + i * increment), math.cos(angle_min + i * increment))
+        if abs(angle) <= params.sector_half_angle and r == -math.inf:
+            return True, -math.inf  # too close to measure
         if abs(angle) <= params.sector_half_angle and math.isfinite(r) and r > 0.0:
             closest = min(closest, r)
     return closest <= params.stop_distance, closest

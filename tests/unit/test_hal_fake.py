@@ -99,7 +99,7 @@ def test_scan_rotates_with_the_robot() -> None:
 
 def test_scan_range_limits_are_inf() -> None:
     near = FakeHardware(obstacles=[BoxObstacle(0.2, 0.0, 0.1, 0.5)])
-    assert np.isposinf(near.read_scan().ranges[180])  # 0.04 m < range_min
+    assert np.isneginf(near.read_scan().ranges[180])  # 0.04 m < range_min: REP 117 -inf
     far = FakeHardware(obstacles=[BoxObstacle(2.0, 0.0, 0.1, 0.1)], lidar_range_max=1.0)
     assert np.all(np.isposinf(far.read_scan().ranges))
 

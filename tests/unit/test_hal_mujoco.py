@@ -186,8 +186,39 @@ def test_lidar_range_limits_give_inf() -> None:
         "empty", lidar_range_min=0.5, extra_obstacles=[BoxObstacle(0.5, 0.0, 0.1, 0.3)]
     )
     scan = near.read_scan()
-    assert np.isposinf(scan.ranges[scan.beam_index(0.0)])  # 0.34 m < range_min 0.5
+    # REP 117: too close to measure is -inf (it was +inf, which reads as "free").
+    assert np.isneginf(scan.ranges[scan.beam_index(0.0)])  # 0.34 m < range_min 0.5
     assert scan.ranges[scan.beam_index(math.pi)] == pytest.approx(5.06, abs=0.005)
+
+
+def _mirrored(ranges: np.ndarray) -> np.ndarray:
+    """The scan a lidar with the wrong handedness would give: the beam at angle a reads
+    what is at -a (beam i at -pi + i*2pi/n swaps with beam n - i)."""
+    n = ranges.size
+    return ranges[(n - np.arange(n)) % n]
+
+
+def _left_box_is_on_the_left(ranges: np.ndarray, left: int, right: int, expected: float) -> bool:
+    return bool(abs(ranges[left] - expected) < 0.01 and np.isposinf(ranges[right]))
+
+
+@pytest.mark.parametrize("yaw", [0.0, 1.0])
+def test_lidar_handedness_a_box_at_plus_y_is_hit_by_the_plus_half_pi_beam(yaw: float) -> None:
+    """REP 103: x forward, y left, angles CCW. A box on the robot's left (+y in its
+    frame) must be seen by the +pi/2 beam, not the -pi/2 one; a mirrored scan fails."""
+    # 1.5 m to the robot's left, whatever its heading; the laser is 0.06 m ahead of
+    # base_link, so the +pi/2 beam starts 0.06 m forward and runs parallel to the box.
+    left_x, left_y = -math.sin(yaw) * 1.5, math.cos(yaw) * 1.5
+    box = BoxObstacle(left_x, left_y, 0.2, 0.2, yaw)
+    hw = MujocoInterface("empty", extra_obstacles=[box], lidar_range_max=3.0, start=(0, 0, yaw))
+    scan = hw.read_scan()
+    left, right = scan.beam_index(math.pi / 2), scan.beam_index(-math.pi / 2)
+    assert scan.angles[left] == pytest.approx(math.pi / 2)
+    assert hw.geom_name(int(hw.scan_hit_geoms()[left])) == "obstacle_extra_0"
+    expected = 1.5 - 0.2  # the box's near face, along the beam
+    assert _left_box_is_on_the_left(scan.ranges, left, right, expected)
+    # The check has teeth: the same scan mirrored is caught.
+    assert not _left_box_is_on_the_left(_mirrored(scan.ranges), left, right, expected)
 
 
 def test_reading_sensors_does_not_perturb_physics() -> None:

@@ -24,6 +24,10 @@ from mcap_ros2.decoder import DecoderFactory
 from otonav import msgs
 from otonav.msgs import (
     Clock,
+    DiagnosticArray,
+    DiagnosticStatus,
+    Frame,
+    HardwareStatus,
     Header,
     Imu,
     LaserScan,
@@ -45,6 +49,7 @@ from otonav.msgs import (
     Vector3,
     WheelCommand,
 )
+from otonav.msgs import KeyValue as DiagKeyValue
 from otonav.record.cdr import encode
 from otonav.record.cdr_decode import decode as decode_cdr
 from otonav.record.schemas import schema_for
@@ -135,6 +140,8 @@ def assert_same(decoded: Any, original: Message, where: str = "") -> None:
     for name in kind.model_fields:
         path = f"{where}{kind.__name__}.{name}"
         want, got = getattr(original, name), getattr(decoded, name)
+        if isinstance(got, bytes):  # mcap_ros2 gives uint8[N] as bytes
+            got = tuple(got)
         if isinstance(want, Message):
             assert_same(got, want, path + ".")
         elif isinstance(want, tuple) and want and isinstance(want[0], Message):
@@ -206,6 +213,32 @@ def samples() -> dict[type[Message], list[Message]]:
         Time: list(STAMPS),
         Header: list(HEADERS),
         Clock: [Clock(clock=s) for s in STAMPS],
+        Frame: [
+            Frame(header=HEADERS[1], id=0x02D, dlc=8, data=(0, 0, 0x20, 0xC0, 0, 0, 0x80, 0x3E)),
+            Frame(header=HEADERS[6], id=0x40, is_error=True, dlc=0, data=(0,) * 8),
+            Frame(id=0x7FF, is_rtr=True, is_extended=False, dlc=1, data=(255,) + (0,) * 7),
+        ],
+        DiagnosticStatus: [
+            DiagnosticStatus(
+                level=DiagnosticStatus.ERROR,
+                name="bridge: hardware",
+                message="node 9 (left wheel): no heartbeat",
+                hardware_id="CanBusInterface",
+                values=(DiagKeyValue(key="ready", value="false"), DiagKeyValue(key="ŝ")),
+            ),
+            DiagnosticStatus(),
+        ],
+        DiagnosticArray: [
+            DiagnosticArray(
+                header=HEADERS[2],
+                status=(DiagnosticStatus(level=1, name="a"), DiagnosticStatus(message="b")),
+            ),
+            DiagnosticArray(),
+        ],
+        HardwareStatus: [
+            HardwareStatus(header=HEADERS[3], level=2, ready=False, fault="bus_off", message="x"),
+            HardwareStatus(),
+        ],
         Log: [
             Log(stamp=STAMPS[1], level=Log.WARN, name="nav", msg="blocked", line=42),
             Log(

@@ -1,0 +1,121 @@
+"""The python-can boundary: the only otonav module that imports :mod:`can`.
+
+A :class:`CanEndpoint` wraps one python-can bus and speaks :class:`RawFrame` (id, data,
+flags) to the rest of otonav. It never starts a thread: :meth:`CanEndpoint.poll`
+drains what arrived with ``recv(timeout=0)``, called from sim time (no ``Notifier``,
+whose reader thread would run on the wall clock, notes/can-odrive.md).
+
+On the ``virtual`` interface every endpoint opened on the same channel in this process
+hears every other one, so a stack and its drive emulator meet there. Error frames use
+the Linux SocketCAN error classes (``linux/can/error.h``): a controller that went
+bus-off reports ``CAN_ERR_BUSOFF``, and one restarted after bus-off ``CAN_ERR_RESTARTED``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Final
+
+import can
+
+__all__ = [
+    "CAN_ERR_BUSOFF",
+    "CAN_ERR_RESTARTED",
+    "BusError",
+    "CanEndpoint",
+    "RawFrame",
+    "open_endpoint",
+]
+
+CAN_ERR_BUSOFF: Final = 0x40
+"""Error class bit of a controller in bus-off (SocketCAN error frame id)."""
+CAN_ERR_RESTARTED: Final = 0x100
+"""Error class bit of a controller restarted after bus-off."""
+
+
+@dataclass(frozen=True, slots=True)
+class RawFrame:
+    """One classic CAN frame: 11-bit ``arbitration_id``, up to 8 ``data`` bytes."""
+
+    arbitration_id: int
+    data: bytes = b""
+    is_error: bool = False
+    is_remote: bool = False
+
+
+class BusError(RuntimeError):
+    """The bus refused a frame or could not be opened (bus-off, link down, no driver)."""
+
+
+class CanEndpoint:
+    """One node's access to a CAN bus: ``send`` frames, ``poll`` what arrived."""
+
+    def __init__(self, bus: can.BusABC, channel: str) -> None:
+        self._bus = bus
+        self.channel = channel
+        self._closed = False
+
+    def send(self, frame: RawFrame, timestamp: float = 0.0) -> None:
+        """Put ``frame`` on the bus (``timestamp``: sim seconds, kept on virtual buses)."""
+        message = can.Message(
+            timestamp=timestamp,
+            arbitration_id=frame.arbitration_id,
+            data=frame.data,
+            is_extended_id=False,
+            is_error_frame=frame.is_error,
+            is_remote_frame=frame.is_remote,
+            check=False,
+        )
+        # VirtualBus deep-copies every frame per receiver: immutable bytes copy in
+        # 4.6 us where the bytearray python-can made takes 11 us (measured).
+        message.data = frame.data  # type: ignore[assignment]
+        try:
+            self._bus.send(message, timeout=0.0)
+        except can.CanError as exc:
+            raise BusError(f"CAN send on {self.channel} failed: {exc}") from exc
+
+    def poll(self) -> list[RawFrame]:
+        """Every frame received since the last poll, in arrival order; never blocks."""
+        frames: list[RawFrame] = []
+        recv = self._bus.recv
+        try:
+            while (message := recv(0.0)) is not None:
+                frames.append(
+                    RawFrame(
+                        message.arbitration_id,
+                        bytes(message.data),
+                        message.is_error_frame,
+                        message.is_remote_frame,
+                    )
+                )
+        except can.CanError as exc:
+            raise BusError(f"CAN receive on {self.channel} failed: {exc}") from exc
+        return frames
+
+    def close(self) -> None:
+        """Shut the bus down. Idempotent."""
+        if not self._closed:
+            self._closed = True
+            self._bus.shutdown()
+
+
+def open_endpoint(interface: str, channel: str, *, label: str | None = None) -> CanEndpoint:
+    """Open ``channel`` on python-can ``interface`` (``virtual``, ``socketcan``, ...).
+
+    ``label`` is the name the endpoint reports as its channel (default ``channel``): a
+    private virtual channel keeps the name people configured.
+
+    Raises :class:`BusError` naming the interface and channel when python-can cannot
+    (an unknown interface, a missing ``can0``). The bitrate of a SocketCAN link is set
+    by ``ip link``, not here.
+    """
+    kwargs: dict[str, Any] = {}
+    if interface == "virtual":
+        kwargs["preserve_timestamps"] = True  # sim time, not the wall clock
+    try:
+        bus = can.Bus(interface=interface, channel=channel, **kwargs)
+    except (can.CanError, OSError, ValueError, ImportError, NotImplementedError) as exc:
+        raise BusError(
+            f"cannot open CAN channel {channel!r} on interface {interface!r}: {exc}"
+        ) from exc
+    return CanEndpoint(bus, channel if label is None else label)

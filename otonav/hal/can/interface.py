@@ -1,0 +1,323 @@
+"""The robot's wheels over a CAN bus: ODrive drives speaking CAN Simple.
+
+:class:`CanBusInterface` is a :class:`~otonav.hal.interface.RobotHardwareInterface`
+composed of a *wheel bus* (a :class:`~otonav.hal.can.bus.CanEndpoint`) and a *sensor
+source*: another interface that supplies the IMU, the lidar, geometry and time. On a
+real robot that source is the sensor drivers; in simulation it is the MuJoCo world,
+whose wheels the drive emulator at the far end of the bus turns. This interface never
+writes the world's wheels nor reads its joints: every wheel command leaves as a
+``Set_Input_Vel`` frame and every encoder reading arrives as a ``Get_Encoder_Estimates``
+frame.
+
+Time: :meth:`advance` steps the sensor source in chunks, stopping at every instant
+the *peer* on the bus (the emulator: anything with ``next_event_tick`` and
+``exchange``) needs; at each stop the peer exchanges frames, this interface drains the
+bus with ``recv(timeout=0)``, and the :class:`~otonav.hal.can.monitor.DriveMonitor`
+checks the drives. No thread and no wall clock: the same run gives the same frames.
+With no peer (real drives) the bus is drained at every ``advance``.
+
+Startup: construction sends Clear_Errors, Set_Controller_Mode (velocity, passthrough)
+and Set_Axis_State(CLOSED_LOOP_CONTROL) to both drives; :meth:`health` is "starting"
+(not ready: the base holds zero) until a later heartbeat of each shows closed loop,
+or a fault naming the silent node id after ``startup_timeout`` s of sim time.
+:meth:`close` sets both drives IDLE.
+
+Units: wheel rad = ``sign * 2 pi * motor turns / gear_ratio`` per axis.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+from typing import Protocol
+
+from otonav.hal.can import protocol as p
+from otonav.hal.can.bus import CAN_ERR_BUSOFF, CAN_ERR_RESTARTED, BusError, CanEndpoint, RawFrame
+from otonav.hal.can.monitor import Action, DriveMonitor, MonitorLimits, NodeLabel
+from otonav.hal.health import HardwareHealth
+from otonav.hal.interface import RobotHardwareInterface
+from otonav.hal.types import (
+    BoxObstacle,
+    GroundTruth,
+    ImuSample,
+    RangeScan,
+    RobotGeometry,
+    WheelCommand,
+    WheelState,
+)
+
+__all__ = ["BusPeer", "CanBusInterface", "WheelAxis"]
+
+_TWO_PI = 2.0 * math.pi
+
+
+@dataclass(frozen=True, slots=True)
+class WheelAxis:
+    """One wheel's drive: its CAN node id, direction sign and gear ratio."""
+
+    node_id: int
+    sign: int = 1
+    gear_ratio: float = 1.0
+    """Motor turns per wheel revolution."""
+    label: str = "wheel"
+
+    def __post_init__(self) -> None:
+        if not 0 <= self.node_id <= p.MAX_NODE_ID:
+            raise ValueError(f"{self.label}: node id must be 0..{p.MAX_NODE_ID}")
+        if self.sign not in (1, -1) or not self.gear_ratio > 0:
+            raise ValueError(f"{self.label}: sign must be +-1 and gear_ratio > 0")
+
+    def turns_per_rad(self) -> float:
+        return self.sign * self.gear_ratio / _TWO_PI
+
+
+class BusPeer(Protocol):
+    """A simulated node at the far end of the bus, stepped on sim ticks."""
+
+    def next_event_tick(self, now: int) -> int: ...
+
+    def exchange(self, now: int) -> None: ...
+
+    def close(self) -> None: ...
+
+
+class CanBusInterface(RobotHardwareInterface):
+    """Wheels on ODrive CAN Simple drives, sensors and time from ``sensors``.
+
+    ``frame_log`` bounds the frames kept for :meth:`take_frames` (the recording tap);
+    older ones are dropped and counted in :attr:`frames_dropped_from_log`.
+    """
+
+    def __init__(
+        self,
+        endpoint: CanEndpoint,
+        sensors: RobotHardwareInterface,
+        left: WheelAxis,
+        right: WheelAxis,
+        limits: MonitorLimits = MonitorLimits(),
+        *,
+        peer: BusPeer | None = None,
+        frame_log: int = 50_000,
+    ) -> None:
+        if left.node_id == right.node_id:
+            raise ValueError(f"left and right wheel share node id {left.node_id}")
+        self._endpoint = endpoint
+        self._sensors = sensors
+        self._peer = peer
+        self._axes = (left, right)
+        self._index = {left.node_id: 0, right.node_id: 1}
+        self._scale = (left.turns_per_rad(), right.turns_per_rad())
+        self.monitor = DriveMonitor(
+            (NodeLabel(left.node_id, left.label), NodeLabel(right.node_id, right.label)),
+            limits,
+        )
+        self._pos = [0.0, 0.0]  # wheel rad, from the last encoder frames
+        self._vel = [0.0, 0.0]
+        self._wheels: WheelState | None = WheelState(0.0, 0.0, 0.0, 0.0)
+        self._log: deque[tuple[float, RawFrame]] = deque(maxlen=frame_log)
+        self._logged = 0
+        self.frames_dropped_from_log = 0
+        self._closed = False
+        self._serviced_at = -1  # the tick of the last bus instant
+        self._sent = False  # frames sent since then (the peer must hear them)
+        self._tick = sensors.tick
+        self._start(sensors.ticks * self._tick)
+
+    @property
+    def peer(self) -> BusPeer | None:
+        """The simulated far end of the bus (the drive emulator), if any."""
+        return self._peer
+
+    @property
+    def channel(self) -> str:
+        return self._endpoint.channel
+
+    # -- time ----------------------------------------------------------------------------
+
+    @property
+    def tick(self) -> float:
+        return self._tick
+
+    @property
+    def ticks(self) -> int:
+        return self._sensors.ticks
+
+    def advance(self, n: int) -> None:
+        self._check_open()
+        if n < 0:
+            raise ValueError(f"cannot advance by a negative number of ticks ({n})")
+        sensors, peer = self._sensors, self._peer
+        target = sensors.ticks + n
+        while True:
+            now = sensors.ticks
+            # The instant we stopped at last time was serviced then; again only if
+            # something was sent since (a wheel command the drives must apply now).
+            if now != self._serviced_at or self._sent:
+                self._service(now)
+            if now >= target:
+                return
+            nxt = target if peer is None else min(target, peer.next_event_tick(now))
+            sensors.advance(nxt - now)
+
+    def _service(self, now: int) -> None:
+        """One bus instant: the peer exchanges, we drain and decode, the monitor checks."""
+        t = now * self._tick
+        self._serviced_at = now
+        self._sent = False
+        if self._peer is not None:
+            self._peer.exchange(now)
+        monitor = self.monitor
+        try:
+            frames = self._endpoint.poll()
+        except BusError as exc:
+            monitor.bus_off(t, str(exc))
+            frames = []
+        for frame in frames:
+            self._record(t, frame)
+            if frame.is_error:
+                if frame.arbitration_id & CAN_ERR_BUSOFF:
+                    monitor.bus_off(t, "error frame from the controller (CAN_ERR_BUSOFF)")
+                if frame.arbitration_id & CAN_ERR_RESTARTED:
+                    monitor.bus_restarted(t)
+                continue
+            if frame.is_remote:
+                continue
+            node, cmd = p.split_id(frame.arbitration_id)
+            try:
+                if cmd == p.CMD_GET_ENCODER_ESTIMATES:
+                    self._on_encoder(node, frame.data, t)
+                elif cmd == p.CMD_HEARTBEAT:
+                    beat = p.decode_heartbeat(frame.data)
+                    monitor.heartbeat(node, beat.axis_error, beat.axis_state, t)
+            except ValueError:  # a short payload: ignored, like a bad frame on the wire
+                continue
+        self._apply(monitor.check(t), t)
+
+    def _on_encoder(self, node: int, data: bytes, t: float) -> None:
+        self.monitor.encoder(node, t)
+        i = self._index.get(node)
+        if i is None:
+            return
+        position, velocity = p.unpack_two_f32(data)
+        scale = self._scale[i]
+        self._pos[i] = position / scale
+        self._vel[i] = velocity / scale
+        self._wheels = None
+
+    def _apply(self, actions: tuple[Action, ...], t: float) -> None:
+        for action in actions:
+            if action is Action.ESTOP_ALL:
+                for axis in self._axes:
+                    self._send(*p.estop(axis.node_id), t)
+            elif action is Action.ZERO_ALL:
+                for axis in self._axes:
+                    self._send(*p.set_input_vel(axis.node_id, 0.0), t)
+            elif action is Action.START_ALL:
+                self._start(t)
+
+    def _start(self, t: float) -> None:
+        for axis in self._axes:
+            self._send(*p.clear_errors(axis.node_id), t)
+            self._send(
+                *p.set_controller_mode(
+                    axis.node_id, p.ControlMode.VELOCITY_CONTROL, p.InputMode.PASSTHROUGH
+                ),
+                t,
+            )
+            self._send(*p.set_axis_state(axis.node_id, p.AxisState.CLOSED_LOOP_CONTROL), t)
+        self.monitor.requested(t)
+
+    def _send(self, ident: int, data: bytes, t: float) -> None:
+        frame = RawFrame(ident, data)
+        try:
+            self._endpoint.send(frame, t)
+        except BusError as exc:
+            self.monitor.bus_off(t, str(exc))
+            return
+        self._sent = True
+        self._record(t, frame)
+
+    def _record(self, t: float, frame: RawFrame) -> None:
+        log = self._log
+        if len(log) == log.maxlen:
+            self.frames_dropped_from_log += 1
+        log.append((t, frame))
+
+    def take_frames(self) -> list[tuple[float, RawFrame]]:
+        """Frames sent and received since the last call, with their sim times (s)."""
+        frames = list(self._log)
+        self._log.clear()
+        return frames
+
+    # -- I/O -----------------------------------------------------------------------------
+
+    def write(self, cmd: WheelCommand) -> None:
+        """Send both setpoints as Set_Input_Vel; zero while the drives are not drivable
+        (starting, faulted, recovering)."""
+        self._check_open()
+        if not (math.isfinite(cmd.left) and math.isfinite(cmd.right)):
+            raise ValueError(f"wheel command must be finite, got {cmd}")
+        drivable = self.monitor.health.drivable
+        t = self._sensors.ticks * self._tick
+        left, right = self._axes
+        sl, sr = self._scale
+        self._send(*p.set_input_vel(left.node_id, cmd.left * sl if drivable else 0.0), t)
+        self._send(*p.set_input_vel(right.node_id, cmd.right * sr if drivable else 0.0), t)
+
+    def read_wheels(self) -> WheelState:
+        wheels = self._wheels
+        if wheels is None:
+            pos, vel = self._pos, self._vel
+            wheels = self._wheels = WheelState(pos[0], pos[1], vel[0], vel[1])
+        return wheels
+
+    def health(self) -> HardwareHealth:
+        return self.monitor.health
+
+    def read_imu(self) -> ImuSample:
+        return self._sensors.read_imu()
+
+    def read_scan(self) -> RangeScan:
+        return self._sensors.read_scan()
+
+    def ground_truth(self) -> GroundTruth:
+        return self._sensors.ground_truth()
+
+    @property
+    def geometry(self) -> RobotGeometry:
+        return self._sensors.geometry
+
+    def obstacles(self) -> tuple[BoxObstacle, ...]:
+        return self._sensors.obstacles()
+
+    def walls(self) -> tuple[BoxObstacle, ...]:
+        return self._sensors.walls()
+
+    @property
+    def sensors(self) -> RobotHardwareInterface:
+        """The sensor source (in simulation: the world, for viewers and ground truth)."""
+        return self._sensors
+
+    def close(self) -> None:
+        """Set both drives IDLE, let a simulated peer hear it, close the bus. Idempotent."""
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            t = self._sensors.ticks * self._tick
+            for axis in self._axes:
+                self._send(*p.set_axis_state(axis.node_id, p.AxisState.IDLE), t)
+            if self._peer is not None:
+                self._peer.exchange(self._sensors.ticks)
+        finally:
+            try:
+                self._endpoint.close()
+            finally:
+                if self._peer is not None:
+                    self._peer.close()
+                self._sensors.close()
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise RuntimeError("CanBusInterface is closed")

@@ -1,0 +1,368 @@
+"""Watching the drives: startup, fault detection, recovery. Pure logic on sim time.
+
+The interface feeds a :class:`DriveMonitor` what it hears (heartbeats, encoder frames,
+error frames, failed sends) and calls :meth:`DriveMonitor.check` at every instant it
+polls the bus. ``check`` returns the :class:`Action` frames to send and keeps
+:attr:`DriveMonitor.health` current. Phases:
+
+    STARTING --all nodes report CLOSED_LOOP_CONTROL--> RUNNING --fault--> FAULT
+    FAULT --cause clear for recovery_delay--> RECOVERING (Clear_Errors + closed loop)
+    RECOVERING --all nodes in closed loop--> RUNNING      (logged as a recovery)
+    STARTING / RECOVERING --startup_timeout--> FAULT       (naming the silent node ids)
+
+Faults, and what the interface does on detection (ADR "CAN interface"):
+
+=================  ======================================================  ==========
+fault              detected when                                           action
+=================  ======================================================  ==========
+startup_timeout    a node does not report closed loop within the timeout   Estop all
+heartbeat_lost     a node's heartbeat is older than ``heartbeat_timeout``  Estop all
+axis_error         a heartbeat shows an error, or a state not closed loop  Estop all
+encoder_stale      a node's encoder estimate is older than the timeout     zero vel
+frame_loss         encoder frames lost over ``loss_window`` > max          zero vel
+bus_off            an error frame says bus-off, or a send fails            zero vel
+=================  ======================================================  ==========
+
+A fault latches; recovery starts only once its cause has been clear for
+``recovery_delay`` s, at most ``max_recovery_attempts`` times in a row.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections import deque
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from otonav.hal.can.protocol import AxisState, error_names
+from otonav.hal.health import HardwareHealth, HealthLevel
+
+__all__ = ["Action", "DriveMonitor", "MonitorLimits", "NodeLabel", "Phase"]
+
+
+class Phase(enum.Enum):
+    STARTING = "starting"
+    RUNNING = "running"
+    FAULT = "fault"
+    RECOVERING = "recovering"
+
+
+class Action(enum.Enum):
+    """What the interface must put on the bus after a check."""
+
+    ESTOP_ALL = "estop_all"
+    ZERO_ALL = "zero_all"
+    START_ALL = "start_all"
+    """Clear_Errors, Set_Controller_Mode (velocity), Set_Axis_State(CLOSED_LOOP)."""
+
+
+@dataclass(frozen=True, slots=True)
+class NodeLabel:
+    node_id: int
+    label: str
+
+    def __str__(self) -> str:
+        return f"node {self.node_id} ({self.label})"
+
+
+@dataclass(frozen=True, slots=True)
+class MonitorLimits:
+    """Seconds of sim time, and the tolerated encoder frame loss (0..1)."""
+
+    startup_timeout: float = 1.0
+    heartbeat_timeout: float = 0.25
+    encoder_timeout: float = 0.05
+    encoder_period: float = 0.01
+    max_frame_loss: float = 0.2
+    loss_window: float = 0.5
+    recovery_delay: float = 0.3
+    max_recovery_attempts: int = 3
+
+
+class _Node:
+    __slots__ = ("arrivals", "encoder_at", "error", "heartbeat_at", "label", "state")
+
+    def __init__(self, label: NodeLabel) -> None:
+        self.label = label
+        self.heartbeat_at = -math.inf
+        self.encoder_at = -math.inf
+        self.error = 0
+        self.state = int(AxisState.UNDEFINED)
+        self.arrivals: deque[float] = deque()
+
+
+class DriveMonitor:
+    """Startup, fault detection and recovery for the drives ``nodes``."""
+
+    def __init__(self, nodes: Sequence[NodeLabel], limits: MonitorLimits = MonitorLimits()):
+        self.limits = limits
+        self._nodes = {n.node_id: _Node(n) for n in nodes}
+        self._foreign: set[int] = set()
+        self.phase = Phase.STARTING
+        self._requested_at = 0.0
+        self._running_since = 0.0
+        self._fault = ""
+        self._fault_message = ""
+        self._clear_since: float | None = None
+        self._attempts = 0
+        self._bus_off = False
+        self._bus_restarted = False
+        self._loss_due = -math.inf
+        self.events: list[tuple[float, str]] = []
+        self.health = HardwareHealth(
+            level=HealthLevel.WARN,
+            ready=False,
+            fault="",
+            message="starting: waiting for "
+            + ", ".join(str(n) for n in nodes)
+            + " to report CLOSED_LOOP_CONTROL",
+            since=0.0,
+        )
+
+    # -- what the interface heard --------------------------------------------------------
+
+    def heartbeat(self, node_id: int, error: int, state: int, now: float) -> None:
+        node = self._nodes.get(node_id)
+        if node is None:
+            self._foreign.add(node_id)
+            return
+        node.heartbeat_at, node.error, node.state = now, error, state
+
+    def encoder(self, node_id: int, now: float) -> None:
+        node = self._nodes.get(node_id)
+        if node is None:
+            self._foreign.add(node_id)
+            return
+        node.encoder_at = now
+        node.arrivals.append(now)
+
+    def bus_off(self, now: float, detail: str) -> None:
+        self._bus_off = True
+        self._bus_restarted = False
+        if self.phase is not Phase.FAULT or self._fault != "bus_off":
+            self._enter_fault(now, "bus_off", f"CAN bus-off: {detail}")
+
+    def bus_restarted(self, now: float) -> None:
+        if self._bus_off:
+            self._bus_off = False
+            self._bus_restarted = True
+            self.events.append((now, "CAN controller restarted after bus-off"))
+
+    def requested(self, now: float) -> None:
+        """The interface sent the closed-loop request (startup or recovery)."""
+        self._requested_at = now
+
+    # -- the check -----------------------------------------------------------------------
+
+    def check(self, now: float) -> tuple[Action, ...]:
+        phase = self.phase
+        if phase is Phase.STARTING or phase is Phase.RECOVERING:
+            return self._check_starting(now)
+        if phase is Phase.RUNNING:
+            return self._check_running(now)
+        return self._check_fault(now)
+
+    def _in_closed_loop(self, node: _Node) -> bool:
+        return (
+            node.heartbeat_at > self._requested_at
+            and node.error == 0
+            and node.state == AxisState.CLOSED_LOOP_CONTROL
+        )
+
+    def _check_starting(self, now: float) -> tuple[Action, ...]:
+        if self._bus_off:
+            return (Action.ZERO_ALL,)
+        nodes = self._nodes.values()
+        if all(self._in_closed_loop(n) for n in nodes):
+            recovering = self.phase is Phase.RECOVERING
+            self.phase = Phase.RUNNING
+            self._running_since = now
+            self._attempts = 0
+            for node in nodes:
+                node.arrivals.clear()
+            names = ", ".join(str(n.label) for n in nodes)
+            if recovering:
+                message = (
+                    f"recovered from {self._fault} ({self._fault_message}): {names} "
+                    "in CLOSED_LOOP_CONTROL again"
+                )
+            else:
+                message = f"running: {names} in CLOSED_LOOP_CONTROL"
+            self._set(now, HealthLevel.OK, True, "", message)
+            self._fault = self._fault_message = ""
+            return ()
+        if now - self._requested_at > self.limits.startup_timeout + 1e-9:
+            if self.phase is Phase.RECOVERING:
+                fault = self._fault
+                cause = self._fault_message.split("; recovery from")[0]
+                message = f"{cause}; recovery from {fault} failed: {self._startup_message(now)}"
+            else:
+                fault, message = "startup_timeout", self._startup_message(now)
+            self._enter_fault(now, fault, message)
+            return (Action.ESTOP_ALL,)
+        return ()
+
+    def _startup_message(self, now: float) -> str:
+        parts = []
+        for node in self._nodes.values():
+            if self._in_closed_loop(node):
+                continue
+            if node.heartbeat_at <= self._requested_at:
+                parts.append(f"{node.label}: no heartbeat")
+            else:
+                parts.append(
+                    f"{node.label}: state {_state_name(node.state)}, "
+                    f"axis error 0x{node.error:08x} ({error_names(node.error)})"
+                )
+        text = (
+            "; ".join(parts)
+            + f" within {self.limits.startup_timeout:g} s of sim time after requesting "
+            f"CLOSED_LOOP_CONTROL (at {self._requested_at:.2f} s)"
+        )
+        foreign = sorted(self._foreign)
+        heard = any(n.heartbeat_at > self._requested_at for n in self._nodes.values())
+        if foreign:
+            text += f"; drives answering on this bus: node ids {foreign} (check hal.can.*.node_id)"
+        elif not heard:
+            text += "; no drive answered at all (check wiring, power and hal.can.channel)"
+        return text
+
+    def _check_running(self, now: float) -> tuple[Action, ...]:
+        limits = self.limits
+        for node in self._nodes.values():
+            age = now - node.heartbeat_at
+            if age > limits.heartbeat_timeout + 1e-9:
+                self._enter_fault(
+                    now,
+                    "heartbeat_lost",
+                    f"{node.label}: no heartbeat for {age:.3f} s of sim time "
+                    f"(timeout {limits.heartbeat_timeout:g} s)",
+                )
+                return (Action.ESTOP_ALL,)
+            if node.error or node.state != AxisState.CLOSED_LOOP_CONTROL:
+                self._enter_fault(
+                    now,
+                    "axis_error",
+                    f"{node.label}: axis error 0x{node.error:08x} "
+                    f"({error_names(node.error)}), state {_state_name(node.state)}",
+                )
+                return (Action.ESTOP_ALL,)
+            age = now - node.encoder_at
+            if age > limits.encoder_timeout + 1e-9:
+                self._enter_fault(
+                    now,
+                    "encoder_stale",
+                    f"{node.label}: no encoder estimate for {age:.3f} s of sim time "
+                    f"(timeout {limits.encoder_timeout:g} s; frames delayed or lost)",
+                )
+                return (Action.ZERO_ALL,)
+            # The loss is judged ten times per window, not at every instant.
+            if now < self._loss_due:
+                continue
+            loss = self._loss(node, now, self._running_since)
+            if loss is not None and loss > limits.max_frame_loss:
+                self._enter_fault(
+                    now,
+                    "frame_loss",
+                    f"{node.label}: {loss:.0%} of encoder frames lost over the last "
+                    f"{limits.loss_window:g} s (max {limits.max_frame_loss:.0%})",
+                )
+                return (Action.ZERO_ALL,)
+        if now >= self._loss_due:
+            self._loss_due = now + limits.loss_window / 10.0
+        return ()
+
+    def _loss(self, node: _Node, now: float, since: float) -> float | None:
+        """Fraction of encoder frames missing over the loss window; None until a whole
+        window has passed ``since``."""
+        limits = self.limits
+        start = now - limits.loss_window
+        arrivals = node.arrivals
+        while arrivals and arrivals[0] <= start + 1e-9:
+            arrivals.popleft()
+        if now - since < limits.loss_window - 1e-9:
+            return None
+        expected = limits.loss_window / limits.encoder_period
+        return max(0.0, 1.0 - len(arrivals) / expected)
+
+    def _cause_clear(self, now: float) -> bool:
+        limits = self.limits
+        if self._bus_off:
+            return False
+        fresh = all(now - n.heartbeat_at <= limits.heartbeat_timeout for n in self._nodes.values())
+        if self._fault in ("encoder_stale", "frame_loss"):
+            for node in self._nodes.values():
+                loss = self._loss(node, now, -math.inf)
+                if now - node.encoder_at > limits.encoder_timeout or (
+                    loss is not None and loss > limits.max_frame_loss
+                ):
+                    return False
+        return fresh
+
+    def _check_fault(self, now: float) -> tuple[Action, ...]:
+        limits = self.limits
+        if not self._cause_clear(now):
+            self._clear_since = None
+            return ()
+        if self._clear_since is None:
+            self._clear_since = now
+        if now - self._clear_since < limits.recovery_delay - 1e-9:
+            return ()
+        if self._attempts >= limits.max_recovery_attempts:
+            if "gave up" not in self.health.message:
+                self._set(
+                    now,
+                    HealthLevel.ERROR,
+                    False,
+                    self._fault,
+                    f"{self._fault_message}; gave up after {self._attempts} recovery "
+                    "attempts: restart the drives",
+                )
+            return ()
+        self._attempts += 1
+        self.phase = Phase.RECOVERING
+        self._requested_at = now
+        self._bus_restarted = False
+        self._set(
+            now,
+            HealthLevel.WARN,
+            False,
+            self._fault,
+            f"recovering from {self._fault} (attempt {self._attempts}): cause clear for "
+            f"{now - self._clear_since:.2f} s; Clear_Errors and CLOSED_LOOP_CONTROL sent to "
+            + ", ".join(str(n.label) for n in self._nodes.values()),
+        )
+        self._clear_since = None
+        return (Action.START_ALL,)
+
+    def _enter_fault(self, now: float, fault: str, message: str) -> None:
+        self.phase = Phase.FAULT
+        self._fault, self._fault_message = fault, message
+        self._clear_since = None
+        self._set(now, HealthLevel.ERROR, False, fault, message)
+
+    def _set(self, now: float, level: HealthLevel, ready: bool, fault: str, message: str) -> None:
+        values = tuple(
+            (
+                f"node {n.label.node_id}",
+                f"{n.label.label}: state {_state_name(n.state)}, error 0x{n.error:08x}",
+            )
+            for n in self._nodes.values()
+        )
+        self.health = HardwareHealth(
+            level=level,
+            ready=ready,
+            fault=fault,
+            message=message,
+            since=now,
+            values=(("phase", self.phase.value), *values),
+        )
+        self.events.append((now, message))
+
+
+def _state_name(state: int) -> str:
+    try:
+        return AxisState(state).name
+    except ValueError:
+        return str(state)

@@ -1,0 +1,79 @@
+"""The CAN tap: publishes every frame the interface sent or received on ``/can/frames``
+(``can_msgs/msg/Frame``), so a recording shows the bus like ``candump`` would.
+
+It only reads the interface's frame log (:meth:`CanBusInterface.take_frames`); it never
+commands the hardware. The stack builder adds it when ``hal.kind`` is ``can``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from typing import Final
+
+import anyio
+
+from otonav.hal.can.bus import RawFrame
+from otonav.hal.can.interface import CanBusInterface
+from otonav.msgs import Frame, Header, Time
+from otonav.runtime import Actor, Output, QoS
+
+__all__ = ["FRAMES_QOS", "FRAMES_TOPIC", "CanFrameTap"]
+
+FRAMES_TOPIC: Final = "/can/frames"
+FRAMES_QOS: Final = QoS(depth=200)
+"""Reliable: a recording must hold every frame (~330 per simulated second)."""
+
+_PAD: Final = tuple(bytes(8 - n) for n in range(9))
+
+
+class CanFrameTap(Actor):
+    """At ``rate_hz``, publish the frames logged since the last wake, in bus order,
+    each stamped with the sim time it crossed the bus (the recording's log time is the
+    publish time, up to one period later: 20 Hz costs a fifth of the wake-ups of 100 Hz
+    and the frames keep their exact stamps)."""
+
+    frames = Output(FRAMES_TOPIC, Frame, FRAMES_QOS)
+
+    def __init__(self, hal: CanBusInterface, *, rate_hz: float = 20.0, name: str = "can_tap"):
+        super().__init__(name)
+        if not rate_hz > 0:
+            raise ValueError(f"can tap rate must be > 0 Hz, got {rate_hz}")
+        self.hal = hal
+        self.rate_hz = rate_hz
+
+    async def run(self) -> None:
+        rate = self.clock.rate(self.rate_hz)
+        while True:
+            await rate.sleep()
+            await self.flush()
+
+    async def on_stop(self) -> None:
+        # The last frames (the IDLE requests are sent when the HAL closes, later).
+        for t, raw in self.hal.take_frames():
+            with contextlib.suppress(anyio.WouldBlock):
+                header = Header.fast(stamp=Time.from_seconds(t), frame_id=self.hal.channel)
+                self.frames.publish_nowait(_frame(header, raw))
+
+    async def flush(self) -> None:
+        channel = self.hal.channel
+        publish = self.frames.publish
+        header: Header | None = None
+        last = -1.0
+        for t, raw in self.hal.take_frames():
+            if header is None or t != last:  # frames of one instant share a header
+                header, last = Header.fast(stamp=Time.from_seconds(t), frame_id=channel), t
+            await publish(_frame(header, raw))
+
+
+def _frame(header: Header, raw: RawFrame) -> Frame:
+    data = raw.data
+    n = len(data)
+    return Frame.fast(
+        header=header,
+        id=raw.arbitration_id,
+        is_rtr=raw.is_remote,
+        is_extended=False,
+        is_error=raw.is_error,
+        dlc=n,
+        data=tuple(data + _PAD[n]) if n <= 8 else tuple(data[:8]),
+    )

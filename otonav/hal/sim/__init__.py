@@ -1,0 +1,10 @@
+"""Test equipment at the far end of the HAL: the ODrive drive emulator.
+
+Never imported by robot code (an import-linter contract): only the stack builder, which
+composes a simulated robot, and tests use it.
+"""
+
+from otonav.hal.sim.emulator import BusFaults, DriveEmulator, DriveMount
+from otonav.hal.sim.odrive import AxisModel, AxisParams
+
+__all__ = ("AxisModel", "AxisParams", "BusFaults", "DriveEmulator", "DriveMount")

@@ -1,0 +1,269 @@
+"""Two ODrive-like drives at the far end of a CAN bus, turning the MuJoCo wheels.
+
+Everything runs on sim time, driven by whoever steps the world (the CAN interface's
+``advance``): :meth:`DriveEmulator.exchange` is called at every instant the world
+stopped at, and :meth:`DriveEmulator.next_event_tick` says the next instant it needs
+(its next cyclic frame or a delayed frame coming due). No thread, no wall clock.
+
+At each exchange: receive frames (Set_Axis_State, Set_Controller_Mode, Set_Input_Vel,
+Estop, Clear_Errors), update both axes (:class:`~otonav.hal.sim.odrive.AxisModel`),
+put their velocity setpoints on the world's wheels (rad/s), then send what is due:
+Get_Encoder_Estimates every ``encoder_period`` (10 ms) and the heartbeat every
+``heartbeat_period`` (100 ms) of sim time, on whole ticks counted from tick 0.
+
+The wheels are the world's: a drive's encoder reads the wheel joint, converted to motor
+turns through its mounting ``sign`` and ``gear_ratio`` (the physical robot).
+
+Faults (:class:`BusFaults` and the methods below) are injected here, on the bus or in a
+drive: dropped and delayed frames (seeded, so deterministic), bus-off, a drive whose
+heartbeat stops, an axis error. This package is test equipment: robot code never
+imports it (an import-linter contract).
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from otonav.hal.can import protocol as p
+from otonav.hal.can.bus import CAN_ERR_BUSOFF, CAN_ERR_RESTARTED, CanEndpoint, RawFrame
+from otonav.hal.interface import RobotHardwareInterface
+from otonav.hal.sim.odrive import AxisModel, AxisParams
+from otonav.hal.types import WheelCommand, WheelState
+
+__all__ = ["BusFaults", "DriveEmulator", "DriveMount"]
+
+_TWO_PI = 2.0 * math.pi
+
+
+@dataclass(frozen=True, slots=True)
+class DriveMount:
+    """How a drive's motor is mounted on its wheel: wheel rad = sign * 2 pi * turns / gear."""
+
+    sign: int = 1
+    gear_ratio: float = 1.0
+    """Motor turns per wheel revolution."""
+
+    def __post_init__(self) -> None:
+        if self.sign not in (1, -1) or not self.gear_ratio > 0:
+            raise ValueError(f"DriveMount needs sign +-1 and gear_ratio > 0, got {self}")
+
+
+@dataclass(slots=True)
+class BusFaults:
+    """Bus-level fault injection, applied to frames in both directions.
+
+    ``drop_rate``: probability (0..1) that a frame is lost. ``delay``: seconds every
+    frame is held back, plus up to ``jitter`` seconds more (uniform; frames may then
+    arrive out of order, as behind a congested gateway).
+    """
+
+    drop_rate: float = 0.0
+    delay: float = 0.0
+    jitter: float = 0.0
+    dropped: int = field(default=0)
+    delayed: int = field(default=0)
+
+
+class _Drive:
+    __slots__ = ("axis", "heartbeat_silent", "mount", "node_id")
+
+    def __init__(self, params: AxisParams, mount: DriveMount) -> None:
+        self.axis = AxisModel(params)
+        self.mount = mount
+        self.node_id = params.node_id
+        self.heartbeat_silent = False
+
+
+class DriveEmulator:
+    """Two drives (left, right) on ``endpoint``, driving ``world``'s wheels.
+
+    ``seed`` seeds the fault injection's random numbers (nothing else is random).
+    """
+
+    def __init__(
+        self,
+        endpoint: CanEndpoint,
+        world: RobotHardwareInterface,
+        left: AxisParams,
+        right: AxisParams,
+        *,
+        left_mount: DriveMount = DriveMount(),
+        right_mount: DriveMount = DriveMount(),
+        heartbeat_period: float = 0.1,
+        encoder_period: float = 0.01,
+        seed: int = 0,
+    ) -> None:
+        if left.node_id == right.node_id:
+            raise ValueError(f"both drives have node id {left.node_id}")
+        tick = world.tick
+        self._hb_ticks = max(1, round(heartbeat_period / tick))
+        self._enc_ticks = max(1, round(encoder_period / tick))
+        self._endpoint = endpoint
+        self._world = world
+        self._tick = tick
+        self.drives = (_Drive(left, left_mount), _Drive(right, right_mount))
+        self._by_node = {d.node_id: d for d in self.drives}
+        self.faults = BusFaults()
+        self._rng = np.random.default_rng(seed)
+        self._bus_off = False
+        self._sent_at = -1  # last tick whose cyclic frames went out
+        self._seq = 0
+        # Delayed frames: (due tick, seq, outbound?, frame).
+        self._held: list[tuple[int, int, bool, RawFrame]] = []
+        self._last_cmd = (math.nan, math.nan)
+        self.frames_sent = 0
+        self.frames_received = 0
+
+    # -- fault injection -----------------------------------------------------------------
+
+    def drive(self, node_id: int) -> AxisModel:
+        """The axis answering on ``node_id`` (for tests and fault injection)."""
+        return self._by_node[node_id].axis
+
+    def silence_heartbeat(self, node_id: int, silent: bool = True) -> None:
+        """Stop (or resume) the heartbeat of drive ``node_id``; it still obeys commands."""
+        self._by_node[node_id].heartbeat_silent = silent
+
+    def inject_axis_error(self, node_id: int, code: int = p.AxisError.DRV_FAULT) -> None:
+        """Drive ``node_id`` reports ``code`` and disarms, until Clear_Errors."""
+        self._by_node[node_id].axis.raise_error(code)
+
+    def set_bus_off(self, off: bool, now_tick: int | None = None) -> None:
+        """The bus goes bus-off (nothing passes; the host's controller reports
+        CAN_ERR_BUSOFF) or restarts (CAN_ERR_RESTARTED), like SocketCAN with restart-ms."""
+        if off == self._bus_off:
+            return
+        t = (self._world.ticks if now_tick is None else now_tick) * self._tick
+        error = CAN_ERR_BUSOFF if off else CAN_ERR_RESTARTED
+        self._endpoint.send(RawFrame(error, bytes(8), is_error=True), t)
+        self._bus_off = off
+
+    @property
+    def bus_off(self) -> bool:
+        return self._bus_off
+
+    def close(self) -> None:
+        """Leave the bus. Idempotent."""
+        self._endpoint.close()
+
+    # -- time ----------------------------------------------------------------------------
+
+    def next_event_tick(self, now: int) -> int:
+        """The first tick after ``now`` at which this emulator must exchange frames."""
+        nxt = (now // self._enc_ticks + 1) * self._enc_ticks
+        if self._held and self._held[0][0] < nxt:
+            nxt = max(now + 1, self._held[0][0])
+        return nxt
+
+    def exchange(self, now: int) -> None:
+        """Receive, update the drives and the wheels, send what is due at tick ``now``."""
+        t = now * self._tick
+        incoming = self._endpoint.poll()
+        if self._bus_off:
+            incoming = []  # nothing crosses a bus-off bus
+        for frame in incoming:
+            self.frames_received += 1
+            if self._lose_or_hold(frame, now, outbound=False):
+                continue
+            self._handle(frame, t)
+        while self._held and self._held[0][0] <= now:
+            _, _, outbound, frame = heapq.heappop(self._held)
+            if self._bus_off:
+                continue
+            if outbound:
+                self._endpoint.send(frame, t)
+                self.frames_sent += 1
+            else:
+                self._handle(frame, t)
+        wheels = self._world.read_wheels()
+        self._drive_wheels(t, wheels)
+        if now != self._sent_at and not self._bus_off:
+            self._sent_at = now
+            if now % self._enc_ticks == 0:
+                self._send_encoders(now, t, wheels)
+            if now % self._hb_ticks == 0:
+                self._send_heartbeats(now, t)
+
+    # -- internals -----------------------------------------------------------------------
+
+    def _lose_or_hold(self, frame: RawFrame, now: int, *, outbound: bool) -> bool:
+        """Apply drop/delay to ``frame``: True if it is not to be used now."""
+        faults = self.faults
+        if faults.drop_rate > 0.0 and self._rng.random() < faults.drop_rate:
+            faults.dropped += 1
+            return True
+        if faults.delay > 0.0 or faults.jitter > 0.0:
+            extra = faults.jitter * self._rng.random() if faults.jitter > 0.0 else 0.0
+            due = now + max(1, round((faults.delay + extra) / self._tick))
+            self._seq += 1
+            heapq.heappush(self._held, (due, self._seq, outbound, frame))
+            faults.delayed += 1
+            return True
+        return False
+
+    def _transmit(self, frame: RawFrame, now: int, t: float) -> None:
+        if self._lose_or_hold(frame, now, outbound=True):
+            return
+        self._endpoint.send(frame, t)
+        self.frames_sent += 1
+
+    def _handle(self, frame: RawFrame, t: float) -> None:
+        if frame.is_error or frame.is_remote:
+            return
+        node, cmd = p.split_id(frame.arbitration_id)
+        drive = self._by_node.get(node)
+        if drive is None:
+            return
+        axis, data = drive.axis, frame.data
+        try:
+            if cmd == p.CMD_SET_INPUT_VEL:
+                axis.set_input_vel(p.unpack_two_f32(data)[0], t)
+            elif cmd == p.CMD_SET_AXIS_STATE:
+                axis.request_state(p.decode_set_axis_state(data), t)
+            elif cmd == p.CMD_ESTOP:
+                axis.estop()
+            elif cmd == p.CMD_CLEAR_ERRORS:
+                axis.clear_errors()
+            elif cmd == p.CMD_SET_CONTROLLER_MODE:
+                axis.set_controller_mode(*p.decode_set_controller_mode(data))
+        except ValueError:  # a short payload (struct.error is a ValueError): ignored
+            return
+
+    def _drive_wheels(self, t: float, wheels: WheelState) -> None:
+        left, right = self.drives
+        out = []
+        for drive, wheel_vel in ((left, wheels.left_velocity), (right, wheels.right_velocity)):
+            mount = drive.mount
+            measured = mount.sign * wheel_vel * mount.gear_ratio / _TWO_PI
+            turns = drive.axis.update(t, measured)
+            out.append(mount.sign * turns * _TWO_PI / mount.gear_ratio)
+        cmd = (out[0], out[1])
+        if cmd != self._last_cmd:
+            self._last_cmd = cmd
+            self._world.write(WheelCommand(cmd[0], cmd[1]))
+
+    def _send_encoders(self, now: int, t: float, wheels: WheelState) -> None:
+        left, right = self.drives
+        for drive, pos, vel in (
+            (left, wheels.left_position, wheels.left_velocity),
+            (right, wheels.right_position, wheels.right_velocity),
+        ):
+            k = drive.mount.sign * drive.mount.gear_ratio / _TWO_PI
+            ident, data = p.encode_encoder_estimates(
+                drive.node_id, p.EncoderEstimates(pos * k, vel * k)
+            )
+            self._transmit(RawFrame(ident, data), now, t)
+
+    def _send_heartbeats(self, now: int, t: float) -> None:
+        for drive in self.drives:
+            if drive.heartbeat_silent:
+                continue
+            axis = drive.axis
+            ident, data = p.encode_heartbeat(
+                drive.node_id, p.Heartbeat(int(axis.error), int(axis.state))
+            )
+            self._transmit(RawFrame(ident, data), now, t)

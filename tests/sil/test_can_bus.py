@@ -1,0 +1,397 @@
+"""Layer 3: the whole stack over a CAN bus (python-can ``virtual``), the ODrive drives
+emulated on the MuJoCo wheels, all in virtual time.
+
+The acceptance scenario over CAN, deterministic recordings, startup and shutdown like a
+real drive, and one test per fault: each detected by the interface, reported on /rosout
+and /diagnostics, the base at zero within 2 control periods, the navigator in ``fault``,
+and the recovery explicit and logged.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, TypeVar
+
+import pytest
+
+from otonav.actors import topics
+from otonav.hal import HealthLevel, RobotHardwareInterface, WheelCommand
+from otonav.hal.can import CanBusInterface, MonitorLimits, WheelAxis, open_endpoint
+from otonav.hal.can import protocol as p
+from otonav.hal.can.tap import FRAMES_TOPIC
+from otonav.hal.mujoco import MujocoInterface
+from otonav.hal.sim import AxisParams, DriveEmulator, DriveMount
+from otonav.msgs import DiagnosticArray, Frame, Log, NavState, Point, Pose, PoseStamped
+from otonav.msgs import WheelCommand as WheelCommandMsg
+from otonav.record.reader import read_messages, summarize
+from otonav.runtime import LATCHED_QOS, QoS, Reliability, Subscription, until
+from otonav.scenario import ScenarioConfig, run_scenario
+from otonav.stack import StackConfig
+from otonav.stack.overrides import apply_overrides
+from otonav.testing import running_stack
+
+pytestmark = pytest.mark.sil
+
+CAN = apply_overrides(StackConfig(), ["hal.kind=can"])
+BASE_PERIOD = 1.0 / CAN.base.rate_hz
+NAV_PERIOD = 1.0 / CAN.nav.rate_hz
+WATCH = QoS(Reliability.BEST_EFFORT, depth=5000)
+M = TypeVar("M")
+
+
+def drain(sub: Subscription[M]) -> list[M]:
+    out: list[M] = []
+    while (m := sub.try_recv()) is not None:
+        out.append(m)
+    return out
+
+
+def emulator_of(hal: RobotHardwareInterface) -> DriveEmulator:
+    assert isinstance(hal, CanBusInterface)
+    assert isinstance(hal.peer, DriveEmulator)
+    return hal.peer
+
+
+# -- the acceptance scenario over CAN ----------------------------------------------------
+
+
+def test_acceptance_over_can_passes_and_every_wheel_command_is_a_frame(tmp_path: Path) -> None:
+    verdict = run_scenario(ScenarioConfig(), CAN, out_dir=tmp_path, plot=False)
+    assert verdict.passed, verdict.reason
+    assert verdict.time_to_goal_s is not None
+    assert verdict.time_to_goal_s < 20.0
+    assert verdict.min_clearance_m >= 0.3
+    recording = tmp_path / "recording.mcap"
+    frames = [m for _t, _s, m in read_messages(recording, [FRAMES_TOPIC])]
+    by_cmd: dict[int, list[Any]] = {}
+    for frame in frames:
+        by_cmd.setdefault(p.split_id(frame.id)[1], []).append(frame)
+    sim = verdict.sim_time_s
+    # Encoder estimates every 10 ms and heartbeats every 100 ms, from both drives.
+    assert len(by_cmd[p.CMD_GET_ENCODER_ESTIMATES]) == pytest.approx(2 * sim / 0.01, abs=4)
+    assert len(by_cmd[p.CMD_HEARTBEAT]) == pytest.approx(2 * sim / 0.1, abs=4)
+    # Every /wheel_cmd left as a pair of Set_Input_Vel frames with the same values
+    # (turns/s, float32, left motor mirrored).
+    wheel_cmds = [m for _t, _s, m in read_messages(recording, [topics.WHEEL_CMD])]
+    setpoints = [
+        (frame.id >> 5, struct_f32(bytes(frame.data))) for frame in by_cmd[p.CMD_SET_INPUT_VEL]
+    ]
+    assert len(setpoints) == 2 * len(wheel_cmds)
+    for cmd, (left, right) in zip(
+        wheel_cmds, zip(setpoints[::2], setpoints[1::2], strict=True), strict=True
+    ):
+        if cmd.header.stamp.sec + cmd.header.stamp.nanosec * 1e-9 < 0.15:
+            continue  # zero while the drives start
+        assert (left[0], right[0]) == (0, 1)
+        assert left[1] == pytest.approx(-cmd.left / (2 * math.pi), rel=1e-6, abs=1e-6)
+        assert right[1] == pytest.approx(cmd.right / (2 * math.pi), rel=1e-6, abs=1e-6)
+    # Startup (Clear_Errors, controller mode, closed loop) and shutdown (IDLE) frames.
+    states = [p.decode_set_axis_state(bytes(f.data)) for f in by_cmd[p.CMD_SET_AXIS_STATE]]
+    assert states[:2] == [p.AxisState.CLOSED_LOOP_CONTROL] * 2
+    logs = [m.msg for _t, _s, m in read_messages(recording, [topics.ROSOUT])]
+    assert any("running: node 0 (left wheel), node 1 (right wheel)" in m for m in logs)
+
+
+def struct_f32(data: bytes) -> float:
+    return float(p.unpack_two_f32(data)[0])
+
+
+def test_two_can_runs_give_byte_identical_recordings(tmp_path: Path) -> None:
+    scenario = ScenarioConfig(sim_budget=3.0)
+    run_scenario(scenario, CAN, out_dir=tmp_path / "a", plot=False)
+    run_scenario(scenario, CAN, out_dir=tmp_path / "b", plot=False)
+    a = (tmp_path / "a" / "recording.mcap").read_bytes()
+    b = (tmp_path / "b" / "recording.mcap").read_bytes()
+    assert summarize(tmp_path / "a" / "recording.mcap").topics
+    assert len(a) > 50_000
+    assert a == b
+
+
+# -- the interface alone: startup, shutdown, encoders only from frames -------------------
+
+
+class _SensorsOnly(RobotHardwareInterface):
+    """The world as the interface's sensor source, refusing wheel access: every wheel
+    command and reading must go through the bus."""
+
+    def __init__(self, world: MujocoInterface) -> None:
+        self.world = world
+
+    tick = property(lambda self: self.world.tick)
+    ticks = property(lambda self: self.world.ticks)
+    geometry = property(lambda self: self.world.geometry)
+
+    def advance(self, n: int) -> None:
+        self.world.advance(n)
+
+    def write(self, cmd: WheelCommand) -> None:
+        raise AssertionError("the CAN interface wrote the world's wheels directly")
+
+    def read_wheels(self) -> Any:
+        raise AssertionError("the CAN interface read the world's wheels directly")
+
+    def read_imu(self) -> Any:
+        return self.world.read_imu()
+
+    def read_scan(self) -> Any:
+        return self.world.read_scan()
+
+    def ground_truth(self) -> Any:
+        return self.world.ground_truth()
+
+    def obstacles(self) -> Any:
+        return self.world.obstacles()
+
+    def close(self) -> None:
+        self.world.close()
+
+
+def _bench(
+    channel: str, *, left_sign: int = -1, mount_sign: int = -1, host_left_id: int = 0
+) -> tuple[CanBusInterface, DriveEmulator, MujocoInterface]:
+    world = MujocoInterface("empty")
+    emulator = DriveEmulator(
+        open_endpoint("virtual", channel),
+        world,
+        AxisParams(0),
+        AxisParams(1),
+        left_mount=DriveMount(mount_sign),
+    )
+    hal = CanBusInterface(
+        open_endpoint("virtual", channel),
+        _SensorsOnly(world),
+        WheelAxis(host_left_id, left_sign, label="left wheel"),
+        WheelAxis(1, 1, label="right wheel"),
+        MonitorLimits(),
+        peer=emulator,
+    )
+    return hal, emulator, world
+
+
+def test_startup_waits_for_closed_loop_in_sim_time_and_shutdown_sets_idle() -> None:
+    hal, emulator, world = _bench("test-startup")
+    with hal:
+        assert not hal.health().ready
+        hal.advance(45)  # 0.09 s: requested, armed, but no heartbeat since
+        assert not hal.health().ready
+        assert emulator.drive(0).state == p.AxisState.CLOSED_LOOP_CONTROL
+        hal.advance(5)  # the 100 ms heartbeat shows closed loop
+        assert hal.health().drivable
+        assert hal.health().since == pytest.approx(0.1)
+        for _ in range(50):
+            hal.write(WheelCommand(6.0, 6.0))
+            hal.advance(5)
+        wheels, truth = hal.read_wheels(), world.read_wheels()
+        # Wheel angles from the last encoder frames (float32 turns): the world's, rounded.
+        assert wheels.left_position == pytest.approx(truth.left_position, abs=1e-5)
+        assert wheels.right_velocity == pytest.approx(truth.right_velocity, abs=1e-4)
+        assert wheels.left_position != truth.left_position
+        assert hal.ground_truth().x > 0.1  # forward: the signs agree
+    assert emulator.drive(0).state == p.AxisState.IDLE
+    assert emulator.drive(1).state == p.AxisState.IDLE
+    frames = hal.take_frames()
+    idle = p.set_axis_state(0, p.AxisState.IDLE)
+    assert (frames[-2][1].arbitration_id, frames[-2][1].data) == idle
+
+
+def test_a_wrong_direction_sign_drives_the_wheel_backwards() -> None:
+    # The host thinks the left motor is not mirrored; the robot then spins in place:
+    # the sign in the config is what makes it drive straight.
+    hal, _emulator, _world = _bench("test-sign", left_sign=1, mount_sign=-1)
+    with hal:
+        hal.advance(50)
+        for _ in range(50):
+            hal.write(WheelCommand(6.0, 6.0))
+            hal.advance(5)
+        truth = hal.ground_truth()
+        assert abs(truth.x) < 0.02
+        assert abs(truth.yaw) > 0.5
+
+
+# -- faults ----------------------------------------------------------------------------
+
+
+async def _fault_scenario(
+    config: StackConfig,
+    inject: Callable[[DriveEmulator], None],
+    clear: Callable[[DriveEmulator], None] | None,
+    *,
+    fault: set[str],
+    names: str,
+    estop: bool,
+    drive_first: bool = True,
+) -> None:
+    """Drive toward a goal, inject the fault, check detection and the reaction, clear
+    it and check the logged recovery (``clear`` None: it must stay faulted)."""
+    async with running_stack(config) as stack:
+        system, hal = stack.system, stack.hal
+        emulator = emulator_of(hal)
+        wheel = system.subscribe(topics.WHEEL_CMD, WheelCommandMsg, WATCH)
+        state = system.subscribe(topics.NAV_STATE, NavState, WATCH)
+        rosout = system.subscribe(topics.ROSOUT, Log, WATCH)
+        diagnostics = system.subscribe(topics.DIAGNOSTICS, DiagnosticArray, WATCH)
+        frames = system.subscribe(FRAMES_TOPIC, Frame, WATCH)
+        goal = system.publisher(topics.GOAL, PoseStamped, LATCHED_QOS, name="test")
+        await goal.publish(PoseStamped(pose=Pose(position=Point(x=4.0, y=1.5))))
+        if drive_first:
+            await until(
+                lambda: math.hypot(hal.ground_truth().vx_world, hal.ground_truth().vy_world) > 0.1,
+                within=3.0,
+                what="the robot drives over CAN",
+            )
+            inject(emulator)
+        start = hal.ground_truth()
+        await until(lambda: hal.health().faulted, within=2.0, what="fault detected")
+        health = hal.health()
+        detected = health.since
+        assert health.fault in fault, health
+        assert names in health.message
+        await system.clock.sleep(0.3)
+
+        # Base: zero within 2 control periods of detection, and from then on.
+        cmds = [m for m in drain(wheel) if m.header.stamp.to_seconds() > detected - 1e-9]
+        first_zero = next(m for m in cmds if m.left == 0.0 and m.right == 0.0)
+        assert first_zero.header.stamp.to_seconds() <= detected + 2 * BASE_PERIOD + 1e-9
+        late = [m for m in cmds if m.header.stamp.to_seconds() >= detected + 2 * BASE_PERIOD]
+        assert late
+        assert all(m.left == 0.0 and m.right == 0.0 for m in late)
+        # Navigator: 'fault' within 2 of its periods.
+        faults = [m for m in drain(state) if m.state == "fault"]
+        assert faults[0].header.stamp.to_seconds() <= detected + 2 * NAV_PERIOD + 1e-9
+        # Reported on /rosout and /diagnostics, naming the part.
+        logs = drain(rosout)
+        assert any(m.level == Log.ERROR and names in m.msg for m in logs), logs
+        assert any(
+            s.level == HealthLevel.ERROR and names in s.message
+            for d in drain(diagnostics)
+            for s in d.status
+        )
+        sent = [f for f in drain(frames) if f.header.stamp.to_seconds() >= detected - 1e-9]
+        estops = {f.id >> 5 for f in sent if f.id & 0x1F == p.CMD_ESTOP}
+        assert estops == (
+            {config.hal.can.left.node_id, config.hal.can.right.node_id} if estop else set()
+        )
+
+        if clear is None:
+            await system.clock.sleep(1.0)
+            assert hal.health().faulted
+            if not drive_first:  # it never moved: the drives never took a command
+                end = hal.ground_truth()
+                assert math.hypot(end.x - start.x, end.y - start.y) < 0.01
+            return
+        clear(emulator)
+        await until(lambda: hal.health().drivable, within=3.0, what="recovery")
+        assert hal.health().message.startswith("recovered from")
+        await system.clock.sleep(0.2)
+        logs = drain(rosout)
+        assert any("recovering from" in m.msg and m.level == Log.WARN for m in logs), logs
+        assert any("recovered from" in m.msg for m in logs)
+        restart = [f for f in drain(frames) if f.id & 0x1F == p.CMD_CLEAR_ERRORS]
+        assert {f.id >> 5 for f in restart} == {0, 1}
+        await until(
+            lambda: math.hypot(hal.ground_truth().vx_world, hal.ground_truth().vy_world) > 0.1,
+            within=2.0,
+            what="driving again after the recovery",
+        )
+        assert drain(state)[-1].state == "driving"
+
+
+@pytest.mark.sim(wall_ceiling=60)
+async def test_heartbeat_loss_is_detected_and_estops() -> None:
+    await _fault_scenario(
+        CAN,
+        lambda emu: emu.silence_heartbeat(1),
+        lambda emu: emu.silence_heartbeat(1, False),
+        fault={"heartbeat_lost"},
+        names="node 1 (right wheel): no heartbeat",
+        estop=True,
+    )
+
+
+@pytest.mark.sim(wall_ceiling=60)
+async def test_axis_error_is_detected_and_recovered_with_clear_errors() -> None:
+    await _fault_scenario(
+        CAN,
+        lambda emu: emu.inject_axis_error(0, p.AxisError.DRV_FAULT),
+        lambda emu: None,  # transient: Clear_Errors clears it
+        fault={"axis_error"},
+        names="node 0 (left wheel): axis error 0x00000020 (DRV_FAULT)",
+        estop=True,
+    )
+
+
+def _drop(rate: float) -> Callable[[DriveEmulator], None]:
+    def inject(emu: DriveEmulator) -> None:
+        emu.faults.drop_rate = rate
+
+    return inject
+
+
+@pytest.mark.sim(wall_ceiling=60)
+async def test_dropped_frames_are_detected() -> None:
+    await _fault_scenario(
+        CAN,
+        _drop(0.4),
+        _drop(0.0),
+        fault={"frame_loss", "encoder_stale"},
+        names="wheel)",
+        estop=False,
+    )
+
+
+@pytest.mark.sim(wall_ceiling=60)
+async def test_a_few_dropped_frames_are_tolerated() -> None:
+    async with running_stack(CAN) as stack:
+        await until(lambda: stack.hal.health().drivable, within=1.0)
+        emulator = emulator_of(stack.hal)
+        emulator.faults.drop_rate = 0.05
+        await stack.system.clock.sleep(3.0)
+        assert emulator.faults.dropped > 20
+        assert stack.hal.health().drivable
+
+
+def _delay(seconds: float) -> Callable[[DriveEmulator], None]:
+    def inject(emu: DriveEmulator) -> None:
+        emu.faults.delay = seconds
+
+    return inject
+
+
+@pytest.mark.sim(wall_ceiling=60)
+async def test_delayed_frames_are_detected() -> None:
+    await _fault_scenario(
+        CAN,
+        _delay(0.08),
+        _delay(0.0),
+        fault={"encoder_stale"},
+        names="no encoder estimate for",
+        estop=False,
+    )
+
+
+@pytest.mark.sim(wall_ceiling=60)
+async def test_bus_off_is_detected_and_the_restart_recovers() -> None:
+    await _fault_scenario(
+        CAN,
+        lambda emu: emu.set_bus_off(True),
+        lambda emu: emu.set_bus_off(False),
+        fault={"bus_off"},
+        names="CAN bus-off",
+        estop=False,
+    )
+
+
+@pytest.mark.sim(wall_ceiling=60)
+async def test_a_wrong_node_id_at_startup_times_out_naming_it() -> None:
+    config = apply_overrides(CAN, ["hal.can.left.node_id=9"])
+    await _fault_scenario(
+        config,
+        lambda emu: None,  # the drives answer on 0 and 1; the host expects 9 and 1
+        None,
+        fault={"startup_timeout"},
+        names="node 9 (left wheel): no heartbeat within 1 s",
+        estop=True,
+        drive_first=False,
+    )
