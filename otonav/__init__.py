@@ -6,7 +6,9 @@ Layers, top to bottom; imports point down only (import-linter contracts in pypro
     stack              the launch file as data: pydantic config -> world + actors
     actors             bridge, base controller, navigator, recorder: subscribe, compute, publish
     record             MCAP recordings in ROS 2 CDR: write, read, info, salvage
-    hal                RobotHardwareInterface, FakeHardware; only hal.mujoco imports mujoco
+    hal                RobotHardwareInterface, FakeHardware; only hal.mujoco imports mujoco;
+                       hal.can (wheels over CAN, only hal.can.bus imports python-can);
+                       hal.sim (the drive emulator: test equipment, never robot code)
     nav, control       pure math: go-to-goal, obstacle guard, diff-drive kinematics
     msgs, runtime      ROS 2-shaped messages; virtual-time loop, actors, topics, QoS, waits
 """

@@ -63,7 +63,16 @@ def add_parser(commands: Any) -> None:
         default=None,
         help="with --realtime/--gui only: sim seconds per wall second (default 1)",
     )
-    p.add_argument("--gui", action="store_true", help="show the run in MuJoCo's viewer (real time)")
+    p.add_argument(
+        "--gui",
+        action="store_true",
+        help="show the run in MuJoCo's viewer (real time); the camera follows the robot",
+    )
+    p.add_argument(
+        "--hold",
+        action="store_true",
+        help="with --gui: keep the window open at the end, until you close it",
+    )
     p.set_defaults(handler=main)
 
 
@@ -116,6 +125,8 @@ def main(args: argparse.Namespace) -> int:
             f"--scale {args.scale:g}: only with --realtime or --gui "
             "(a headless run is not paced: it runs as fast as it can)"
         )
+    if args.hold and not args.gui:
+        raise ConfigFileError("--hold: only with --gui (it keeps the viewer window open)")
     if not (scale > 0 and math.isfinite(scale)):
         raise ConfigFileError(f"--scale {scale}: must be a finite number > 0 (sim s per wall s)")
     scenario = load_scenario(args.scenario)
@@ -137,6 +148,14 @@ def main(args: argparse.Namespace) -> int:
         for path in stale:
             path.unlink(missing_ok=True)
 
+    console = Console(highlight=False)
+    held: list[Verdict] = []
+
+    def hold(verdict: Verdict) -> None:
+        print_verdict(verdict, console)
+        console.print("the recording is finished; close the viewer window to exit")
+        held.append(verdict)
+
     try:
         if args.gui or args.realtime:
             from otonav.scenario.realtime import run_scenario_realtime
@@ -149,6 +168,7 @@ def main(args: argparse.Namespace) -> int:
                 scale=scale,
                 gui=args.gui,
                 on_start=on_start,
+                hold=hold if args.hold else None,
             )
         else:
             verdict = run_scenario(
@@ -169,7 +189,11 @@ def main(args: argparse.Namespace) -> int:
     out.mkdir(parents=True, exist_ok=True)
     summary = out / "summary.json"
     summary.write_text(json.dumps(finite_figures(verdict.as_dict()), indent=2, default=str) + "\n")
-    console = Console(highlight=False)
-    print_verdict(verdict, console)
+    if held:  # the table was printed while the window was held open
+        for label, path in (("recording", verdict.recording), ("plot", verdict.plot)):
+            if path:
+                console.print(f"{label}: {path}")
+    else:
+        print_verdict(verdict, console)
     console.print(f"summary: {summary}")
     return 0 if verdict.passed else 1

@@ -89,6 +89,12 @@ _ROBOT_FRAGMENT: Final = "robot.xml"
 _RAY_GROUPS: Final = np.array([1, 0, 1, 0, 0, 0], dtype=np.uint8)  # groups 0 and 2
 _ROBOT_GROUP: Final = 1
 _OBSTACLE_HEIGHT: Final = 0.5  # m, height of boxes added through extra_obstacles
+VIEWER_DISTANCE: Final = 4.0
+"""m from the tracked robot to the viewer's camera."""
+VIEWER_ELEVATION: Final = -40.0
+"""degrees: the tracking camera looks down at the robot from this angle."""
+VIEWER_AZIMUTH: Final = 135.0
+"""degrees, MuJoCo's convention: the tracking camera's heading around the robot."""
 _SETTLE_TIME: Final = 0.25  # s of physics run at construction, before tick 0
 
 
@@ -497,8 +503,13 @@ class MujocoInterface(RobotHardwareInterface):
         """The live ``mujoco.MjData`` (for a viewer inside ``otonav.hal`` only)."""
         return self._data
 
-    def open_viewer(self) -> ViewerHandle:
+    def open_viewer(self, *, track: bool = True) -> ViewerHandle:
         """Open MuJoCo's passive viewer (no side panels) on this world.
+
+        ``track``: the camera follows the robot (MuJoCo's tracking camera on body
+        ``chassis``, from behind-left and above, ~4 m away), so it never drives out of
+        the picture; the user can still turn and zoom it. ``track=False``: MuJoCo's
+        default free camera, fixed on the model's centre.
 
         Raises :class:`NoDisplayError` (one line: what is missing, and the fix) when
         there is no display GLFW can open, instead of MuJoCo's hard exit.
@@ -513,6 +524,13 @@ class MujocoInterface(RobotHardwareInterface):
         handle = mujoco.viewer.launch_passive(
             self._model, self._data, show_left_ui=False, show_right_ui=False
         )
+        if track:
+            with handle.lock():
+                handle.cam.type = mujoco.mjtCamera.mjCAMERA_TRACKING
+                handle.cam.trackbodyid = self._chassis
+                handle.cam.distance = VIEWER_DISTANCE
+                handle.cam.elevation = VIEWER_ELEVATION
+                handle.cam.azimuth = VIEWER_AZIMUTH
         elapsed = time.perf_counter() - started
         new = [t for t in threading.enumerate() if t not in before]
         threads = [t for t in new if _VIEWER_THREAD in t.name] or new

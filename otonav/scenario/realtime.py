@@ -36,6 +36,9 @@ __all__ = ["VIEWER_HZ", "run_scenario_realtime"]
 VIEWER_HZ = 60.0
 """Wall-clock rate at which the viewer is shown the world."""
 
+HOLD_POLL_S = 0.05
+"""Wall seconds between looks at whether the user closed the held window."""
+
 MAX_STEP_BATCH = 0.05
 """Most sim seconds stepped at once: a machine slower than the scale makes sim time slip
 behind the wall clock (the verdict's RTF shows it) rather than step in bursts."""
@@ -51,6 +54,16 @@ async def _show(
         await rate.sleep()  # wakes with the world stepped to the wall clock
     closed_at.append(clock.now())
     stop.cancel()
+
+
+def _hold(viewer: ViewerHandle, held: list[Verdict], hold: Callable[[Verdict], None]) -> None:
+    """Keep the window open on the final state until the user closes it (a cleanup of
+    the session: the recording is finished, the world not yet closed)."""
+    if not held or not viewer.is_running():
+        return  # the run did not finish, or the user closed the window during it
+    hold(held[0])
+    while viewer.is_running():  # the viewer's thread draws and takes input meanwhile
+        time.sleep(HOLD_POLL_S)
 
 
 async def _main(
@@ -81,6 +94,7 @@ def run_scenario_realtime(
     scale: float = 1.0,
     gui: bool = False,
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
+    hold: Callable[[Verdict], None] | None = None,
 ) -> Verdict:
     """Run ``scenario`` with sim time following the wall clock times ``scale`` and judge
     it, like :func:`~otonav.scenario.run.run_scenario` (same artifacts in ``out_dir``,
@@ -91,6 +105,9 @@ def run_scenario_realtime(
     is none), the window opens before the clock starts, is synced at ~60 Hz wall and
     closed at the end. Closing the window stops the run: the verdict fails and says so.
     ``on_start(loop, task)`` is called on the run's loop once the window (if any) is up.
+    ``hold`` (with ``gui``): once the run is over and its recording finished, call
+    ``hold(verdict)`` (its artifact paths are not set yet) and keep the window open on
+    the final state until the user closes it; Ctrl-C ends the hold too.
     """
     if not scale > 0:
         raise ValueError(f"real-time scale must be > 0, got {scale!r}")
@@ -116,6 +133,10 @@ def run_scenario_realtime(
             session.close()
             raise
         session.add_cleanup(viewer.close)  # after the recording, before the world
+        if hold is not None:  # cleanups run last added first: before the window closes
+            shown = viewer
+            session.add_cleanup(lambda: _hold(shown, held, hold))
+    held: list[Verdict] = []
     closed_at: list[float] = []
     wall_start = time.perf_counter()
     ended = "completed"
@@ -142,6 +163,8 @@ def run_scenario_realtime(
                         f"({judge.distance:.3f} m from the goal)"
                     ),
                 )
+            if ended == "completed":
+                held.append(verdict)
             verdict = save_artifacts(verdict, scenario, stack, judge, session, out_dir, plot)
         finally:
             session.close()  # idempotent: the viewer, then the world, on every path

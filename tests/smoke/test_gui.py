@@ -8,6 +8,7 @@ the test with what to install (``scripts/ensure_xvfb.sh``); nothing is skipped.
 from __future__ import annotations
 
 import json
+import math
 import os
 import queue
 import shutil
@@ -28,7 +29,10 @@ from otonav.hal.viewer import NO_DISPLAY_FIX
 
 pytestmark = pytest.mark.smoke
 
-XVFB_SCREEN = "-screen 0 640x480x24"
+# -noreset: Xvfb resets whenever its last client disconnects, and a connection made
+# during the reset fails ("Failed to open display"): a screenshot taken while the viewer
+# probes the display, or a probe made while a screenshot closes, raced it.
+XVFB_SCREEN = "-screen 0 640x480x24 -noreset"
 ENSURE = "scripts/ensure_xvfb.sh (Debian packages xvfb, x11-apps)"
 
 NO_DISPLAY_CHILD = """
@@ -183,16 +187,27 @@ class _Child:
         return f" (exit {self.proc.poll()}); child stderr:\n{''.join(self.stderr)[-3000:]}"
 
 
-@pytest.fixture
-def gui_child(tmp_path: Path) -> Iterator[Callable[[str, float], _Child]]:
+def _first_display() -> int:
+    return 100 + (os.getpid() * 7 + len(_STARTED)) % 800
+
+
+_STARTED: list[int] = []
+
+
+def _start_children(tmp_path: Path, source: str) -> Iterator[Callable[..., _Child]]:
+    """Start ``source`` as a script under its own ``xvfb-run``, with the given argv."""
     xvfb_run = _need("xvfb-run")
     script = tmp_path / "gui_child.py"
-    script.write_text(GUI_CHILD)
+    script.write_text(source)
     children: list[_Child] = []
 
-    def start(mode: str, scale: float) -> _Child:
+    def start(*argv: object) -> _Child:
         proc = subprocess.Popen(
-            [xvfb_run, "-a", "-s", XVFB_SCREEN, sys.executable, str(script), mode, str(scale)],
+            # -a from a number of our own: parallel suites on one machine (each starting at
+            # :99) raced for the same display ("Failed to open display").
+            [xvfb_run, "-a", "-n", str(_first_display()), "-s", XVFB_SCREEN]
+            + [sys.executable, str(script)]
+            + [str(a) for a in argv],
             env=_child_env(),
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
@@ -200,6 +215,7 @@ def gui_child(tmp_path: Path) -> Iterator[Callable[[str, float], _Child]]:
             text=True,
             start_new_session=True,  # its own process group: xvfb-run, Xvfb and python
         )
+        _STARTED.append(proc.pid)
         child = _Child(proc)
         children.append(child)
         child.start_readers()
@@ -210,8 +226,18 @@ def gui_child(tmp_path: Path) -> Iterator[Callable[[str, float], _Child]]:
         child.close()
 
 
-def _screenshot_colours(display: str, xauthority: str) -> int:
-    """How many distinct colours the whole X screen shows (``xwd -root``)."""
+@pytest.fixture
+def gui_child(tmp_path: Path) -> Iterator[Callable[..., _Child]]:
+    yield from _start_children(tmp_path, GUI_CHILD)
+
+
+@pytest.fixture
+def cli_gui_child(tmp_path: Path) -> Iterator[Callable[..., _Child]]:
+    yield from _start_children(tmp_path, CLI_GUI_CHILD)
+
+
+def _screenshot(display: str, xauthority: str) -> np.ndarray:
+    """The whole X screen (``xwd -root``) as an (height, width, 3) array of 8-bit RGB."""
     env = {**os.environ, "DISPLAY": display, "XAUTHORITY": xauthority}
     shot = subprocess.run(
         [_need("xwd"), "-root", "-silent", "-display", display],
@@ -233,10 +259,22 @@ def _screenshot_colours(display: str, xauthority: str) -> int:
     assert len(shot) >= offset + height * bytes_per_line, header
     rows = np.frombuffer(shot, dtype=np.uint8, count=height * bytes_per_line, offset=offset)
     pixels = rows.reshape(height, bytes_per_line)[:, : width * per_pixel]
-    if per_pixel == 3:
-        return len(np.unique(pixels.reshape(-1, 3), axis=0))
-    values = pixels.copy().view("<u4" if byte_order == 0 else ">u4") & masks
-    return len(np.unique(values))
+    if per_pixel == 3:  # pad each pixel to 32 bits on its most significant side
+        pad = np.zeros((height, width, 1), dtype=np.uint8)
+        rgb = pixels.reshape(height, width, 3)
+        pixels = np.concatenate((rgb, pad) if byte_order == 0 else (pad, rgb), axis=2)
+    values = pixels.copy().view("<u4" if byte_order == 0 else ">u4").reshape(height, width)
+    channels = []
+    for mask in header[14:17]:  # red, green, blue masks (8 bits each on a 24-bit visual)
+        shift = (mask & -mask).bit_length() - 1
+        channels.append(((values & mask) >> shift).astype(np.uint8))
+    assert masks == 0xFFFFFF, header
+    return np.stack(channels, axis=2)
+
+
+def _screenshot_colours(display: str, xauthority: str) -> int:
+    """How many distinct colours the whole X screen shows."""
+    return len(np.unique(_screenshot(display, xauthority).reshape(-1, 3), axis=0))
 
 
 def _screen_of(child: _Child) -> tuple[str, str]:
@@ -245,7 +283,7 @@ def _screen_of(child: _Child) -> tuple[str, str]:
 
 
 def test_gui_run_draws_the_world_in_a_window_and_reaches_the_goal(
-    gui_child: Callable[[str, float], _Child],
+    gui_child: Callable[..., _Child],
 ) -> None:
     child = gui_child("run", 5.0)
     display, xauthority = _screen_of(child)
@@ -268,7 +306,7 @@ def test_gui_run_draws_the_world_in_a_window_and_reaches_the_goal(
 
 
 def test_closing_the_viewer_window_stops_the_run_cleanly(
-    gui_child: Callable[[str, float], _Child],
+    gui_child: Callable[..., _Child],
 ) -> None:
     child = gui_child("close", 1.0)  # ~8.5 s to the goal: the window closes well before
     _screen_of(child)
@@ -280,3 +318,76 @@ def test_closing_the_viewer_window_stops_the_run_cleanly(
     assert "viewer window was closed" in verdict["reason"], verdict["reason"]
     assert verdict["sim_time_s"] < 2.0, verdict
     assert child.proc.wait(timeout=10) == 0, str(child)
+
+
+# -- the CLI's viewer: a camera that follows the robot, a window held open ----------------
+
+# argv: the otonav CLI's. Prints the display first; "close" on stdin closes the viewer
+# window as its close button would.
+CLI_GUI_CHILD = """
+import os, sys, threading
+from otonav.cli import main
+from otonav.hal.mujoco import MujocoInterface
+
+print("DISPLAY", os.environ["DISPLAY"], os.environ.get("XAUTHORITY", ""), flush=True)
+handles = []
+open_viewer = MujocoInterface.open_viewer
+
+def capture(self, **kwargs):
+    handles.append(open_viewer(self, **kwargs))
+    return handles[-1]
+
+MujocoInterface.open_viewer = capture
+
+def close_on_request():
+    for line in sys.stdin:
+        if line.strip() == "close" and handles:
+            handles[0]._handle.close()
+
+threading.Thread(target=close_on_request, daemon=True).start()
+code = main(sys.argv[1:])
+print("EXIT", code, flush=True)
+sys.exit(code)
+"""
+
+
+def _robot(shot: np.ndarray) -> tuple[int, float, float]:
+    """Pixels of the robot's blue chassis (rgba 0.2 0.4 0.8, lit) and their centroid."""
+    r, g, b = (shot[:, :, i].astype(int) for i in range(3))
+    ys, xs = np.nonzero((b > 110) & (b > r + 60) & (b > g + 35))
+    if len(xs) == 0:
+        return 0, math.nan, math.nan
+    return len(xs), float(xs.mean()), float(ys.mean())
+
+
+def test_gui_camera_follows_the_robot_and_hold_keeps_the_window_open(
+    cli_gui_child: Callable[..., _Child], tmp_path: Path
+) -> None:
+    # empty scenario: the robot drives 3.2 m, from (0, 0) to (3, -1), in ~9 s of sim time
+    child = cli_gui_child(
+        "run", "--gui", "--hold", "--scenario", "empty", "--scale", "5", "--out", tmp_path
+    )
+    display, xauthority = _screen_of(child)
+    deadline = time.monotonic() + 15.0
+    start = (0, math.nan, math.nan)
+    while start[0] < 30 and time.monotonic() < deadline and child.proc.poll() is None:
+        try:
+            start = _robot(_screenshot(display, xauthority))  # the window is up, robot in it
+        except subprocess.CalledProcessError as exc:
+            child.proc.wait(timeout=10)  # the X server went: the child ended
+            raise AssertionError(f"no screenshot ({exc.stderr!r}){child}") from None
+    assert start[0] >= 30, f"no robot on screen after the viewer opened: {start}{child}"
+
+    child.expect("the recording is finished;", timeout=30)  # the run ended, window held
+    assert child.proc.poll() is None, f"the window was not held open{child}"
+    end = _robot(_screenshot(display, xauthority))
+    print(f"robot on screen: start {start}, end {end}")
+    assert end[0] >= 30, f"the robot left the picture: {end}{child}"
+    # The camera tracks the robot: after 3.2 m it is drawn where it was at the start.
+    assert math.hypot(end[1] - start[1], end[2] - start[2]) < 20, (start, end)
+    assert (tmp_path / "recording.mcap").exists()  # finished before the hold
+
+    child.send("close")
+    assert child.expect("EXIT", timeout=15) == ["0"], str(child)
+    assert child.proc.wait(timeout=10) == 0, str(child)
+    assert json.loads((tmp_path / "summary.json").read_text())["passed"] is True

@@ -64,3 +64,12 @@ def test_scale_without_realtime_or_gui_is_a_usage_error(
         "(a headless run is not paced: it runs as fast as it can)"
     )
     assert not list(tmp_path.iterdir()), "a refused run must not write anything"
+
+
+def test_hold_without_gui_is_a_usage_error(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    assert main(["run", "--hold", "--realtime", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.strip() == "otonav: error: --hold: only with --gui (it keeps the viewer window open)"
+    assert not list(tmp_path.iterdir())
