@@ -17,7 +17,7 @@ import sys
 from collections.abc import Sequence
 from typing import Any
 
-COMMANDS: tuple[str, ...] = ("run", "info", "inspect", "bench", "replay")
+COMMANDS: tuple[str, ...] = ("run", "info", "inspect", "bench", "sweep", "replay")
 """Modules under ``otonav.cli`` whose ``add_parser`` registers a command, in help order."""
 
 USAGE_ERROR = 2

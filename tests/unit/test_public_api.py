@@ -21,6 +21,7 @@ PACKAGES = [
     "otonav.testing",
     "otonav.embed",
     "otonav.replay",
+    "otonav.sweep",
 ]
 
 

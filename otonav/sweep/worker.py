@@ -1,0 +1,166 @@
+"""What a worker does with one :class:`RunTask`, whatever the backend: run the scenario
+through the public :func:`~otonav.scenario.run_scenario` in a private scratch
+directory, hash the recording, and hand back the verdict figures plus, for runs the
+sweep keeps, the artifacts as bytes. The driver alone writes into ``--out``, so a
+worker on another machine needs no shared filesystem
+(docs/adr/0018-sweep-backends-and-artifacts.md).
+
+A worker imports otonav once and runs many tasks; nothing of one run survives into the
+next (each run builds its own world, loop and recorder), which is what makes a run's
+recording the same in any worker.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import os
+import signal
+import socket
+import threading
+import time
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+from otonav.scenario import ScenarioConfig, run_scenario
+from otonav.scenario.run import finite_figures
+from otonav.stack import StackConfig
+from otonav.sweep.plan import RunTask
+from otonav.sweep.worlds import draw_world
+
+Status = Literal["passed", "failed", "error"]
+
+#: Test hook, comma-separated: ``crash:NAME`` (SIGKILL itself), ``hang:NAME`` (block
+#: forever) or ``raise:NAME`` as a worker starts a run of scenario NAME. For the sweep's
+#: own tests of crashed and hung workers; unset in normal use.
+FAULT_ENV = "OTONAV_SWEEP_FAULT"
+
+RECORDING = "recording.mcap"
+PLOT = "trajectory.png"
+
+
+@dataclass(frozen=True, slots=True)
+class RunOutcome:
+    """What comes back from a worker for one run."""
+
+    run_id: str
+    status: Status
+    reason: str
+    figures: dict[str, Any]
+    """The verdict's figures (JSON-safe: non-finite numbers are None)."""
+    recording_sha256: str | None
+    wall_time_s: float
+    """Wall time of the whole run in the worker: world build to artifacts."""
+    worker: str
+    artifacts: dict[str, bytes] = field(default_factory=dict)
+    """File name -> content, for runs the sweep keeps."""
+    scenario_json: str | None = None
+    """The scenario a generated world turned out to be (None: the task's own)."""
+
+
+def worker_name() -> str:
+    return f"{socket.gethostname()}:{os.getpid()}"
+
+
+def _inject_fault(task: RunTask) -> None:
+    for fault in filter(None, os.environ.get(FAULT_ENV, "").split(",")):
+        kind, _, name = fault.partition(":")
+        if name != task.scenario:
+            continue
+        if kind == "crash":
+            os.kill(os.getpid(), signal.SIGKILL)
+        elif kind == "hang":
+            threading.Event().wait()
+        elif kind == "raise":
+            raise RuntimeError(f"injected fault ({FAULT_ENV}={fault})")
+
+
+def _keeps(task: RunTask, status: Status) -> bool:
+    return task.keep == "all" or (task.keep == "failures" and status != "passed")
+
+
+def execute(task: RunTask, scratch: Path) -> RunOutcome:
+    """Run ``task`` with its files in ``scratch`` (reused by the next task). Never
+    raises for a failing run or a broken scenario: that is an ``error`` outcome."""
+    start = time.perf_counter()
+    recording = scratch / RECORDING
+    recording.unlink(missing_ok=True)
+    scenario_json: str | None = None
+    labels: dict[str, Any] = {}
+    try:
+        _inject_fault(task)
+        if task.world is not None:
+            scenario_json, labels = draw_world(*task.world)
+            scenario = ScenarioConfig.model_validate_json(scenario_json)
+            if scenario.seed != task.seed:
+                scenario = ScenarioConfig.model_validate(
+                    {**scenario.model_dump(), "seed": task.seed}
+                )
+                scenario_json = scenario.model_dump_json()
+        else:
+            scenario = ScenarioConfig.model_validate_json(task.scenario_json)
+        stack = StackConfig.model_validate_json(task.stack_json)
+        verdict = run_scenario(
+            scenario,
+            stack,
+            out_dir=scratch,
+            plot=False,
+            wall_ceiling=task.wall_ceiling_s,
+            source=f"scenario {task.scenario!r}",
+        )
+    except Exception as exc:  # a broken run is a result, not the end of the sweep
+        last = traceback.extract_tb(exc.__traceback__)[-1:]
+        where = f" ({Path(last[0].filename).name}:{last[0].lineno})" if last else ""
+        reason = f"{type(exc).__name__}: {exc}{where}".replace("\n", " ")
+        return RunOutcome(
+            run_id=task.run_id,
+            status="error",
+            reason=reason,
+            figures={},
+            recording_sha256=_sha256(recording),
+            wall_time_s=time.perf_counter() - start,
+            worker=worker_name(),
+            artifacts=_artifacts(recording, None) if task.keep != "none" else {},
+            scenario_json=scenario_json,
+        )
+    status: Status = "passed" if verdict.passed else "failed"
+    figures = finite_figures(verdict.as_dict())
+    for key in ("recording", "plot", "wall_time_s", "rtf", "scenario", "reason"):
+        figures.pop(key, None)
+    figures["sim_wall_s"] = verdict.wall_time_s
+    figures.update(labels)
+    artifacts = _artifacts(recording, scratch / PLOT) if _keeps(task, status) else {}
+    return RunOutcome(
+        run_id=task.run_id,
+        status=status,
+        reason=verdict.reason,
+        figures=figures,
+        recording_sha256=_sha256(recording),
+        wall_time_s=time.perf_counter() - start,
+        worker=worker_name(),
+        artifacts=artifacts,
+        scenario_json=scenario_json,
+    )
+
+
+def _sha256(path: Path) -> str | None:
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except FileNotFoundError:
+        return None
+
+
+def _artifacts(recording: Path, png: Path | None) -> dict[str, bytes]:
+    """The recording and, drawn from it, the trajectory plot (only for kept runs: a
+    plot costs about as much as a short run)."""
+    if not recording.exists():
+        return {}
+    out = {RECORDING: recording.read_bytes()}
+    if png is not None:
+        from otonav.scenario.replay import plot_recording
+
+        with contextlib.suppress(Exception):  # a plot is a convenience; the recording is
+            out[PLOT] = plot_recording(recording, png).read_bytes()  # the artifact
+    return out
