@@ -63,6 +63,34 @@ def add_parser(commands: Any) -> None:
         default=None,
         help="with --realtime/--gui only: sim seconds per wall second (default 1)",
     )
+<<<<<<< HEAD
+    p.add_argument("--gui", action="store_true", help="show the run in MuJoCo's viewer (real time)")
+    live = p.add_argument_group("live view in Foxglove (needs the otonav[foxglove] extra)")
+    live.add_argument(
+        "--foxglove",
+        action="store_true",
+        help="serve every topic over the Foxglove WebSocket protocol while the run goes",
+    )
+    live.add_argument(
+        "--foxglove-port",
+        type=int,
+        default=8765,
+        metavar="PORT",
+        help="TCP port (default 8765; 0: any free port)",
+    )
+    live.add_argument(
+        "--foxglove-host",
+        default="127.0.0.1",
+        metavar="HOST",
+        help="interface to bind (default 127.0.0.1, loopback only; 0.0.0.0: every interface)",
+    )
+    live.add_argument(
+        "--foxglove-wait",
+        type=float,
+        default=None,
+        metavar="S",
+        help="hold sim time at the start until a client subscribes (at most S wall seconds)",
+=======
     p.add_argument(
         "--gui",
         action="store_true",
@@ -72,6 +100,7 @@ def add_parser(commands: Any) -> None:
         "--hold",
         action="store_true",
         help="with --gui: keep the window open at the end, until you close it",
+>>>>>>> main
     )
     p.set_defaults(handler=main)
 
@@ -148,6 +177,9 @@ def main(args: argparse.Namespace) -> int:
         for path in stale:
             path.unlink(missing_ok=True)
 
+<<<<<<< HEAD
+    server, extra = _live_view(args)
+=======
     console = Console(highlight=False)
     held: list[Verdict] = []
 
@@ -156,6 +188,7 @@ def main(args: argparse.Namespace) -> int:
         console.print("the recording is finished; close the viewer window to exit")
         held.append(verdict)
 
+>>>>>>> main
     try:
         if args.gui or args.realtime:
             from otonav.scenario.realtime import run_scenario_realtime
@@ -168,7 +201,11 @@ def main(args: argparse.Namespace) -> int:
                 scale=scale,
                 gui=args.gui,
                 on_start=on_start,
+<<<<<<< HEAD
+                extra_actors=extra,
+=======
                 hold=hold if args.hold else None,
+>>>>>>> main
             )
         else:
             verdict = run_scenario(
@@ -179,6 +216,7 @@ def main(args: argparse.Namespace) -> int:
                 progress=progress,
                 source=source,
                 on_start=on_start,
+                extra_actors=extra,
             )
     except asyncio.CancelledError:
         print("otonav: terminated; the recording was finished and is readable", file=sys.stderr)
@@ -186,6 +224,8 @@ def main(args: argparse.Namespace) -> int:
     finally:
         if progress is not None:
             progress.clear()
+        if server is not None:
+            server.close()
     out.mkdir(parents=True, exist_ok=True)
     summary = out / "summary.json"
     summary.write_text(json.dumps(finite_figures(verdict.as_dict()), indent=2, default=str) + "\n")
@@ -197,3 +237,30 @@ def main(args: argparse.Namespace) -> int:
         print_verdict(verdict, console)
     console.print(f"summary: {summary}")
     return 0 if verdict.passed else 1
+
+
+def _live_view(args: argparse.Namespace) -> tuple[Any, tuple[Any, ...]]:
+    """The Foxglove server and its actor when ``--foxglove`` (one line, exit 2, when it
+    cannot start); ``(None, ())`` otherwise."""
+    import sys
+
+    from otonav.stack.files import ConfigFileError
+
+    if not args.foxglove:
+        return None, ()
+    from otonav.actors.live_view import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
+
+    try:
+        options = LiveViewOptions(
+            host=args.foxglove_host, port=args.foxglove_port, wait_for_subscriber=args.foxglove_wait
+        )
+        server = FoxgloveServer(options)
+    except LiveViewError as exc:
+        raise ConfigFileError(str(exc)) from None
+    print(
+        f"foxglove: serving every topic on {server.url} (Foxglove: Open connection -> "
+        "Foxglove WebSocket)",
+        file=sys.stderr,
+        flush=True,
+    )
+    return server, (LiveView(server),)

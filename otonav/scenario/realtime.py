@@ -15,7 +15,7 @@ import anyio
 
 from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
-from otonav.runtime import RealTimeClock
+from otonav.runtime import Actor, RealTimeClock
 from otonav.runtime.timesource import tick_rate
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
@@ -94,7 +94,11 @@ def run_scenario_realtime(
     scale: float = 1.0,
     gui: bool = False,
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
+<<<<<<< HEAD
+    extra_actors: tuple[Actor, ...] = (),
+=======
     hold: Callable[[Verdict], None] | None = None,
+>>>>>>> main
 ) -> Verdict:
     """Run ``scenario`` with sim time following the wall clock times ``scale`` and judge
     it, like :func:`~otonav.scenario.run.run_scenario` (same artifacts in ``out_dir``,
@@ -105,9 +109,13 @@ def run_scenario_realtime(
     is none), the window opens before the clock starts, is synced at ~60 Hz wall and
     closed at the end. Closing the window stops the run: the verdict fails and says so.
     ``on_start(loop, task)`` is called on the run's loop once the window (if any) is up.
+<<<<<<< HEAD
+    ``extra_actors`` join the system (a live view, monitors).
+=======
     ``hold`` (with ``gui``): once the run is over and its recording finished, call
     ``hold(verdict)`` (its artifact paths are not set yet) and keep the window open on
     the final state until the user closes it; Ctrl-C ends the hold too.
+>>>>>>> main
     """
     if not scale > 0:
         raise ValueError(f"real-time scale must be > 0, got {scale!r}")
@@ -121,6 +129,7 @@ def run_scenario_realtime(
         hal,
         judge,
         realtime=RealTime(scale, MAX_STEP_BATCH),
+        extra_actors=extra_actors,
         recording=out_dir / "recording.mcap" if out_dir and record else None,
     )
     viewer: ViewerHandle | None = None
