@@ -63,8 +63,16 @@ def add_parser(commands: Any) -> None:
         default=None,
         help="with --realtime/--gui only: sim seconds per wall second (default 1)",
     )
-<<<<<<< HEAD
-    p.add_argument("--gui", action="store_true", help="show the run in MuJoCo's viewer (real time)")
+    p.add_argument(
+        "--gui",
+        action="store_true",
+        help="show the run in MuJoCo's viewer (real time); the camera follows the robot",
+    )
+    p.add_argument(
+        "--hold",
+        action="store_true",
+        help="with --gui: keep the window open at the end, until you close it",
+    )
     live = p.add_argument_group("live view in Foxglove (needs the otonav[foxglove] extra)")
     live.add_argument(
         "--foxglove",
@@ -90,17 +98,6 @@ def add_parser(commands: Any) -> None:
         default=None,
         metavar="S",
         help="hold sim time at the start until a client subscribes (at most S wall seconds)",
-=======
-    p.add_argument(
-        "--gui",
-        action="store_true",
-        help="show the run in MuJoCo's viewer (real time); the camera follows the robot",
-    )
-    p.add_argument(
-        "--hold",
-        action="store_true",
-        help="with --gui: keep the window open at the end, until you close it",
->>>>>>> main
     )
     p.set_defaults(handler=main)
 
@@ -177,9 +174,7 @@ def main(args: argparse.Namespace) -> int:
         for path in stale:
             path.unlink(missing_ok=True)
 
-<<<<<<< HEAD
     server, extra = _live_view(args)
-=======
     console = Console(highlight=False)
     held: list[Verdict] = []
 
@@ -188,7 +183,6 @@ def main(args: argparse.Namespace) -> int:
         console.print("the recording is finished; close the viewer window to exit")
         held.append(verdict)
 
->>>>>>> main
     try:
         if args.gui or args.realtime:
             from otonav.scenario.realtime import run_scenario_realtime
@@ -201,11 +195,8 @@ def main(args: argparse.Namespace) -> int:
                 scale=scale,
                 gui=args.gui,
                 on_start=on_start,
-<<<<<<< HEAD
                 extra_actors=extra,
-=======
                 hold=hold if args.hold else None,
->>>>>>> main
             )
         else:
             verdict = run_scenario(

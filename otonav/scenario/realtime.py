@@ -94,11 +94,8 @@ def run_scenario_realtime(
     scale: float = 1.0,
     gui: bool = False,
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
-<<<<<<< HEAD
     extra_actors: tuple[Actor, ...] = (),
-=======
     hold: Callable[[Verdict], None] | None = None,
->>>>>>> main
 ) -> Verdict:
     """Run ``scenario`` with sim time following the wall clock times ``scale`` and judge
     it, like :func:`~otonav.scenario.run.run_scenario` (same artifacts in ``out_dir``,
@@ -109,13 +106,10 @@ def run_scenario_realtime(
     is none), the window opens before the clock starts, is synced at ~60 Hz wall and
     closed at the end. Closing the window stops the run: the verdict fails and says so.
     ``on_start(loop, task)`` is called on the run's loop once the window (if any) is up.
-<<<<<<< HEAD
     ``extra_actors`` join the system (a live view, monitors).
-=======
     ``hold`` (with ``gui``): once the run is over and its recording finished, call
     ``hold(verdict)`` (its artifact paths are not set yet) and keep the window open on
     the final state until the user closes it; Ctrl-C ends the hold too.
->>>>>>> main
     """
     if not scale > 0:
         raise ValueError(f"real-time scale must be > 0, got {scale!r}")
