@@ -2,8 +2,8 @@
 something, and for every cell the distance to the nearest such cell.
 
 Frames and units: odom, m. The grid is a square of ``2 * half_size`` m centred on
-``(centre_x, centre_y)`` (the start pose), ``resolution`` m per cell. Outside it nothing
-is known.
+``(centre_x, centre_y)`` (the start pose), ``resolution`` m per cell (default 5 cm).
+Outside it nothing is known.
 
 * **Unknown is free.** A cell is occupied once a return fell in it; nothing clears it
   (the worlds are static: a moving obstacle would leave a trail). A route through space
@@ -16,7 +16,8 @@ is known.
   so both use the one centre clearance of :mod:`otonav.nav.footprint`.
 * **Incremental.** Marking a new cell stamps a precomputed disk of distances around it
   (``np.minimum`` on a window); a cell already occupied costs nothing. A 20 x 20 m map
-  at 2.5 cm is 800 x 800 float32 (2.5 MB); a stamp of 0.6 m costs ~10 us.
+  at 5 cm is 400 x 400 float32 (0.6 MB); a stamp of 0.65 m (27 x 27 cells) costs a few us;
+  at 2.5 cm the acceptance run marked 3453 cells at ~10-20 us each (measured).
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ class ClearanceMap:
         centre_y: float,
         *,
         half_size: float = 10.0,
-        resolution: float = 0.025,
+        resolution: float = 0.05,
         max_distance: float = 0.6,
     ) -> None:
         for name, value in (

@@ -85,7 +85,7 @@ class NavigationParams:
     dwa: DwaParams = field(default_factory=DwaParams)
     tolerance: float = 0.08
     map_half_size: float = 10.0
-    map_resolution: float = 0.025
+    map_resolution: float = 0.05
     plan_resolution: float = 0.1
     plan_penalty: float = 2.0
     replan_period: float = 0.5
