@@ -20,12 +20,13 @@ One step:
    may then only move away). A sample is admissible when it can stop within its free
    length: ``v * latency + v**2 / (2 * max_accel) <= free length``.
 4. **Score** (higher is better), each term in [0, 1] or [-1, 1]:
-   ``w_heading * (1 - |bearing error to the target at the end| / pi)
+   ``w_heading * (1 - |bearing error to the target| / pi)
    + w_progress * (distance to the target gained) / (max_v * horizon)
    + w_clearance * min(min clearance - radius, clearance_cap) / clearance_cap
    + w_speed * v / max_v``.
-   The target is a point of the global path ahead of the robot (or the goal); the
-   rollout's end is its last pose before the first one under the threshold.
+   The target is a point of the global path ahead of the robot (or the goal); heading
+   and progress are taken at the rollout's closest approach to it, among its poses
+   before the first one under the threshold.
 
 The best admissible sample is the command. With none admissible the command is the
 braking one and the reason says so.
@@ -217,13 +218,22 @@ def dwa_step(
         )
     # A rollout that reaches a pose under the threshold is cut before it: it is scored
     # where it can get to, not through the obstacle.
+    # Each rollout is judged at its closest approach to the target (up to its cut): a
+    # fast arc that passes the goal within the horizon is not worse than a slow one
+    # that stops short of it (judged at the end, the DWA crawls into every goal).
     rows = np.arange(n)
-    ex, ey = xs[rows, last], ys[rows, last]
-    end_th = th[rows, last]
-    bearing = np.arctan2(ty - ey, tx - ex) - end_th
+    to_target = np.hypot(tx - xs, ty - ys)
+    beyond = np.arange(steps + 1)[None, :] > last[:, None]
+    # Ties (a turn on the spot stays at one point) go to the latest pose: its heading.
+    late = to_target - 1e-9 * np.arange(steps + 1)[None, :]
+    best_i = np.argmin(np.where(beyond, np.inf, late), axis=1)
+    ex, ey = xs[rows, best_i], ys[rows, best_i]
+    closest = to_target[rows, best_i]
+    bearing = np.arctan2(ty - ey, tx - ex) - th[rows, best_i]
     bearing = np.abs(np.remainder(bearing + math.pi, math.tau) - math.pi)
+    bearing = np.where(closest < 0.05, 0.0, bearing)  # at the target: no bearing to keep
     d0 = math.hypot(tx - x0, ty - y0)
-    gain = (d0 - np.hypot(tx - ex, ty - ey)) / (p.max_v * p.horizon)
+    gain = (d0 - closest) / (p.max_v * p.horizon)
     min_clear = clear.min(axis=1)
     room = np.clip(min_clear - p.radius, 0.0, p.clearance_cap) / p.clearance_cap
     score = (

@@ -150,6 +150,13 @@ def test_dwa_never_picks_an_arc_it_cannot_stop_on() -> None:
     assert "braking" in none.reason
 
 
+def test_dwa_does_not_crawl_into_a_goal_inside_its_horizon() -> None:
+    m = _map_with(np.empty((0, 2)))
+    # Goal 0.3 m ahead, 0.4 m/s now: an arc through the goal beats one stopping short.
+    r = dwa_step((0.0, 0.0, 0.0), 0.4, 0.0, (0.3, 0.0), 0.3, m.clearance, DwaParams())
+    assert r.v >= 0.35
+
+
 def test_dwa_turns_first_toward_a_target_behind() -> None:
     m = _map_with(np.empty((0, 2)))
     r = dwa_step((0.0, 0.0, 0.0), 0.0, 0.0, (-2.0, 0.1), 2.0, m.clearance, DwaParams())
