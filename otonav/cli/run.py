@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:  # the command's imports are in main(): --help stays fast
     from rich.console import Console
 
+    from otonav.cli.signals import StopOnSignals
     from otonav.scenario import Verdict
 
 DEFAULT_OUT = Path("out")
@@ -130,9 +131,15 @@ def print_verdict(verdict: Verdict, console: Console) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    from otonav.cli.signals import StopOnSignals
+
+    with StopOnSignals() as guard:
+        return _main(args, guard)
+
+
+def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
     import asyncio
     import json
-    import math
     import sys
 
     from pydantic import ValidationError
@@ -140,6 +147,8 @@ def main(args: argparse.Namespace) -> int:
 
     from otonav.cli.loading import load_scenario, load_stack
     from otonav.cli.progress import ProgressLine
+    from otonav.limits import check_scale
+    from otonav.runtime import WallClockCeilingError
     from otonav.scenario import ScenarioConfig, run_scenario
     from otonav.scenario.builtin import BUILTIN
     from otonav.scenario.run import finite_figures
@@ -153,8 +162,9 @@ def main(args: argparse.Namespace) -> int:
         )
     if args.hold and not args.gui:
         raise ConfigFileError("--hold: only with --gui (it keeps the viewer window open)")
-    if not (scale > 0 and math.isfinite(scale)):
-        raise ConfigFileError(f"--scale {scale}: must be a finite number > 0 (sim s per wall s)")
+    problem = check_scale(scale)
+    if problem is not None:
+        raise ConfigFileError(problem)
     scenario = load_scenario(args.scenario)
     if args.seed is not None:  # validated like the file (model_copy would not check it)
         try:
@@ -167,12 +177,13 @@ def main(args: argparse.Namespace) -> int:
     progress = ProgressLine() if sys.stderr.isatty() else None
     stale = [out / "summary.json"] + ([out / "recording.mcap"] if args.no_record else [])
 
-    def on_start(_loop: object, _task: object) -> None:
+    def on_start(loop: asyncio.AbstractEventLoop, task: asyncio.Task[None]) -> None:
         # The run has started (its input is valid, its world built, its recording
         # opened): the previous run's artifacts must not pass for this one's. Nothing is
         # deleted on bad input. An interrupted run writes no summary.json.
         for path in stale:
             path.unlink(missing_ok=True)
+        guard.attach(loop, task)  # a signal now cancels the run, which then finishes
 
     server, extra = _live_view(args)
     console = Console(highlight=False)
@@ -183,6 +194,7 @@ def main(args: argparse.Namespace) -> int:
         console.print("the recording is finished; close the viewer window to exit")
         held.append(verdict)
 
+    guard.arm()  # from here a signal stops the run and lets it finish its artifacts
     try:
         if args.gui or args.realtime:
             from otonav.scenario.realtime import run_scenario_realtime
@@ -210,13 +222,27 @@ def main(args: argparse.Namespace) -> int:
                 extra_actors=extra,
             )
     except asyncio.CancelledError:
+        if guard.received is not None:
+            return guard.report()
         print("otonav: terminated; the recording was finished and is readable", file=sys.stderr)
         return 143
+    except WallClockCeilingError as exc:
+        # A run that outlasts its wall-clock ceiling is a failed run, not a crash: the
+        # recording and the plot were finished on the way out.
+        kept = [str(out / name) for name in ("recording.mcap", "trajectory.png")]
+        kept = [path for path in kept if Path(path).exists()]
+        print(
+            f"otonav: error: {exc}" + (f"; kept {', '.join(kept)}" if kept else ""),
+            file=sys.stderr,
+        )
+        return 1
     finally:
         if progress is not None:
             progress.clear()
         if server is not None:
             server.close()
+    if guard.received is not None:  # the run had ended; the signal came while saving
+        return guard.report()
     out.mkdir(parents=True, exist_ok=True)
     summary = out / "summary.json"
     summary.write_text(json.dumps(finite_figures(verdict.as_dict()), indent=2, default=str) + "\n")

@@ -15,6 +15,7 @@ from otonav.actors.live_view import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.embed._wait import _wait_done
 from otonav.embed.paced import PacedClock
 from otonav.hal import RobotHardwareInterface
+from otonav.limits import check_scale
 from otonav.msgs import Header, Message, Point, Pose, PoseStamped, Time
 from otonav.runtime import (
     DEFAULT_QOS,
@@ -327,11 +328,15 @@ async def open_live_stack(
     On exit (normal, an exception, or the host's cancellation) the stack stops and the
     recording is finished. If an actor crashed and stopped the stack while the body ran
     normally, its :class:`~otonav.runtime.ActorCrashedError` is raised on exit.
+    A ``scale`` outside [0.01, 100] raises ``ValueError`` (``otonav.limits``).
 
     ``foxglove=True`` (or :class:`~otonav.actors.live_view.LiveViewOptions`) also serves
     every topic to Foxglove over WebSocket (127.0.0.1:8765 by default; ``live.foxglove``
     is the server, stopped on exit).
     """
+    problem = check_scale(scale, "scale")
+    if problem is not None:
+        raise ValueError(problem)
     server = _foxglove_server(foxglove)
     try:
         hal = build_world(stack)

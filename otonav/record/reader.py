@@ -26,6 +26,11 @@ class RecordingError(ValueError):
     """A file that is not a readable recording: one line naming it and why."""
 
 
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text if len(text) <= 120 else text[:117] + "..."
+
+
 @dataclass(slots=True)
 class TopicSummary:
     topic: str
@@ -142,8 +147,12 @@ def _scan_truncated(path: Path, size: int) -> RecordingSummary:
         try:
             header = NonSeekingReader(f).get_header()
             profile, library = header.profile, header.library
-        except CUT_OFF_ERRORS:
-            pass
+        except CUT_OFF_ERRORS as exc:
+            # The magic and then no header: not a cut-off recording, not a recording.
+            raise RecordingError(
+                f"{path}: no readable MCAP header after the magic ({_one_line(exc)}); "
+                "not a recording otonav can read"
+            ) from None
     schemas: dict[int, str] = {}
     channels: dict[int, TopicSummary] = {}
     metadata: dict[str, dict[str, str]] = {}

@@ -33,6 +33,8 @@ publishes on every wake, so this is exact for them. Actors that sleep on the clo
 from __future__ import annotations
 
 import asyncio
+import bisect
+import math
 from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -171,12 +173,23 @@ class Gate:
 
 class ReplayClock(Clock):
     """Sim time for one replayed actor: like the virtual clock, but its timers pass
-    through the :class:`Gate` so the feeder can order them against the inputs."""
+    through the :class:`Gate` so the feeder can order them against the inputs.
 
-    def __init__(self, gate: Gate, actor: str) -> None:
+    ``wakes`` (ticks, sorted): wake the actor at the recorded instants instead of its
+    own deadlines -- for a recording made in real time, where an actor asleep until t
+    woke when the world had caught up with the wall clock, a little after t. A sleep
+    until t then ends at the first recorded instant at or after t (the instants its
+    outputs were published at); past the last one the actor sleeps for good.
+    """
+
+    def __init__(
+        self, gate: Gate, actor: str, *, wakes: Sequence[int] | None = None, rate: float = 1.0
+    ) -> None:
         self._gate = gate
         self._loop = gate.loop
         self._actor = actor
+        self._wakes = wakes
+        self._rate = rate
 
     def now(self) -> float:
         return self._loop.time()
@@ -193,6 +206,13 @@ class ReplayClock(Clock):
             await asyncio.sleep(0)
             return
         future: asyncio.Future[None] = loop.create_future()
+        if self._wakes is not None:
+            now = round(loop.time() * self._rate)
+            asked = max(math.ceil(sim_time * self._rate - 1e-6), now + 1)
+            index = bisect.bisect_left(self._wakes, asked)
+            if index == len(self._wakes):
+                await future  # never resolved: the system stops it at the end
+            sim_time = self._wakes[index] / self._rate
         handle = loop.call_at(sim_time, self._gate.due, self._actor, future)
         try:
             await future

@@ -15,6 +15,7 @@ import anyio
 
 from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
+from otonav.limits import check_scale
 from otonav.runtime import Actor, RealTimeClock
 from otonav.runtime.timesource import tick_rate
 from otonav.scenario.config import ScenarioConfig
@@ -111,8 +112,9 @@ def run_scenario_realtime(
     ``hold(verdict)`` (its artifact paths are not set yet) and keep the window open on
     the final state until the user closes it; Ctrl-C ends the hold too.
     """
-    if not scale > 0:
-        raise ValueError(f"real-time scale must be > 0, got {scale!r}")
+    problem = check_scale(scale, "scale")
+    if problem is not None:
+        raise ValueError(problem)
     if gui:
         check_display()
     stack, hal = scenario_world(scenario, stack)
