@@ -163,7 +163,7 @@ def test_a_real_time_recording_replays_with_recorded_wakes(tmp_path: Path) -> No
     # (a burst whose outputs were published at two instants can differ: a loaded machine
     # makes more bursts, hence the margin).
     recorded = replay_recording(recording, ["nav"], wake="recorded")
-    cmd = next(t for t in recorded.topics if t.topic == "/cmd_vel")
+    cmd = next(t for t in recorded.topics if t.topic == "/cmd_vel_nav")
     assert cmd.identical >= 0.75 * cmd.recorded
     # /nav/state's stamp is taken at the wake-up, which the recording does not keep.
     assert {d.field for d in recorded.divergences if d.kind == "content"} <= {
