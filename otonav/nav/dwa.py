@@ -7,7 +7,8 @@ One step:
 
 1. **Window.** The (v, omega) reachable within one control period ``period`` under the
    acceleration limits, intersected with ``[0, max_v] x [-max_omega, max_omega]``; the
-   top of the v range is also capped at ``sqrt(2 * max_accel * goal_distance)`` so the
+   top of the v range is also capped at ``sqrt(max_accel * goal_distance)`` (braking at
+   half the limit stops at the goal) so the
    robot arrives instead of overshooting. ``v_samples x omega_samples`` samples,
    plus the braking command (the window's lowest v, omega toward 0). With the target
    more than ``rotate_threshold`` off the heading only the lowest v is sampled: the
@@ -170,7 +171,8 @@ def dwa_step(
     """
     p = params
     x0, y0, th0 = pose
-    v_cap = min(p.max_v, math.sqrt(2.0 * p.max_accel * max(goal_distance, 0.0)))
+    # Arrive: braking at half the limit would stop at the goal (margin for the period).
+    v_cap = min(p.max_v, math.sqrt(p.max_accel * max(goal_distance, 0.0)))
     v_lo = min(max(v0 - p.max_accel * p.period, 0.0), v_cap)
     v_hi = min(max(v0 + p.max_accel * p.period, 0.0), v_cap)
     w_lo = max(omega0 - p.max_alpha * p.period, -p.max_omega)
