@@ -274,9 +274,12 @@ def _live_view(args: argparse.Namespace) -> tuple[Any, tuple[Any, ...]]:
         server = FoxgloveServer(options)
     except LiveViewError as exc:
         raise ConfigFileError(str(exc)) from None
+    hint = ""
+    if not (args.realtime or args.gui) and args.foxglove_wait is None:
+        hint = "; in virtual time the run may be over before a client connects: --foxglove-wait S"
     print(
         f"foxglove: serving every topic on {server.url} (Foxglove: Open connection -> "
-        "Foxglove WebSocket)",
+        f"Foxglove WebSocket){hint}",
         file=sys.stderr,
         flush=True,
     )

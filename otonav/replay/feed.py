@@ -33,8 +33,6 @@ publishes on every wake, so this is exact for them. Actors that sleep on the clo
 from __future__ import annotations
 
 import asyncio
-import bisect
-import math
 from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -177,9 +175,9 @@ class ReplayClock(Clock):
 
     ``wakes`` (ticks, sorted): wake the actor at the recorded instants instead of its
     own deadlines -- for a recording made in real time, where an actor asleep until t
-    woke when the world had caught up with the wall clock, a little after t. A sleep
-    until t then ends at the first recorded instant at or after t (the instants its
-    outputs were published at); past the last one the actor sleeps for good.
+    woke when the world had caught up with the wall clock, a little after t. Each sleep
+    then ends at the actor's next recorded wake-up (the instants its outputs were
+    published at, in order); past the last one the actor sleeps for good.
     """
 
     def __init__(
@@ -190,6 +188,7 @@ class ReplayClock(Clock):
         self._actor = actor
         self._wakes = wakes
         self._rate = rate
+        self._next = 0
 
     def now(self) -> float:
         return self._loop.time()
@@ -202,17 +201,23 @@ class ReplayClock(Clock):
 
     async def sleep_until(self, sim_time: float) -> None:
         loop = self._loop
-        if sim_time <= loop.time():
+        if sim_time <= loop.time() and self._wakes is None:
             await asyncio.sleep(0)
             return
         future: asyncio.Future[None] = loop.create_future()
         if self._wakes is not None:
+            # Follow the recorded wake-ups in order, whatever instant the actor asks for:
+            # in real time an actor can wake twice at one instant (its sleep until a
+            # time the world had already passed returned at once), which a replay, where
+            # time stands still while it computes, would not ask for.
             now = round(loop.time() * self._rate)
-            asked = max(math.ceil(sim_time * self._rate - 1e-6), now + 1)
-            index = bisect.bisect_left(self._wakes, asked)
-            if index == len(self._wakes):
+            wakes, index = self._wakes, self._next
+            while index < len(wakes) and wakes[index] < now:
+                index += 1
+            if index == len(wakes):
                 await future  # never resolved: the system stops it at the end
-            sim_time = self._wakes[index] / self._rate
+            self._next = index + 1
+            sim_time = wakes[index] / self._rate
         handle = loop.call_at(sim_time, self._gate.due, self._actor, future)
         try:
             await future
