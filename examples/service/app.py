@@ -14,13 +14,19 @@ Endpoints::
                                    "set": ["nav.kp_lin=0.5"], "seed": 3} -> 202 {"id": ...}
     GET    /runs                  every run and its status
     GET    /runs/{id}?wait=10     status, sim time so far, verdict (wait: for the end, s)
+    GET    /runs/{id}/recording   the finished run's MCAP file (409 while it runs)
+    GET    /runs/{id}/plot        the finished run's trajectory.png (409 while it runs)
     DELETE /runs/{id}             cancel; its recording is finished and indexed
     GET    /live/pose?hz=10       text/event-stream of {"t", "x", "y", "yaw"} (odometry)
     POST   /live/goal             {"x": 4.0, "y": 1.5} -> 202
     GET    /live/graph            actors, topics, QoS and statistics of the live stack
 
-Bad input gets a 4xx whose ``error`` is the one-line message the CLI prints after
-``otonav: error:``. The server binds to 127.0.0.1 unless told otherwise.
+Bad input gets a 4xx whose ``error`` is one line naming the request's field (``scenario``,
+``set``, ``seed``, ``goal``), what is wrong and what is valid. The live robot's recording,
+OUT/live.mcap, rotates at ``--live-record-mb`` (64 MB): the finished file becomes
+live.1.mcap (older ones move up; ``--live-record-keep`` of them stay, default 2), so disk
+use stays under about (keep + 1) x the cap. The server binds to 127.0.0.1 unless told
+otherwise.
 """
 
 from __future__ import annotations
@@ -45,20 +51,22 @@ import uvicorn
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from starlette.applications import Starlette
 from starlette.requests import Request
-from starlette.responses import JSONResponse, Response, StreamingResponse
+from starlette.responses import FileResponse, JSONResponse, Response, StreamingResponse
 from starlette.routing import Route
 
 from otonav.actors import topics
-from otonav.cli.loading import load_scenario, load_stack
+from otonav.cli.loading import load_stack
 from otonav.embed import LiveStack, check_run, open_live_stack, run_scenario_async
 from otonav.hal.mujoco import SceneError, scene_names
 from otonav.msgs import Odometry
+from otonav.record.rotating import RotatingRecordingWriter
 from otonav.runtime import QoS, Reliability
 from otonav.scenario import GoalSpec, ScenarioConfig, Verdict
 from otonav.scenario.builtin import BUILTIN
 from otonav.scenario.validate import check_goal
 from otonav.stack import StackConfig
 from otonav.stack.files import ConfigFileError, describe_validation_error, to_json
+from otonav.stack.overrides import apply_overrides
 
 log = logging.getLogger("otonav.service")
 
@@ -134,19 +142,21 @@ def resolve_scenario(spec: str | dict[str, Any], seed: int | None) -> tuple[Scen
         scenario, source = BUILTIN[spec], f"scenario '{spec}'"
     elif _names_a_file(spec, (".yaml", ".yml")):
         raise ConfigFileError(
-            f"--scenario {spec!r}: the service runs built-in scenarios "
+            f"scenario: {spec!r}: the service runs built-in scenarios "
             f"({', '.join(BUILTIN)}) or inline ones, and reads no files"
         )
     else:
-        scenario = load_scenario(spec)  # raises the CLI's "not a built-in scenario" error
-        source = spec
+        raise ConfigFileError(
+            f"scenario: {spec!r} is not a built-in scenario ({', '.join(BUILTIN)}); "
+            "give one of those names or a scenario object"
+        )
     if seed is not None:
         data = scenario.model_dump()
         data["seed"] = seed
         try:
             scenario = ScenarioConfig.model_validate(data)
-        except ValidationError as exc:
-            raise ConfigFileError(describe_validation_error("--seed", exc)) from None
+        except ValidationError as exc:  # the location says "seed": no prefix to repeat it
+            raise ConfigFileError(describe_validation_error("", exc).removeprefix(": ")) from None
     return scenario, source
 
 
@@ -179,7 +189,16 @@ class Run:
             "verdict": self.verdict.as_dict() if self.verdict else None,
             "error": self.error,
             "recording": str(recording) if recording.exists() else None,
+            "links": {
+                name: f"/runs/{self.id}/{name}"
+                for name, path in (("recording", recording), ("plot", self.plot_path))
+                if self.done.is_set() and path.exists()
+            },
         }
+
+    @property
+    def plot_path(self) -> Path:
+        return self.out_dir / "trajectory.png"
 
 
 class Runs:
@@ -295,12 +314,16 @@ class Service:
         live: bool = True,
         live_scale: float = 1.0,
         live_record: Path | None = None,
+        live_record_bytes: int = 64 * 2**20,
+        live_record_keep: int = 2,
         max_runs: int = 2,
     ) -> None:
         self.stack = stack
         self.live_enabled = live
         self.live_scale = live_scale
         self.live_record = live_record
+        self.live_record_bytes = live_record_bytes
+        self.live_record_keep = live_record_keep
         self.runs = Runs(out_root, max_runs)
         self.live: LiveStack | None = None
 
@@ -309,8 +332,19 @@ class Service:
         self.runs.limiter = anyio.CapacityLimiter(self.runs.max_runs)
         async with AsyncExitStack() as stack:
             if self.live_enabled:
+                # The live robot runs for as long as the service does: its recording
+                # rotates at a size cap instead of growing without limit.
+                record = (
+                    RotatingRecordingWriter(
+                        self.live_record,
+                        max_bytes=self.live_record_bytes,
+                        keep=self.live_record_keep,
+                    )
+                    if self.live_record is not None
+                    else None
+                )
                 self.live = await stack.enter_async_context(
-                    open_live_stack(self.stack, scale=self.live_scale, record_to=self.live_record)
+                    open_live_stack(self.stack, scale=self.live_scale, record_to=record)
                 )
             try:
                 yield
@@ -325,6 +359,8 @@ class Service:
             Route("/runs", self.list_runs, methods=["GET"]),
             Route("/runs/{run_id}", _errors_as_4xx(self.get_run), methods=["GET"]),
             Route("/runs/{run_id}", _errors_as_4xx(self.delete_run), methods=["DELETE"]),
+            Route("/runs/{run_id}/recording", _errors_as_4xx(self.get_recording), methods=["GET"]),
+            Route("/runs/{run_id}/plot", _errors_as_4xx(self.get_plot), methods=["GET"]),
             Route("/live/pose", _errors_as_4xx(self.live_pose), methods=["GET"]),
             Route("/live/goal", _errors_as_4xx(self.live_goal), methods=["POST"]),
             Route("/live/graph", _errors_as_4xx(self.live_graph), methods=["GET"]),
@@ -347,10 +383,13 @@ class Service:
     async def post_run(self, request: Request) -> Response:
         body: RunRequest = _parse(RunRequest, await _json_body(request), "request")
         scenario, source = resolve_scenario(body.scenario, body.seed)
-        stack = load_stack(None, body.set)
+        stack = apply_overrides(self.stack, body.set, source="set")
         # What the CLI would reject before running (scene, goal): a 400 now, not a
         # failed run later. Building the world takes milliseconds: off the loop.
-        await anyio.to_thread.run_sync(lambda: check_run(scenario, stack, source=source))
+        try:
+            await anyio.to_thread.run_sync(lambda: check_run(scenario, stack, source=source))
+        except SceneError as exc:  # names the scene, not where it came from: add that
+            raise BadRequest(f"{source}: {exc}") from None
         run = self.runs.start(scenario, stack, source)
         return _json(run.as_dict(), 202)
 
@@ -375,6 +414,28 @@ class Service:
             with anyio.move_on_after(min(max(seconds, 0.0), MAX_WAIT_S)):
                 await run.done.wait()
         return _json(run.as_dict())
+
+    def _artifact(self, request: Request, path: Path, what: str) -> Path:
+        run = self._run(request)
+        if not run.done.is_set():
+            raise BadRequest(
+                f"run {run.id} is {run.status}: its {what} is not finished yet "
+                "(ask again when it ends)",
+                409,
+            )
+        if not path.exists():
+            raise BadRequest(f"run {run.id} ({run.status}) left no {what}", 404)
+        return path
+
+    async def get_recording(self, request: Request) -> Response:
+        run = self._run(request)
+        path = self._artifact(request, run.out_dir / "recording.mcap", "recording")
+        return FileResponse(path, media_type="application/octet-stream", filename=f"{run.id}.mcap")
+
+    async def get_plot(self, request: Request) -> Response:
+        run = self._run(request)
+        path = self._artifact(request, run.plot_path, "plot")
+        return FileResponse(path, media_type="image/png")
 
     async def delete_run(self, request: Request) -> Response:
         run = self._run(request)
@@ -406,13 +467,16 @@ class Service:
     async def live_goal(self, request: Request) -> Response:
         live = self._live()
         goal: GoalRequest = _parse(GoalRequest, await _json_body(request), "goal")
-        check_goal(
-            ScenarioConfig(scene=self.stack.world.scene, goal=GoalSpec(x=goal.x, y=goal.y)),
-            self.stack.world.scene,
-            live.hal.obstacles(),
-            live.hal.walls(),
-            source="goal",
-        )
+        try:
+            check_goal(
+                ScenarioConfig(scene=self.stack.world.scene, goal=GoalSpec(x=goal.x, y=goal.y)),
+                self.stack.world.scene,
+                live.hal.obstacles(),
+                live.hal.walls(),
+                source="goal",
+            )
+        except ConfigFileError as exc:  # "goal: goal: (x, y) is ...": say it once
+            raise BadRequest(str(exc).replace("goal: goal: ", "goal ", 1)) from None
         await live.publish_goal(goal.x, goal.y)
         return _json({"goal": {"x": goal.x, "y": goal.y}, "sim_time_s": live.now()}, 202)
 
@@ -477,10 +541,26 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-live", action="store_true", help="no live robot")
     parser.add_argument("--live-scale", type=float, default=1.0, help="sim s per wall s")
     parser.add_argument("--no-live-record", action="store_true")
+    parser.add_argument(
+        "--live-record-mb",
+        type=float,
+        default=64.0,
+        help="rotate OUT/live.mcap at this size (MB; default 64)",
+    )
+    parser.add_argument(
+        "--live-record-keep",
+        type=int,
+        default=2,
+        help="finished live recordings kept as live.1.mcap, live.2.mcap, ... (default 2)",
+    )
     parser.add_argument("--max-runs", type=int, default=2, help="simulations at once")
     args = parser.parse_args(argv)
     try:
         stack = load_stack(args.config, args.overrides)
+        if not args.live_record_mb >= 0.1:
+            raise ConfigFileError(f"--live-record-mb {args.live_record_mb:g}: must be >= 0.1")
+        if args.live_record_keep < 0:
+            raise ConfigFileError(f"--live-record-keep {args.live_record_keep}: must be >= 0")
     except ConfigFileError as exc:
         print(f"otonav: error: {exc}", file=sys.stderr)
         return 2
@@ -491,6 +571,8 @@ def main(argv: list[str] | None = None) -> int:
         live=not args.no_live,
         live_scale=args.live_scale,
         live_record=None if args.no_live_record else out / "live.mcap",
+        live_record_bytes=round(args.live_record_mb * 2**20),
+        live_record_keep=args.live_record_keep,
         max_runs=args.max_runs,
     )
     # Bind first, so the address is known (port 0) before the server starts accepting.

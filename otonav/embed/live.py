@@ -17,6 +17,7 @@ from otonav.embed.paced import PacedClock
 from otonav.hal import RobotHardwareInterface
 from otonav.limits import check_scale
 from otonav.msgs import Header, Message, Point, Pose, PoseStamped, Time
+from otonav.record.writer import RecordingWriter
 from otonav.runtime import (
     DEFAULT_QOS,
     LATCHED_QOS,
@@ -313,7 +314,7 @@ async def open_live_stack(
     stack: StackConfig = StackConfig(),
     *,
     scale: float = 1.0,
-    record_to: Path | None = None,
+    record_to: Path | RecordingWriter | None = None,
     goal: tuple[float, float] | None = None,
     navigator: bool = True,
     extra_actors: Sequence[Actor] = (),
@@ -323,7 +324,9 @@ async def open_live_stack(
     """Bring the robot stack up on the running (stock asyncio) loop in real-time mode,
     the world stepped to follow the wall clock times ``scale``; yield a
     :class:`LiveStack`. With ``record_to`` every topic goes to that MCAP file, finished
-    on every exit. ``goal``: an initial goal for the navigator (or publish one later).
+    on every exit (or to that writer, e.g. a size-capped
+    :class:`~otonav.record.rotating.RotatingRecordingWriter`). ``goal``: an initial
+    goal for the navigator (or publish one later).
 
     On exit (normal, an exception, or the host's cancellation) the stack stops and the
     recording is finished. If an actor crashed and stopped the stack while the body ran
