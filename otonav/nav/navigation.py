@@ -14,7 +14,9 @@ Each :meth:`Navigation.step` (at the navigator's rate):
    look around (the ``spin`` stage), then, if still none, ``unreachable``: "no path
    to the goal in the observed map". The map only gains obstacles, so a second proof
    stands;
-3. **DWA** (:mod:`otonav.nav.dwa`) toward a point ``lookahead`` m along the path:
+3. within ``approach_radius`` of the goal, a proportional controller finishes, forward
+   or in reverse (an overshoot is backed out of, not turned around); farther away,
+   **DWA** (:mod:`otonav.nav.dwa`) toward a point ``lookahead`` m along the path:
    ``driving``, or ``avoiding`` when the chosen arc passes near a return; ``blocked``
    when no arc is admissible;
 4. **progress** (:class:`~otonav.nav.recovery.ProgressChecker`): when it fails, the next
@@ -80,6 +82,10 @@ class NavigationParams:
         follow_time: the longest boundary following, s.
         follow_speed: its speed, m/s.
         follow_distance: centre-to-boundary distance while following, m.
+        approach_radius: within this distance of the goal a proportional controller
+            finishes (forward or in reverse, whichever faces the goal), m.
+        kp_lin: its speed per metre of distance, 1/s.
+        kp_ang: its yaw rate per radian of heading error, 1/s.
     """
 
     dwa: DwaParams = field(default_factory=DwaParams)
@@ -101,6 +107,9 @@ class NavigationParams:
     follow_time: float = 8.0
     follow_speed: float = 0.2
     follow_distance: float = 0.45
+    approach_radius: float = 0.25
+    kp_lin: float = 0.8
+    kp_ang: float = 2.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -235,6 +244,8 @@ class Navigation:
             stage = LADDER[self._ladder]
             self._ladder += 1
             return self._begin(stage, now, pose, distance, heading, points, stuck)
+        if distance < self.params.approach_radius:
+            return self._approach(distance, heading)
         target = self._target(pose)
         result = dwa_step(pose, v0, omega0, target, distance, self.map.clearance, self.params.dwa)
         if result.admissible == 0:
@@ -267,6 +278,18 @@ class Navigation:
             self.path_length if self.path is not None else math.nan,
             self.replans,
         )
+
+    def _approach(self, distance: float, heading: float) -> NavOutput:
+        """The last centimetres: P-control on distance and heading, in reverse when the
+        goal is behind (an overshoot is undone by backing up, not by a U-turn); the
+        safety layer still checks every command."""
+        p = self.params
+        ahead = abs(heading) <= math.pi / 2
+        facing = heading if ahead else wrap_angle(heading - math.pi)
+        v_max = min(p.dwa.max_v, math.sqrt(p.dwa.max_accel * distance))
+        v = min(p.kp_lin * distance, v_max) * math.cos(facing) * (1.0 if ahead else -1.0)
+        omega = min(max(p.kp_ang * facing, -p.dwa.max_omega), p.dwa.max_omega)
+        return self._out(v, omega, "driving", "final approach", distance, heading)
 
     def _give_up(self, reason: str, distance: float, heading: float) -> NavOutput:
         self._gave_up = reason

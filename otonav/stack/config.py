@@ -152,6 +152,9 @@ class NavConfig(_Section):
     clearance: float = Field(0.35, ge=0.0, le=5.0)
     """m, robot centre (base_link, the judged point) to any return: what the planner
     keeps, in [0, 5]; at least ``safety.clearance``."""
+    approach_radius: float = Field(0.25, ge=0.0, le=5.0)
+    """m (dwa planner): within this distance of the goal a proportional controller
+    (``kp_lin``, ``kp_ang``) finishes, in reverse if the goal is behind, in [0, 5]."""
     footprint_padding: float = Field(0.05, ge=0.0, le=1.0)
     """m, gap kept between the footprint (read from the MJCF) and any return, in [0, 1].
     The planner keeps its centre max(clearance, footprint radius + padding) away."""

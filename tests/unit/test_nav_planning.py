@@ -252,3 +252,12 @@ def test_navigation_plans_around_a_box_and_reports_reached() -> None:
     done = nav.step(1.0, (2.95, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
     assert done.state == "reached"
     assert (done.v, done.omega) == (0.0, 0.0)
+
+
+def test_an_overshot_goal_is_backed_into_not_turned_around() -> None:
+    nav = Navigation(NavigationParams(), (0.0, 0.0))
+    nav.set_goal((1.0, 0.0))
+    out = nav.step(0.0, (1.12, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))  # 0.12 m past it
+    assert out.reason == "final approach"
+    assert out.v < 0.0
+    assert abs(out.omega) < 1e-9
