@@ -2,7 +2,7 @@
 runs, with the recordings' ROS 2 schemas and CDR payloads (so Foxglove's 3D panel draws
 the robot, its scan and /tf live), stamped with sim time.
 
-Two parts (docs/adr/0016-live-view-over-foxglove-sdk.md):
+Two parts (docs/adr/0031-live-view-over-foxglove-sdk.md):
 
 - :class:`FoxgloveServer` wraps ``foxglove-sdk``'s WebSocket server (the optional extra
   ``otonav[foxglove]``). The server runs on the SDK's own threads; handing it a message
