@@ -131,6 +131,17 @@ def test_a_generated_world_is_kept_with_a_repro_that_reproduces_it(tmp_path: Pat
     assert hashlib.sha256(recording).hexdigest() == record["recording_sha256"]
 
 
+def test_a_worker_is_recycled_after_its_quota_of_runs(tmp_path: Path) -> None:
+    from otonav.sweep.backends.process import ProcessBackend
+
+    sweep = write_sweep(tmp_path)
+    tasks = [t for t in tasks_of(sweep) if t.scenario == "stuck"][:3]  # 0.5 s of sim each
+    records = execute(prepare(tmp_path / "out", tasks), ProcessBackend(1, runs_per_worker=2))
+    workers = [r["worker"] for r in records]
+    assert workers[0] == workers[1] != workers[2]
+    assert [r["status"] for r in records] == ["failed"] * 3
+
+
 def test_crashed_and_hung_workers_are_errors_then_resume_retries_only_them(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
