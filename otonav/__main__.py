@@ -1,5 +1,5 @@
 """``python -m otonav``: the command-line interface."""
 
-from otonav.cli import main
+from otonav._entry import main
 
 raise SystemExit(main())

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass
 
+import anyio
+
 from otonav.actors import topics
 from otonav.control import DiffDriveGeometry, limit_twist, twist_to_wheels
-from otonav.msgs import HardwareStatus, Header, Time, Twist, WheelCommand
+from otonav.msgs import HardwareStatus, Header, Log, Time, Twist, WheelCommand
 from otonav.runtime import Actor, Input, Output
 
 
@@ -28,11 +31,20 @@ class BaseController(Actor):
 
     While /hardware/status says the hardware is not drivable (a fault, or starting or
     recovering), it commands zero at once, bypassing the acceleration limits, and
-    counts it in ``hardware_stops``; when it is drivable again it ramps up from rest."""
+    counts it in ``hardware_stops``; when it is drivable again it ramps up from rest.
+
+    A /cmd_vel that is not finite (NaN, inf) is dropped: the base keeps the last good
+    command (the watchdog still counts from it), counts it in ``rejected_commands`` and
+    says so on /rosout, at most once per second of sim time. One bad message from one
+    publisher must not stop the robot's whole stack."""
 
     cmd_vel = Input(topics.CMD_VEL, Twist, topics.COMMAND_QOS)
     wheel_cmd = Output(topics.WHEEL_CMD, WheelCommand, topics.COMMAND_QOS)
     hardware = Input(topics.HARDWARE_STATUS, HardwareStatus, topics.HARDWARE_QOS)
+    rosout = Output(topics.ROSOUT, Log, topics.ROSOUT_QOS)
+
+    LOG_EVERY = 1.0
+    """s of sim time between two warnings about rejected commands."""
 
     def __init__(
         self,
@@ -53,6 +65,9 @@ class BaseController(Actor):
         self.rate_hz = rate_hz
         self.cmd_timeout = cmd_timeout
         self.watchdog_trips = 0
+        self.rejected_commands = 0
+        self._logged_at = -math.inf
+        self._logged_count = 0
         self.hardware_stops = 0
 
     async def run(self) -> None:
@@ -73,7 +88,10 @@ class BaseController(Actor):
                 drivable = status.drivable
             latest = self.cmd_vel.take_latest()
             if latest is not None:
-                target, received_at, timed_out = latest, now, False
+                if math.isfinite(latest.linear.x) and math.isfinite(latest.angular.z):
+                    target, received_at, timed_out = latest, now, False
+                else:
+                    self._reject(latest, now)
             # received_at is the control tick that picked the command up, up to one
             # period after it arrived: trip at >= so the stop starts within
             # cmd_timeout + one period of the last command, never before cmd_timeout.
@@ -107,3 +125,26 @@ class BaseController(Actor):
                     right=right,
                 )
             )
+
+    def _reject(self, command: Twist, now: float) -> None:
+        self.rejected_commands += 1
+        if now - self._logged_at < self.LOG_EVERY - 1e-9:
+            return
+        since = self.rejected_commands - self._logged_count - 1
+        more = f" ({since} more since the last warning)" if since else ""
+        text = (
+            f"rejected a /cmd_vel that is not finite (linear.x={command.linear.x}, "
+            f"angular.z={command.angular.z}); keeping the last good command{more}"
+        )
+        self._logged_at, self._logged_count = now, self.rejected_commands
+        log = Log.fast(
+            stamp=Time.from_seconds(now),
+            level=Log.WARN,
+            name=self.name,
+            msg=text,
+            file="",
+            function="",
+            line=0,
+        )
+        with contextlib.suppress(anyio.WouldBlock):  # never stall control for a log line
+            self.rosout.publish_nowait(log)

@@ -54,6 +54,14 @@ def add_parser(commands: Any) -> None:
     p.add_argument(
         "--out", type=Path, help="write an MCAP with the replayed outputs beside the inputs"
     )
+    p.add_argument(
+        "--wake",
+        choices=("timers", "recorded"),
+        default="timers",
+        help="when the actors wake: on their own timers (default; exact for virtual-time "
+        "recordings), or at the instants their outputs were recorded (for a recording made "
+        "in real time, where wake-ups followed the wall clock)",
+    )
     p.set_defaults(handler=main)
 
 
@@ -71,7 +79,11 @@ def main(args: argparse.Namespace) -> int:
         raise ConfigFileError(f"--tolerance {args.tolerance}: must be a finite number >= 0")
     try:
         result = replay_recording(
-            args.recording, nodes, overrides=args.overrides, tolerance=args.tolerance
+            args.recording,
+            nodes,
+            overrides=args.overrides,
+            tolerance=args.tolerance,
+            wake=args.wake,
         )
         written = write_replay(result, args.out) if args.out is not None else None
     except ReplayInputError as exc:
@@ -111,6 +123,10 @@ def print_result(result: ReplayResult, console: Console) -> None:
     if first is not None:
         console.print(f"first divergence: {first}")
         console.print(f"DIVERGED: {len(result.divergences)} message(s) beyond the tolerance")
+        if all(d.kind != "content" for d in result.divergences):
+            console.print(
+                "(only timing differs: if the recording was made in real time, try --wake recorded)"
+            )
     elif result.crash is None:
         verdict = "byte-identical" if result.byte_identical else "same within the tolerance"
         console.print(f"SAME: every output {verdict}")

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:  # the command's imports are in main(): --help stays fast
     from rich.console import Console
 
+    from otonav.cli.signals import StopOnSignals
     from otonav.scenario import Verdict
 
 DEFAULT_OUT = Path("out")
@@ -73,6 +74,32 @@ def add_parser(commands: Any) -> None:
         action="store_true",
         help="with --gui: keep the window open at the end, until you close it",
     )
+    live = p.add_argument_group("live view in Foxglove (needs the otonav[foxglove] extra)")
+    live.add_argument(
+        "--foxglove",
+        action="store_true",
+        help="serve every topic over the Foxglove WebSocket protocol while the run goes",
+    )
+    live.add_argument(
+        "--foxglove-port",
+        type=int,
+        default=8765,
+        metavar="PORT",
+        help="TCP port (default 8765; 0: any free port)",
+    )
+    live.add_argument(
+        "--foxglove-host",
+        default="127.0.0.1",
+        metavar="HOST",
+        help="interface to bind (default 127.0.0.1, loopback only; 0.0.0.0: every interface)",
+    )
+    live.add_argument(
+        "--foxglove-wait",
+        type=float,
+        default=None,
+        metavar="S",
+        help="hold sim time at the start until a client subscribes (at most S wall seconds)",
+    )
     p.set_defaults(handler=main)
 
 
@@ -104,9 +131,15 @@ def print_verdict(verdict: Verdict, console: Console) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    from otonav.cli.signals import StopOnSignals
+
+    with StopOnSignals() as guard:
+        return _main(args, guard)
+
+
+def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
     import asyncio
     import json
-    import math
     import sys
 
     from pydantic import ValidationError
@@ -114,6 +147,8 @@ def main(args: argparse.Namespace) -> int:
 
     from otonav.cli.loading import load_scenario, load_stack
     from otonav.cli.progress import ProgressLine
+    from otonav.limits import check_scale
+    from otonav.runtime import WallClockCeilingError
     from otonav.scenario import ScenarioConfig, run_scenario
     from otonav.scenario.builtin import BUILTIN
     from otonav.scenario.run import finite_figures
@@ -127,8 +162,9 @@ def main(args: argparse.Namespace) -> int:
         )
     if args.hold and not args.gui:
         raise ConfigFileError("--hold: only with --gui (it keeps the viewer window open)")
-    if not (scale > 0 and math.isfinite(scale)):
-        raise ConfigFileError(f"--scale {scale}: must be a finite number > 0 (sim s per wall s)")
+    problem = check_scale(scale)
+    if problem is not None:
+        raise ConfigFileError(problem)
     scenario = load_scenario(args.scenario)
     if args.seed is not None:  # validated like the file (model_copy would not check it)
         try:
@@ -141,13 +177,15 @@ def main(args: argparse.Namespace) -> int:
     progress = ProgressLine() if sys.stderr.isatty() else None
     stale = [out / "summary.json"] + ([out / "recording.mcap"] if args.no_record else [])
 
-    def on_start(_loop: object, _task: object) -> None:
+    def on_start(loop: asyncio.AbstractEventLoop, task: asyncio.Task[None]) -> None:
         # The run has started (its input is valid, its world built, its recording
         # opened): the previous run's artifacts must not pass for this one's. Nothing is
         # deleted on bad input. An interrupted run writes no summary.json.
         for path in stale:
             path.unlink(missing_ok=True)
+        guard.attach(loop, task)  # a signal now cancels the run, which then finishes
 
+    server, extra = _live_view(args)
     console = Console(highlight=False)
     held: list[Verdict] = []
 
@@ -156,6 +194,7 @@ def main(args: argparse.Namespace) -> int:
         console.print("the recording is finished; close the viewer window to exit")
         held.append(verdict)
 
+    guard.arm()  # from here a signal stops the run and lets it finish its artifacts
     try:
         if args.gui or args.realtime:
             from otonav.scenario.realtime import run_scenario_realtime
@@ -168,6 +207,7 @@ def main(args: argparse.Namespace) -> int:
                 scale=scale,
                 gui=args.gui,
                 on_start=on_start,
+                extra_actors=extra,
                 hold=hold if args.hold else None,
             )
         else:
@@ -179,13 +219,30 @@ def main(args: argparse.Namespace) -> int:
                 progress=progress,
                 source=source,
                 on_start=on_start,
+                extra_actors=extra,
             )
     except asyncio.CancelledError:
+        if guard.received is not None:
+            return guard.report()
         print("otonav: terminated; the recording was finished and is readable", file=sys.stderr)
         return 143
+    except WallClockCeilingError as exc:
+        # A run that outlasts its wall-clock ceiling is a failed run, not a crash: the
+        # recording and the plot were finished on the way out.
+        kept = [str(out / name) for name in ("recording.mcap", "trajectory.png")]
+        kept = [path for path in kept if Path(path).exists()]
+        print(
+            f"otonav: error: {exc}" + (f"; kept {', '.join(kept)}" if kept else ""),
+            file=sys.stderr,
+        )
+        return 1
     finally:
         if progress is not None:
             progress.clear()
+        if server is not None:
+            server.close()
+    if guard.received is not None:  # the run had ended; the signal came while saving
+        return guard.report()
     out.mkdir(parents=True, exist_ok=True)
     summary = out / "summary.json"
     summary.write_text(json.dumps(finite_figures(verdict.as_dict()), indent=2, default=str) + "\n")
@@ -197,3 +254,33 @@ def main(args: argparse.Namespace) -> int:
         print_verdict(verdict, console)
     console.print(f"summary: {summary}")
     return 0 if verdict.passed else 1
+
+
+def _live_view(args: argparse.Namespace) -> tuple[Any, tuple[Any, ...]]:
+    """The Foxglove server and its actor when ``--foxglove`` (one line, exit 2, when it
+    cannot start); ``(None, ())`` otherwise."""
+    import sys
+
+    from otonav.stack.files import ConfigFileError
+
+    if not args.foxglove:
+        return None, ()
+    from otonav.actors.live_view import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
+
+    try:
+        options = LiveViewOptions(
+            host=args.foxglove_host, port=args.foxglove_port, wait_for_subscriber=args.foxglove_wait
+        )
+        server = FoxgloveServer(options)
+    except LiveViewError as exc:
+        raise ConfigFileError(str(exc)) from None
+    hint = ""
+    if not (args.realtime or args.gui) and args.foxglove_wait is None:
+        hint = "; in virtual time the run may be over before a client connects: --foxglove-wait S"
+    print(
+        f"foxglove: serving every topic on {server.url} (Foxglove: Open connection -> "
+        f"Foxglove WebSocket){hint}",
+        file=sys.stderr,
+        flush=True,
+    )
+    return server, (LiveView(server),)

@@ -11,10 +11,13 @@ from types import TracebackType
 from typing import Any, Generic, TypeVar
 
 from otonav.actors import topics
+from otonav.actors.live_view import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.embed._wait import _wait_done
 from otonav.embed.paced import PacedClock
 from otonav.hal import RobotHardwareInterface
+from otonav.limits import check_scale
 from otonav.msgs import Header, Message, Point, Pose, PoseStamped, Time
+from otonav.record.writer import RecordingWriter
 from otonav.runtime import (
     DEFAULT_QOS,
     LATCHED_QOS,
@@ -149,6 +152,8 @@ class LiveStack:
         self._closed = False
         self._close_done: asyncio.Future[None] | None = None
         self._failure: BaseException | None = None
+        self.foxglove: FoxgloveServer | None = None
+        """The Foxglove live view's server, when asked for (``foxglove=True``)."""
 
     # -- what a host reads
 
@@ -298,36 +303,67 @@ class LiveStack:
             raise asyncio.CancelledError
 
 
+def _foxglove_server(foxglove: bool | LiveViewOptions) -> FoxgloveServer | None:
+    if foxglove is False:
+        return None
+    return FoxgloveServer(foxglove if isinstance(foxglove, LiveViewOptions) else LiveViewOptions())
+
+
 @asynccontextmanager
 async def open_live_stack(
     stack: StackConfig = StackConfig(),
     *,
     scale: float = 1.0,
-    record_to: Path | None = None,
+    record_to: Path | RecordingWriter | None = None,
     goal: tuple[float, float] | None = None,
     navigator: bool = True,
     extra_actors: Sequence[Actor] = (),
     max_step_batch: float = 0.05,
+    foxglove: bool | LiveViewOptions = False,
 ) -> AsyncIterator[LiveStack]:
     """Bring the robot stack up on the running (stock asyncio) loop in real-time mode,
     the world stepped to follow the wall clock times ``scale``; yield a
     :class:`LiveStack`. With ``record_to`` every topic goes to that MCAP file, finished
-    on every exit. ``goal``: an initial goal for the navigator (or publish one later).
+    on every exit (or to that writer, e.g. a size-capped
+    :class:`~otonav.record.rotating.RotatingRecordingWriter`). ``goal``: an initial
+    goal for the navigator (or publish one later).
 
     On exit (normal, an exception, or the host's cancellation) the stack stops and the
     recording is finished. If an actor crashed and stopped the stack while the body ran
     normally, its :class:`~otonav.runtime.ActorCrashedError` is raised on exit.
+    A ``scale`` outside [0.01, 100] raises ``ValueError`` (``otonav.limits``).
+
+    ``foxglove=True`` (or :class:`~otonav.actors.live_view.LiveViewOptions`) also serves
+    every topic to Foxglove over WebSocket (127.0.0.1:8765 by default; ``live.foxglove``
+    is the server, stopped on exit).
     """
-    hal = build_world(stack)
+    problem = check_scale(scale, "scale")
+    if problem is not None:
+        raise ValueError(problem)
+    server = _foxglove_server(foxglove)
+    try:
+        hal = build_world(stack)
+    except BaseException:
+        if server is not None:
+            server.close()
+        raise
     live: LiveStack | None = None
     try:
         try:
             clock = PacedClock(hal, scale=scale, max_step_batch=max_step_batch)
             actors = [*build_actors(stack, hal, navigator=navigator, goal=goal), *extra_actors]
+            if server is not None:
+                actors.append(LiveView(server))
         except BaseException:
             hal.close()
+            if server is not None:
+                server.close()
             raise
-        live = LiveStack(StackSession(hal, actors, realtime=clock, record_to=record_to), clock)
+        session = StackSession(hal, actors, realtime=clock, record_to=record_to)
+        if server is not None:
+            session.add_cleanup(server.close)
+        live = LiveStack(session, clock)
+        live.foxglove = server
         live._start()
         yield live
     finally:

@@ -162,16 +162,19 @@ def _compile_steps(message: type[Message]) -> tuple[ReadStep, ...]:
 def _compile_builder(message: type[Message]) -> Builder:
     """The inverse of the leaf flattening: one generated expression per class that
     reads the flat values at fixed indices (every field takes one value, a fixed
-    primitive array n) and nests ``Message.fast`` calls. Generated rather than looped:
-    an Odometry took 15 µs through a generic loop over fields, 4 µs this way."""
-    classes: dict[str, type[Message]] = {}
+    primitive array n) and nests the messages' construction. Generated rather than
+    looped: an Odometry took 15 µs through a generic loop over fields, 4 µs this way;
+    ``_make`` instead of ``Message.fast(**fields)`` saves another quarter per message
+    (1.5 µs against 2.0 µs for a Vector3)."""
+    names: dict[str, object] = {"_make": _make}
 
     def expr(current: type[Message], i: int) -> tuple[str, int]:
-        name = f"_c{len(classes)}"
-        classes[name] = current
+        name = f"_c{len(names)}"
+        names[name] = current
+        names[name + "_fields"] = current._otonav_fields
         layout = layout_for(current)
         if not layout.fields:
-            return f"{name}.fast()", i + 1
+            return f"_make({name}, {{}}, {name}_fields)", i + 1
         parts = []
         for field in layout.fields:
             if not isinstance(field.type, str) and field.array is None:
@@ -181,13 +184,26 @@ def _compile_builder(message: type[Message]) -> Builder:
                 code, i = f"tuple(v[{i}:{i + n}])", i + n
             else:  # one value: a scalar, a string, a sequence, an array of messages/strings
                 code, i = f"v[{i}]", i + 1
-            parts.append(f"{field.name}={code}")
-        return f"{name}.fast({', '.join(parts)})", i
+            parts.append(f"{field.name!r}: {code}")
+        return f"_make({name}, {{{', '.join(parts)}}}, {name}_fields)", i
 
     body, used = expr(message, 0)
     source = f"lambda v, i: ({body}, {used})"
-    build: Builder = eval(source, dict(classes))  # generated from our own layouts only
+    build: Builder = eval(source, names)  # generated from our own layouts only
     return build
+
+
+_set = object.__setattr__
+
+
+def _make(cls: type[Message], fields: dict[str, Any], fields_set: set[str]) -> Message:
+    """``cls.fast(**fields)`` without the keyword-argument round trip (the same object)."""
+    message = cls.__new__(cls)
+    _set(message, "__dict__", fields)
+    _set(message, "__pydantic_fields_set__", fields_set)
+    _set(message, "__pydantic_extra__", None)
+    _set(message, "__pydantic_private__", None)
+    return message
 
 
 _PLANS: dict[type[Message], tuple[tuple[ReadStep, ...], Builder]] = {}

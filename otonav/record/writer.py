@@ -66,8 +66,9 @@ class RecordingWriter:
         self._sequence[channel_id] = 0
         return channel_id
 
-    def write(self, topic: str, message: Message, sim_time: float) -> None:
-        """Record ``message`` on ``topic`` at ``sim_time`` seconds (log and publish time)."""
+    def write(self, topic: str, message: Message, sim_time: float) -> bool:
+        """Record ``message`` on ``topic`` at ``sim_time`` seconds (log and publish time).
+        True when this completed a chunk (it is in the file now)."""
         channel_id = self._channels.get(topic)
         if channel_id is None:
             channel_id = self._channel(topic, type(message))
@@ -76,11 +77,13 @@ class RecordingWriter:
         # Messages accumulate in memory until a chunk is full; when one was written,
         # it goes to the OS at once. (Asking the file its position after every message
         # instead cost an lseek syscall per message.)
-        if self._writer.add_message_and_check(
+        chunk = self._writer.add_message_and_check(
             channel_id, stamp, encode(message), stamp, self._sequence[channel_id]
-        ):
+        )
+        if chunk:
             self._file.flush()
         self.messages += 1
+        return chunk
 
     def add_metadata(self, name: str, data: dict[str, str]) -> None:
         self._writer.add_metadata(name, data)

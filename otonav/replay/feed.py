@@ -171,12 +171,24 @@ class Gate:
 
 class ReplayClock(Clock):
     """Sim time for one replayed actor: like the virtual clock, but its timers pass
-    through the :class:`Gate` so the feeder can order them against the inputs."""
+    through the :class:`Gate` so the feeder can order them against the inputs.
 
-    def __init__(self, gate: Gate, actor: str) -> None:
+    ``wakes`` (ticks, sorted): wake the actor at the recorded instants instead of its
+    own deadlines -- for a recording made in real time, where an actor asleep until t
+    woke when the world had caught up with the wall clock, a little after t. Each sleep
+    then ends at the actor's next recorded wake-up (the instants its outputs were
+    published at, in order); past the last one the actor sleeps for good.
+    """
+
+    def __init__(
+        self, gate: Gate, actor: str, *, wakes: Sequence[int] | None = None, rate: float = 1.0
+    ) -> None:
         self._gate = gate
         self._loop = gate.loop
         self._actor = actor
+        self._wakes = wakes
+        self._rate = rate
+        self._next = 0
 
     def now(self) -> float:
         return self._loop.time()
@@ -189,10 +201,23 @@ class ReplayClock(Clock):
 
     async def sleep_until(self, sim_time: float) -> None:
         loop = self._loop
-        if sim_time <= loop.time():
+        if sim_time <= loop.time() and self._wakes is None:
             await asyncio.sleep(0)
             return
         future: asyncio.Future[None] = loop.create_future()
+        if self._wakes is not None:
+            # Follow the recorded wake-ups in order, whatever instant the actor asks for:
+            # in real time an actor can wake twice at one instant (its sleep until a
+            # time the world had already passed returned at once), which a replay, where
+            # time stands still while it computes, would not ask for.
+            now = round(loop.time() * self._rate)
+            wakes, index = self._wakes, self._next
+            while index < len(wakes) and wakes[index] < now:
+                index += 1
+            if index == len(wakes):
+                await future  # never resolved: the system stops it at the end
+            self._next = index + 1
+            sim_time = wakes[index] / self._rate
         handle = loop.call_at(sim_time, self._gate.due, self._actor, future)
         try:
             await future

@@ -9,6 +9,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Literal
 
 from otonav.msgs import Message
 from otonav.replay.compare import Divergence, Replayed, TopicComparison, compare_topic
@@ -64,6 +65,11 @@ class ReplayResult:
         return self.sim_time_s / self.wall_time_s if self.wall_time_s > 0 else float("inf")
 
 
+SHARED_LOG_TOPICS = frozenset({"/rosout"})
+"""Output topics a replay does not compare: the recording holds every actor's lines and
+the system's lifecycle events there, which a replay of some nodes cannot reproduce."""
+
+
 @dataclass(frozen=True, slots=True)
 class _Ports:
     inputs: dict[str, tuple[type[Message], list[QoS]]]
@@ -80,6 +86,8 @@ def _ports(actors: Sequence[Actor]) -> _Ports:
         for port in actor.ports():
             topic = actor.topic_of(port)
             if port.direction == "out":
+                if topic in SHARED_LOG_TOPICS:
+                    continue  # every actor and the system log there: not one node's output
                 outputs[topic] = port.msg_type
                 publishers_of.setdefault(topic, set()).add(actor.name)
             else:
@@ -129,11 +137,16 @@ def replay_recording(
     overrides: Sequence[str] = (),
     stack: StackConfig | None = None,
     tolerance: float = 0.0,
+    wake: Literal["timers", "recorded"] = "timers",
     wall_ceiling: float | None = 600.0,
 ) -> ReplayResult:
     """Replay ``nodes`` (stack actor names, ``pkg.mod:Name`` paths, or actor objects)
     against ``recording``. Their config is the recording's stored stack config (or
     ``stack``, or the defaults), with ``overrides`` (``key.path=value``) applied.
+
+    ``wake="recorded"``: wake each actor at the instants its outputs were recorded at
+    instead of its own deadlines (a recording made in real time, where wake-ups followed
+    the wall clock; see :class:`~otonav.replay.feed.ReplayClock`).
 
     Raises :class:`ReplayInputError` for bad input (file, node, topic, override).
     """
@@ -163,6 +176,23 @@ def replay_recording(
 
     replayed: list[Replayed] = []
     crash: str | None = None
+    wakes: dict[str, list[int]] = {}
+    if wake == "recorded":
+        # A wake-up publishes each of the actor's outputs once: a topic seen again starts
+        # the next wake-up, at the instant of its first message (in real time the world
+        # moves on while an actor computes, so later outputs of one wake-up come later).
+        bursts: dict[str, set[str]] = {a.name: set() for a in actors}
+        for message in full.messages:
+            for name in ports.publishers_of.get(message.topic, ()):
+                burst = bursts[name]
+                if not burst or message.topic in burst:
+                    burst.clear()
+                    wakes.setdefault(name, []).append(round(message.time_ns * source.rate / 1e9))
+                burst.add(message.topic)
+        for name in bursts:
+            wakes.setdefault(name, [])
+    elif wake != "timers":
+        raise ReplayInputError(f"--wake {wake}: expected timers or recorded")
 
     async def main() -> None:
         loop = asyncio.get_running_loop()
@@ -188,7 +218,9 @@ def replay_recording(
             # Each actor sleeps on its own clock (the System handed out one shared
             # clock; the actors have not run yet, so none has used it).
             for actor in actors:
-                actor._otonav_clock = ReplayClock(gate, actor.name)
+                actor._otonav_clock = ReplayClock(
+                    gate, actor.name, wakes=wakes.get(actor.name), rate=source.rate
+                )
             await feeder.run()
         drain()
 

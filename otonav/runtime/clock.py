@@ -40,6 +40,15 @@ class Clock(ABC):
         """Evaluate ``check()`` as sim time advances until it returns True.
         Returns a function that stops watching."""
 
+    @property
+    def resolution(self) -> float:
+        """The smallest step sim time moves by, s (one tick of the world); 0 if unknown."""
+        return 0.0
+
+    def reached(self, sim_time: float) -> bool:
+        """Whether sim time has reached ``sim_time`` (to within one tick)."""
+        return self.now() + self.resolution >= sim_time
+
     async def sleep_until(self, sim_time: float) -> None:
         """Sleep until sim time reaches ``sim_time``."""
         await anyio.sleep_until(self.to_loop_time(sim_time))
@@ -79,6 +88,10 @@ class VirtualClock(Clock):
 
     def __init__(self, loop: VirtualTimeLoop) -> None:
         self._loop = loop
+
+    @property
+    def resolution(self) -> float:
+        return self._loop.source.tick
 
     def now(self) -> float:
         return self._loop.time()
@@ -143,6 +156,10 @@ class RealTimeClock(Clock):
             max(1, math.floor(max_step_batch * self._rate + 1e-9)) if max_step_batch else None
         )
         self.slipped_ticks = 0
+
+    @property
+    def resolution(self) -> float:
+        return 1.0 / self._rate
 
     @property
     def slip_s(self) -> float:

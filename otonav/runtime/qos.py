@@ -26,6 +26,11 @@ class Durability(StrEnum):
     TRANSIENT_LOCAL = "transient_local"
 
 
+MAX_DEPTH = 1_000_000
+"""Keep-last N at most a million: a mailbox may hold ``depth`` messages, and a million
+360-beam scans is 1.4 GB."""
+
+
 @dataclass(frozen=True, slots=True)
 class QoS:
     """A QoS profile: reliability, history depth (keep-last N) and durability."""
@@ -35,8 +40,24 @@ class QoS:
     durability: Durability = Durability.VOLATILE
 
     def __post_init__(self) -> None:
-        if self.depth < 1:
-            raise ValueError(f"QoS depth must be >= 1 (keep-last N), got {self.depth}")
+        # Checked here, not where the profile is first used: a plain string or a
+        # fractional depth used to pass and break graph() and the mailboxes later.
+        if not isinstance(self.reliability, Reliability):
+            raise TypeError(
+                f"QoS reliability must be a Reliability, got {self.reliability!r} "
+                f"(use {' or '.join(f'Reliability.{r.name}' for r in Reliability)})"
+            )
+        if not isinstance(self.durability, Durability):
+            raise TypeError(
+                f"QoS durability must be a Durability, got {self.durability!r} "
+                f"(use {' or '.join(f'Durability.{d.name}' for d in Durability)})"
+            )
+        if not isinstance(self.depth, int) or isinstance(self.depth, bool):
+            raise TypeError(f"QoS depth must be a whole number (keep-last N), got {self.depth!r}")
+        if not 1 <= self.depth <= MAX_DEPTH:
+            raise ValueError(
+                f"QoS depth must be >= 1 and <= {MAX_DEPTH} (keep-last N), got {self.depth}"
+            )
 
     def __str__(self) -> str:
         return f"{self.reliability.value}/depth={self.depth}/{self.durability.value}"

@@ -66,9 +66,18 @@ async def until(
 
     unwatch = clock.watch(watcher)
     try:
-        with anyio.CancelScope(deadline=clock.to_loop_time(deadline)) as scope:
-            await done
-        if scope.cancelled_caught and not check():
+        # The budget is sim time. A real-time clock maps it to loop time with an offset
+        # that moves when sim time slips behind the wall clock, so a deadline that fired
+        # before sim time got there is set again (virtual time: it is exact, once).
+        while not done.done():
+            with anyio.CancelScope(deadline=clock.to_loop_time(deadline)):
+                await asyncio.wait((done,))  # (never cancels ``done`` itself)
+            if done.done() or clock.reached(deadline):
+                break
+        if done.done():
+            done.result()  # raises what the predicate raised
+            return
+        if not check():
             raise SimTimeoutError(
                 what or str(getattr(predicate, "__name__", "condition")),
                 clock.now(),
@@ -77,6 +86,8 @@ async def until(
             )
     finally:
         unwatch()
+        if not done.done():
+            done.cancel()
 
 
 async def next_message(
@@ -91,12 +102,17 @@ async def next_message(
     ``within`` seconds of sim time."""
     clock = clock or current_clock()
     last: object = "no message"
-    with anyio.CancelScope(deadline=clock.to_loop_time(clock.now() + within)):
-        while True:
-            message = await subscription.recv()
-            last = message
-            if predicate(message):
-                return message
+    deadline = clock.now() + within
+    while True:
+        # A loop-time deadline set again if it fired before sim time got there (see until).
+        with anyio.CancelScope(deadline=clock.to_loop_time(deadline)):
+            while True:
+                message = await subscription.recv()
+                last = message
+                if predicate(message):
+                    return message
+        if clock.reached(deadline):
+            break
     raise SimTimeoutError(
         what or f"a matching message on '{subscription.topic}'", clock.now(), within, last
     )

@@ -2,12 +2,32 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, PositiveFloat
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, PositiveFloat
+
+from otonav import limits
 
 if TYPE_CHECKING:  # imported in to_obstacle: reading a scenario file needs no numpy
     from otonav.hal.types import BoxObstacle
+
+
+# Bounds: what the stack can honour, and why (otonav/limits.py).
+Coordinate = Annotated[float, Field(ge=-limits.MAX_COORDINATE_M, le=limits.MAX_COORDINATE_M)]
+"""m, a position in the world plane."""
+Size = Annotated[float, Field(gt=0.0, le=limits.MAX_COORDINATE_M)]
+"""m, a full box size."""
+Yaw = Annotated[float, Field(ge=-limits.MAX_YAW_RAD, le=limits.MAX_YAW_RAD)]
+"""rad, CCW from +x."""
+Distance = Annotated[float, Field(gt=0.0, le=limits.MAX_DISTANCE_M)]
+"""m, a tolerance or clearance."""
+
+
+def _one_printable_line(text: str) -> str:
+    """No control characters: a newline would break every one-line message naming it."""
+    if any(ord(c) < 0x20 or ord(c) == 0x7F for c in text):
+        raise ValueError("must be one line of printable text (no control characters)")
+    return text
 
 
 class BoxSpec(BaseModel):
@@ -15,11 +35,11 @@ class BoxSpec(BaseModel):
 
     # strict: "yes" is not 1.0 (files are validated in JSON mode, where lists are tuples)
     model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
-    x: float
-    y: float
-    size_x: PositiveFloat
-    size_y: PositiveFloat
-    yaw: float = 0.0
+    x: Coordinate
+    y: Coordinate
+    size_x: Size
+    size_y: Size
+    yaw: Yaw = 0.0
 
     def to_obstacle(self) -> BoxObstacle:
         from otonav.hal.types import BoxObstacle
@@ -29,17 +49,17 @@ class BoxSpec(BaseModel):
 
 class GoalSpec(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
-    x: float
-    y: float
+    x: Coordinate
+    y: Coordinate
 
 
 class StartSpec(BaseModel):
     """The robot's start pose in the world: position (m), heading (rad, CCW from +x)."""
 
     model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
-    x: float = 0.0
-    y: float = 0.0
-    yaw: float = 0.0
+    x: Coordinate = 0.0
+    y: Coordinate = 0.0
+    yaw: Yaw = 0.0
 
     def as_tuple(self) -> tuple[float, float, float]:
         return (self.x, self.y, self.yaw)
@@ -49,20 +69,26 @@ class ScenarioConfig(BaseModel):
     """What to run and how to judge it. Defaults: the acceptance scenario."""
 
     model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
-    name: str = "acceptance"
-    scene: str | None = None
+    name: Annotated[
+        str,
+        Field(min_length=1, max_length=limits.MAX_NAME_CHARS),
+        AfterValidator(_one_printable_line),
+    ] = "acceptance"
+    """One line of printable text, at most 128 characters: a title and a label."""
+    scene: str | None = Field(None, min_length=1, max_length=limits.MAX_PATH_CHARS)
     """Built-in scene name or MJCF path; None: the stack's ``world.scene`` (obstacles)."""
-    obstacles: tuple[BoxSpec, ...] = ()
+    obstacles: tuple[BoxSpec, ...] = Field((), max_length=limits.MAX_OBSTACLES)
     start: StartSpec = StartSpec()
     """Where the robot starts; odometry starts there too (odom = world frame)."""
     goal: GoalSpec = GoalSpec(x=4.0, y=1.5)
-    goal_tolerance: PositiveFloat = 0.15
+    goal_tolerance: Distance = 0.15
     """m: reached when the true position is this close to the goal."""
-    sim_budget: PositiveFloat = 20.0
-    """s of sim time to reach the goal."""
-    min_clearance: PositiveFloat = 0.3
+    sim_budget: PositiveFloat = Field(20.0, le=limits.MAX_SIM_BUDGET_S)
+    """s of sim time to reach the goal, at most half an hour (and see
+    :func:`~otonav.scenario.validate.check_cost`)."""
+    min_clearance: Distance = 0.3
     """m: the robot centre must never come closer than this to an obstacle or wall."""
-    seed: int = Field(0, ge=0)
+    seed: int = Field(0, ge=0, le=limits.MAX_SEED)
     expect: Literal["reached", "unreachable"] = "reached"
     """The outcome that passes: ``reached`` (the goal within tolerance inside the budget)
     or ``unreachable`` (the navigator reports ``unreachable`` on /nav/state inside the

@@ -10,6 +10,11 @@ from otonav.hal import BoxObstacle, RobotHardwareInterface
 from otonav.msgs import NavState
 from otonav.runtime import Actor, Input, QoS, Reliability
 
+#: s of sim time the judge keeps watching after the robot first enters the tolerance.
+ARRIVAL_SETTLE_S = 2.0
+#: m/s: the true speed below which the robot counts as stopped at the goal.
+ARRIVAL_MAX_SPEED = 0.02
+
 
 class Judge(Actor):
     """Samples the true pose at ``rate_hz``: distance to goal, clearance to every
@@ -18,7 +23,14 @@ class Judge(Actor):
     since the last sample, so a short-lived state is not missed): the latest state, and
     the first sim time the navigator declared the goal ``unreachable``. It calls
     ``progress(judge, sim_time)`` after each sample (a UI's hook; it must not act on
-    the robot)."""
+    the robot).
+
+    Arrival (issue 16): entering the tolerance is not arriving. ``settle_s`` after the
+    first entry (``time_to_goal``) the judge checks, on ground truth, that the robot is
+    still within the tolerance, its true speed is below ``max_speed``, and the navigator
+    says ``reached``; ``reached`` is True only then. A robot that drives through the
+    goal fails, and ``arrival_problem`` says why.
+    """
 
     # depth 16: /nav/state comes at 20 Hz and the judge drains it at rate_hz (100 Hz).
     nav_state_in = Input(topics.NAV_STATE, NavState, QoS(Reliability.BEST_EFFORT, depth=16))
@@ -31,9 +43,19 @@ class Judge(Actor):
         *,
         rate_hz: float = 100.0,
         progress: Callable[[Judge, float], None] | None = None,
+        settle_s: float = ARRIVAL_SETTLE_S,
+        max_speed: float = ARRIVAL_MAX_SPEED,
         name: str = "judge",
     ) -> None:
         super().__init__(name)
+        self.settle_s = settle_s
+        self.max_speed = max_speed
+        self.arrival_checked_at: float | None = None
+        """s of sim time of the arrival check (``settle_s`` after the first entry)."""
+        self.arrival_problem: str | None = None
+        """Why the arrival check failed (None: passed, or not checked yet)."""
+        self.speed = 0.0
+        """m/s, the true speed at the latest sample."""
         self.progress = progress
         self.nav_state = "starting"
         self.hal = hal
@@ -53,8 +75,15 @@ class Judge(Actor):
         self._last: tuple[float, float] | None = None
 
     @property
-    def reached(self) -> bool:
+    def entered(self) -> bool:
+        """The robot has been within the tolerance of the goal (at ``time_to_goal``)."""
         return self.time_to_goal is not None
+
+    @property
+    def reached(self) -> bool:
+        """Arrived: within the tolerance, stopped, and the navigator said ``reached``,
+        ``settle_s`` after first entering the tolerance."""
+        return self.arrival_checked_at is not None and self.arrival_problem is None
 
     @property
     def gave_up(self) -> bool:
@@ -63,8 +92,24 @@ class Judge(Actor):
 
     @property
     def finished(self) -> bool:
-        """Nothing more will happen worth waiting for: reached, or given up."""
-        return self.reached or self.gave_up
+        """Nothing more will happen worth waiting for: the arrival checked, or given up."""
+        return self.arrival_checked_at is not None or self.gave_up
+
+    def _check_arrival(self, now: float) -> None:
+        problems = []
+        if self.distance > self.tolerance:
+            problems.append(f"{self.distance:.3f} m from the goal")
+        if self.speed > self.max_speed:
+            problems.append(f"moving at {self.speed:.2f} m/s")
+        if self.nav_state != "reached":
+            problems.append(f"/nav/state '{self.nav_state}'")
+        self.arrival_checked_at = now
+        if problems:
+            self.arrival_problem = (
+                f"entered the goal tolerance at {self.time_to_goal:.2f} s but had not "
+                f"arrived {self.settle_s:g} s later: {', '.join(problems)} (needs <= "
+                f"{self.tolerance} m, < {self.max_speed} m/s and /nav/state 'reached')"
+            )
 
     def _follow_nav_state(self, now: float) -> None:
         while (state := self.nav_state_in.try_recv()) is not None:
@@ -81,8 +126,15 @@ class Judge(Actor):
             self.path_length += math.hypot(x - self._last[0], y - self._last[1])
         self._last = (x, y)
         self.distance = math.hypot(self.goal[0] - x, self.goal[1] - y)
+        self.speed = math.hypot(truth.vx_world, truth.vy_world)
         if self.time_to_goal is None and self.distance <= self.tolerance:
             self.time_to_goal = now
+        if (
+            self.time_to_goal is not None
+            and self.arrival_checked_at is None
+            and now >= self.time_to_goal + self.settle_s - 1e-9
+        ):
+            self._check_arrival(now)
         for box in self.boxes:
             d = box.distance_to(x, y)
             if d < self.min_clearance:

@@ -15,7 +15,8 @@ import anyio
 
 from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
-from otonav.runtime import RealTimeClock
+from otonav.limits import check_scale
+from otonav.runtime import Actor, RealTimeClock
 from otonav.runtime.timesource import tick_rate
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
@@ -94,6 +95,7 @@ def run_scenario_realtime(
     scale: float = 1.0,
     gui: bool = False,
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
+    extra_actors: tuple[Actor, ...] = (),
     hold: Callable[[Verdict], None] | None = None,
 ) -> Verdict:
     """Run ``scenario`` with sim time following the wall clock times ``scale`` and judge
@@ -105,12 +107,14 @@ def run_scenario_realtime(
     is none), the window opens before the clock starts, is synced at ~60 Hz wall and
     closed at the end. Closing the window stops the run: the verdict fails and says so.
     ``on_start(loop, task)`` is called on the run's loop once the window (if any) is up.
+    ``extra_actors`` join the system (a live view, monitors).
     ``hold`` (with ``gui``): once the run is over and its recording finished, call
     ``hold(verdict)`` (its artifact paths are not set yet) and keep the window open on
     the final state until the user closes it; Ctrl-C ends the hold too.
     """
-    if not scale > 0:
-        raise ValueError(f"real-time scale must be > 0, got {scale!r}")
+    problem = check_scale(scale, "scale")
+    if problem is not None:
+        raise ValueError(problem)
     if gui:
         check_display()
     stack, hal = scenario_world(scenario, stack)
@@ -121,6 +125,7 @@ def run_scenario_realtime(
         hal,
         judge,
         realtime=RealTime(scale, MAX_STEP_BATCH),
+        extra_actors=extra_actors,
         recording=out_dir / "recording.mcap" if out_dir and record else None,
     )
     viewer: ViewerHandle | None = None

@@ -33,7 +33,7 @@ from otonav.runtime import (
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
 from otonav.scenario.plot import plot_trajectory
-from otonav.scenario.validate import check_goal
+from otonav.scenario.validate import check_cost, check_goal
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.session import RealTime, StackSession
 
@@ -90,6 +90,7 @@ def scenario_world(
     )
     try:
         check_goal(scenario, stack.world.scene, hal.obstacles(), hal.walls(), source=source)
+        check_cost(scenario, stack, len(hal.obstacles() + hal.walls()), source=source)
     except BaseException:
         hal.close()
         raise
@@ -174,11 +175,20 @@ async def drive(session: StackSession, scenario: ScenarioConfig, judge: Judge) -
         # passes depends on the scenario's ``expect``.
         with contextlib.suppress(SimTimeoutError):
             await until(
-                lambda: judge.finished,
+                lambda: judge.finished or judge.entered,
                 within=scenario.sim_budget,
                 observe=lambda: f"{judge.distance:.3f} m from the goal",
                 what=f"reaching the goal within {scenario.goal_tolerance} m",
             )
+        if judge.entered and not judge.finished:
+            # Entering the tolerance is not arriving: the judge checks settle_s later
+            # (past the budget if need be) that the robot stopped there.
+            with contextlib.suppress(SimTimeoutError):
+                await until(
+                    lambda: judge.finished,
+                    within=judge.settle_s + 2.0 / judge.rate_hz,
+                    what="the arrival check",
+                )
 
 
 async def _main(
@@ -202,14 +212,26 @@ def run_task(
     task = asyncio.current_task()
     if on_start is not None and task is not None:
         on_start(loop, task)
-    in_main_thread = threading.current_thread() is threading.main_thread()
-    if in_main_thread and task is not None:
-        loop.add_signal_handler(signal.SIGTERM, task.cancel)
+    # Only over the default handler (asyncio.Runner's rule for SIGINT): a host that
+    # handles SIGTERM itself (the CLI) keeps its handler. Cancel once: a second
+    # SIGTERM must not cancel the shutdown's own awaits.
+    own = (
+        threading.current_thread() is threading.main_thread()
+        and task is not None
+        and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL
+    )
+    if own and task is not None:
+        loop.add_signal_handler(signal.SIGTERM, _cancel_once, task)
     try:
         yield
     finally:
-        if in_main_thread and task is not None:
+        if own:
             loop.remove_signal_handler(signal.SIGTERM)
+
+
+def _cancel_once(task: asyncio.Task[Any]) -> None:
+    if not task.cancelling():
+        task.cancel()
 
 
 def run_scenario(
@@ -353,7 +375,9 @@ def judge_verdict(scenario: ScenarioConfig, judge: Judge, sim_time: float, wall:
     reasons = []
     if scenario.expect == "reached":
         outcome = judge.reached
-        if not judge.reached:
+        if judge.arrival_problem is not None:
+            reasons.append(judge.arrival_problem)
+        elif not judge.reached:
             why = (
                 f"the navigator reported the goal unreachable at {judge.unreachable_at:.1f} s"
                 if judge.unreachable_at is not None

@@ -5,8 +5,10 @@ from __future__ import annotations
 
 import math
 
+from otonav import limits
 from otonav.hal import BoxObstacle
 from otonav.scenario.config import ScenarioConfig
+from otonav.stack import StackConfig
 from otonav.stack.files import ConfigFileError
 
 
@@ -52,12 +54,41 @@ def check_goal(
                     f"'{scene}' (valid: x in ({x_min:g}, {x_max:g}), "
                     f"y in ({y_min:g}, {y_max:g}))"
                 )
-        for box in obstacles:
+        # Walls too: the judge measures clearance to both, so a start or goal closer
+        # than min_clearance to a wall fails every run (or starts it failed).
+        boxes = [("obstacle", box) for box in obstacles] + [("wall", box) for box in walls]
+        for kind, box in boxes:
             gap = box.distance_to(px, py)
             if gap < scenario.min_clearance:
                 where = "inside" if gap == 0 else f"{gap:.2f} m from"
                 raise ConfigFileError(
-                    f"{source}: {key}: ({px:g}, {py:g}) is {where} the obstacle at "
+                    f"{source}: {key}: ({px:g}, {py:g}) is {where} the {kind} at "
                     f"({box.x:g}, {box.y:g}); it needs at least min_clearance = "
-                    f"{scenario.min_clearance:g} m from every obstacle"
+                    f"{scenario.min_clearance:g} m from every obstacle and wall"
                 )
+
+
+def check_cost(
+    scenario: ScenarioConfig, stack: StackConfig, boxes: int, *, source: str = "scenario"
+) -> None:
+    """Raise :class:`ConfigFileError` when a run of this scenario on this stack is
+    estimated to take more wall time than :data:`~otonav.limits.WALL_BUDGET_S`
+    (each value within its own bound, together too much: a tiny timestep and a long
+    budget, a dense lidar at a high rate, ...). ``boxes``: obstacles and walls."""
+    rates = stack.rates_hz()
+    estimate = limits.estimated_wall_s(
+        sim_budget=scenario.sim_budget,
+        timestep=stack.world.timestep,
+        rates_hz=sum(rates.values()),
+        scan_hz=stack.rates.scan_hz,
+        lidar_beams=stack.world.lidar_beams,
+        boxes=boxes,
+    )
+    if estimate > limits.WALL_BUDGET_S:
+        raise ConfigFileError(
+            f"{source}: sim_budget = {scenario.sim_budget:g} s with world.timestep = "
+            f"{stack.world.timestep:g} s, {sum(rates.values()):g} Hz of actor rates and "
+            f"{stack.world.lidar_beams} lidar beams at {stack.rates.scan_hz:g} Hz is an "
+            f"estimated {estimate:.0f} s of wall time, over the {limits.WALL_BUDGET_S:.0f} s "
+            "a run may take; shorten sim_budget or lighten the stack"
+        )

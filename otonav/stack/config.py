@@ -8,6 +8,8 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, model_validator
 
+from otonav import limits
+
 
 class _Section(BaseModel):
     # strict: "yes" is not 1.0 and "3" is not 3 (a number in YAML is still a number).
@@ -18,17 +20,21 @@ class _Section(BaseModel):
 class WorldConfig(_Section):
     """The simulated world (``otonav.hal.mujoco``)."""
 
-    scene: str = "obstacles"
+    scene: str = Field("obstacles", min_length=1, max_length=limits.MAX_PATH_CHARS)
     """Built-in scene name (``empty``, ``obstacles``) or a path to an MJCF file."""
-    timestep: PositiveFloat = 0.002
-    """Physics step, s: one tick of sim time."""
-    lidar_beams: PositiveInt = 360
+    timestep: float = Field(0.002, ge=limits.MIN_TIMESTEP_S, le=limits.MAX_TIMESTEP_S)
+    """Physics step, s: one tick of sim time. Bounded by the cost of a step below and by
+    the fastest timer (the judge's 100 Hz) above: see ``otonav.limits``."""
+    lidar_beams: PositiveInt = Field(360, le=limits.MAX_LIDAR_BEAMS)
+    """Beams over a full circle, at most 3600 (0.1 degree, the finest 2D lidars)."""
     lidar_range_min: float = Field(0.12, ge=0.0)
-    lidar_range_max: PositiveFloat = 8.0
+    lidar_range_max: PositiveFloat = Field(8.0, le=limits.MAX_LIDAR_RANGE_M)
+    """m, at most 1 km: ranges are float32 in the recording."""
 
 
 class RatesConfig(_Section):
-    """Bridge publishing rates, Hz."""
+    """Bridge publishing rates, Hz. Each at most the physics tick rate (1 / timestep):
+    a timer cannot fire more often than the world ticks."""
 
     clock_hz: PositiveFloat = 100.0
     odom_hz: PositiveFloat = 100.0
@@ -41,10 +47,11 @@ class BaseConfig(_Section):
 
     rate_hz: PositiveFloat = 50.0
     cmd_timeout: PositiveFloat = 0.5
-    max_v: PositiveFloat = 0.5
-    max_omega: PositiveFloat = 1.5
-    max_accel: PositiveFloat = 1.0
-    max_alpha: PositiveFloat = 3.0
+    # Bounded so that wheel speeds stay finite and the limits still limit (limits.py).
+    max_v: PositiveFloat = Field(0.5, le=limits.MAX_BASE_V)
+    max_omega: PositiveFloat = Field(1.5, le=limits.MAX_BASE_OMEGA)
+    max_accel: PositiveFloat = Field(1.0, le=limits.MAX_BASE_ACCEL)
+    max_alpha: PositiveFloat = Field(3.0, le=limits.MAX_BASE_ALPHA)
 
 
 class NavConfig(_Section):
@@ -164,4 +171,19 @@ class StackConfig(_Section):
                 "world.lidar_range_min must be < world.lidar_range_max "
                 f"(got {self.world.lidar_range_min} >= {self.world.lidar_range_max})"
             )
+        tick_hz = 1.0 / self.world.timestep
+        for key, hz in self.rates_hz().items():
+            if hz > tick_hz * (1 + 1e-9):
+                raise ValueError(
+                    f"{key} = {hz:g} Hz is faster than the physics ticks: at most "
+                    f"{tick_hz:g} Hz with world.timestep = {self.world.timestep:g} s "
+                    "(lower the rate, or the timestep)"
+                )
         return self
+
+    def rates_hz(self) -> dict[str, float]:
+        """Every periodic actor rate of the stack, by key path (Hz)."""
+        rates = {f"rates.{key}": float(hz) for key, hz in self.rates.model_dump().items()}
+        rates["base.rate_hz"] = self.base.rate_hz
+        rates["nav.rate_hz"] = self.nav.rate_hz
+        return rates

@@ -1,4 +1,5 @@
-"""Reading configuration files: YAML (safe loading only) validated by the pydantic models."""
+"""Reading configuration files: YAML (safe loading, within size, depth and expansion
+limits: ``otonav.stack.safe_yaml``) validated by the pydantic models."""
 
 from __future__ import annotations
 
@@ -9,6 +10,8 @@ from typing import TypeVar
 import yaml
 from pydantic import BaseModel, ValidationError
 
+from otonav.stack import safe_yaml
+
 _M = TypeVar("_M", bound=BaseModel)
 
 
@@ -17,17 +20,41 @@ class ConfigFileError(ValueError):
     and what would be valid."""
 
 
+SHOWN_CHARS = 60
+"""How much of a rejected value an error line quotes (a 10 MB name stays one short line)."""
+
+SHOWN_PROBLEMS = 5
+"""How many problems an error line lists before "and N more"."""
+
+
+def _shown(value: object) -> str:
+    text = repr(value)
+    if len(text) <= SHOWN_CHARS:
+        return text
+    return f"{text[: SHOWN_CHARS - 25]}... ({len(text):,} characters)"
+
+
 def describe_validation_error(source: str, error: ValidationError) -> str:
     """One line: ``file: key.path: what is wrong (got value); other.key: ...``."""
     problems = []
-    for item in error.errors():
-        path = ".".join(str(part) for part in item["loc"]) or "(top level)"
+    errors = error.errors()
+    for item in errors[:SHOWN_PROBLEMS]:
+        path = ".".join(str(part) for part in item["loc"])
         message = item["msg"]
         if item["type"] == "extra_forbidden":
             message = "unknown key (check the spelling; the README lists the valid keys)"
+        elif item["type"] == "value_error":  # our own validators: the message says it all
+            message = message.removeprefix("Value error, ")
         got = item.get("input")
-        shown = "" if item["type"] in ("extra_forbidden", "missing") else f" (got {got!r})"
-        problems.append(f"{path}: {message}{shown}")
+        if item["type"] in ("extra_forbidden", "missing") or (
+            item["type"] == "value_error" and not path
+        ):
+            shown = ""  # a whole-model check quotes what it needs itself
+        else:
+            shown = f" (got {_shown(got)})"
+        problems.append(f"{path}: {message}{shown}" if path else message)
+    if len(errors) > SHOWN_PROBLEMS:
+        problems.append(f"and {len(errors) - SHOWN_PROBLEMS} more")
     return f"{source}: " + "; ".join(problems)
 
 
@@ -43,21 +70,31 @@ def to_json(data: object, source: str) -> str:
         ) from None
 
 
-def load_model(path: Path, model: type[_M]) -> _M:
-    """Load ``path`` (YAML) as ``model``; raise :class:`ConfigFileError` on any problem."""
+def parse_yaml(text: str | bytes, source: str) -> object:
+    """One YAML document (bytes: must be UTF-8) within the limits of
+    :mod:`otonav.stack.safe_yaml`; :class:`ConfigFileError` naming ``source`` otherwise."""
     try:
-        text = path.read_text()
-    except FileNotFoundError:
-        raise ConfigFileError(f"{path}: no such file") from None
-    except OSError as exc:
-        raise ConfigFileError(f"{path}: cannot read ({exc.strerror})") from None
-    try:
-        data = yaml.safe_load(text)
+        return safe_yaml.load(safe_yaml.decode(text) if isinstance(text, bytes) else text)
+    except safe_yaml.YamlLimitError as exc:
+        raise ConfigFileError(f"{source}: {exc}") from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
         problem = getattr(exc, "problem", None) or str(exc)
-        raise ConfigFileError(f"{path}: invalid YAML{where}: {problem}") from None
+        problem = " ".join(str(problem).split())
+        raise ConfigFileError(f"{source}: invalid YAML{where}: {problem}") from None
+
+
+def load_model(path: Path, model: type[_M]) -> _M:
+    """Load ``path`` (YAML) as ``model``; raise :class:`ConfigFileError` on any problem."""
+    try:
+        with path.open("rb") as f:
+            raw = f.read(safe_yaml.MAX_BYTES + 1)  # bounded, even for /dev/zero
+    except FileNotFoundError:
+        raise ConfigFileError(f"{path}: no such file") from None
+    except OSError as exc:
+        raise ConfigFileError(f"{path}: cannot read ({exc.strerror})") from None
+    data = parse_yaml(raw, str(path))
     if data is None:
         data = {}
     if not isinstance(data, dict):

@@ -8,6 +8,7 @@ from typing import Any, TypeVar
 import yaml
 from pydantic import BaseModel, ValidationError
 
+from otonav.stack import safe_yaml
 from otonav.stack.files import ConfigFileError, describe_validation_error, to_json
 
 _M = TypeVar("_M", bound=BaseModel)
@@ -23,7 +24,9 @@ def apply_overrides(model: _M, assignments: Sequence[str], *, source: str = "--s
                 f"{source} {assignment!r}: expected key.path=value, e.g. nav.kp_lin=0.5"
             )
         try:
-            value = yaml.safe_load(raw)
+            value = safe_yaml.load(raw)
+        except safe_yaml.YamlLimitError as exc:
+            raise ConfigFileError(f"{source} {key.strip()}: {exc}") from None
         except yaml.YAMLError:
             value = raw
         node = data

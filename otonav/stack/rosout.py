@@ -8,11 +8,11 @@ import contextlib
 import anyio
 
 from otonav.actors import topics
+from otonav.actors.topics import ROSOUT_QOS
 from otonav.msgs import Log, Time
-from otonav.runtime import QoS, System, SystemEvent
+from otonav.runtime import System, SystemEvent
 
-#: As in ROS 2: reliable, keep the last 1000.
-ROSOUT_QOS = QoS(depth=1000)
+__all__ = ["ROSOUT_QOS", "attach_rosout"]
 
 _LEVELS = {"crashed": Log.ERROR, "restarted": Log.WARN}
 

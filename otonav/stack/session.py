@@ -72,7 +72,7 @@ class StackSession:
         actors: Sequence[Actor],
         *,
         realtime: RealTime | RealTimeClock | None = None,
-        record_to: Path | None = None,
+        record_to: Path | RecordingWriter | None = None,
         restart: RestartPolicy | Mapping[str, RestartPolicy] | None = None,
     ) -> None:
         self.hal = hal
@@ -87,7 +87,13 @@ class StackSession:
                 realtime = realtime.clock(hal)
             self.realtime_clock: RealTimeClock | None = realtime
             if record_to is not None:
-                self.writer = RecordingWriter(record_to)
+                # A path, or a writer of the caller's (e.g. a RotatingRecordingWriter)
+                # that the session then owns and finishes.
+                self.writer = (
+                    record_to
+                    if isinstance(record_to, RecordingWriter)
+                    else RecordingWriter(record_to)
+                )
                 # Before the first message, so a cut-off file still says its world.
                 self.writer.add_metadata(WORLD_METADATA, world_metadata(hal))
                 self.recorder = Recorder(self.writer)

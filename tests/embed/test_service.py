@@ -23,7 +23,6 @@ from typing import Any
 import httpx
 import pytest
 
-from otonav.cli import main as cli_main
 from otonav.embed import run_scenario_async
 from otonav.record.reader import summarize
 from otonav.scenario import run_scenario
@@ -93,8 +92,8 @@ def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
             if process.stdout is not None:
                 process.stdout.close()
     log = (out / "stderr.log").read_text()
-    # After its graceful shutdown uvicorn re-raises the signal it caught: -SIGTERM.
-    assert code in (0, -signal.SIGTERM), log
+    # After its graceful shutdown the service exits 128 + the signal it caught.
+    assert code == 128 + signal.SIGTERM, log
     assert "Traceback" not in log, log
     live = summarize(out / "live.mcap")
     assert live.truncated is False
@@ -206,52 +205,52 @@ def test_live_pose_stream_moves_after_a_goal(client: httpx.Client) -> None:
         assert time.monotonic() < deadline, "the closed stream still subscribes to /odom"
 
 
-def _cli_error(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
-    assert cli_main(argv) == 2
-    err = capsys.readouterr().err.strip()
-    assert err.startswith("otonav: error: "), err
-    return err.removeprefix("otonav: error: ")
-
-
-def test_bad_input_gets_4xx_with_the_cli_message(
-    client: httpx.Client, capsys: pytest.CaptureFixture[str], tmp_path: Path
-) -> None:
-    out = str(tmp_path / "cli")
-    mars = tmp_path / "mars.yaml"
-    mars.write_text("scene: mars\n")
-    same_as_cli = [
-        ({"scenario": "nope"}, ["run", "--scenario", "nope"]),
-        ({"set": ["nav.kp_lin=-1"]}, ["run", "--set", "nav.kp_lin=-1"]),
-        ({"set": ["nav.bogus=1"]}, ["run", "--set", "nav.bogus=1"]),
-        ({"set": ["rates.odom_hz=fast"]}, ["run", "--set", "rates.odom_hz=fast"]),
-        ({"set": ["nav"]}, ["run", "--set", "nav"]),
-        ({"scenario": {"scene": "mars"}}, ["run", "--scenario", str(mars)]),
-    ]
-    for body, argv in same_as_cli:
-        response = client.post("/runs", json=body)
-        assert response.status_code == 400, (body, response.text)
-        assert response.json()["error"] == _cli_error([*argv, "--out", out], capsys), body
-
-    outside = tmp_path / "outside.yaml"
-    outside.write_text("goal: {x: 40, y: 0}\n")
-    cli = _cli_error(["run", "--scenario", str(outside), "--out", out], capsys)
-    response = client.post("/runs", json={"scenario": {"goal": {"x": 40, "y": 0}}})
-    assert response.status_code == 400
-    # The same message; the CLI names the file where the service says "scenario".
-    assert cli.removeprefix(f"{outside}: ") == response.json()["error"].removeprefix("scenario: ")
-
+def test_bad_input_gets_4xx_in_the_words_of_the_request(client: httpx.Client) -> None:
+    """Each error names the request's field (``scenario``, ``set``, ``seed``), never a
+    CLI flag, and says each thing once."""
     cases: list[tuple[str, str, dict[str, Any], int, str]] = [
         ("POST", "/runs", {"content": b"{nope"}, 400, "request body: invalid JSON"),
         ("POST", "/runs", {"json": {"bogus": 1}}, 400, "request: bogus: unknown key"),
+        (
+            "POST",
+            "/runs",
+            {"json": {"scenario": "nope"}},
+            400,
+            "scenario: 'nope' is not a built-in scenario (acceptance, empty, ",
+        ),
+        (
+            "POST",
+            "/runs",
+            {"json": {"set": ["nav.kp_lin=-1"]}},
+            400,
+            "set: nav.kp_lin: Input should be",
+        ),
+        ("POST", "/runs", {"json": {"set": ["nav.bogus=1"]}}, 400, "set nav.bogus: unknown key"),
+        ("POST", "/runs", {"json": {"set": ["nav"]}}, 400, "set 'nav': expected key.path=value"),
         ("POST", "/runs", {"json": {"scenario": {"goal_tolerance": -1}}}, 400, "scenario: "),
+        (
+            "POST",
+            "/runs",
+            {"json": {"scenario": {"scene": "mars"}}},
+            400,
+            "scenario: scene 'mars' is ",
+        ),
+        (
+            "POST",
+            "/runs",
+            {"json": {"scenario": {"goal": {"x": 40, "y": 0}}}},
+            400,
+            "scenario: goal: (40, 0) is outside the arena",
+        ),
         ("POST", "/runs", {"json": {"scenario": "../etc/passwd"}}, 400, "reads no files"),
         ("POST", "/runs", {"json": {"scenario": {"scene": "/etc/passwd"}}}, 400, "no files"),
-        ("POST", "/runs", {"json": {"seed": -3}}, 400, "--seed: seed:"),
+        ("POST", "/runs", {"json": {"seed": -3}}, 400, "seed: Input should be greater than"),
         ("GET", "/runs/nope", {}, 404, "no run 'nope'"),
         ("DELETE", "/runs/nope", {}, 404, "no run 'nope'"),
+        ("GET", "/runs/nope/recording", {}, 404, "no run 'nope'"),
         ("GET", "/live/pose", {"params": {"hz": "0"}}, 400, "hz='0'"),
-        ("POST", "/live/goal", {"json": {"x": "far", "y": 0}}, 400, "goal: x:"),
-        ("POST", "/live/goal", {"json": {"x": 40, "y": 0}}, 400, "goal: goal: (40, 0)"),
+        ("POST", "/live/goal", {"json": {"x": "far", "y": 0}}, 400, "goal: x: "),
+        ("POST", "/live/goal", {"json": {"x": 40, "y": 0}}, 400, "goal (40, 0) is outside"),
     ]
     for method, path, kwargs, status, text in cases:
         response = client.request(method, path, **kwargs)
@@ -259,8 +258,73 @@ def test_bad_input_gets_4xx_with_the_cli_message(
         error = response.json()["error"]
         assert text in error, (path, kwargs, error)
         assert "\n" not in error
+        assert "--" not in error, f"a CLI flag in an HTTP error: {error}"
+        first = error.split(":")[0].split()[0]
+        assert error.count(f"{first}: {first}") == 0, f"says {first!r} twice: {error}"
     health = client.get("/health").json()
     assert health == {"status": "ok", "live": "running", "runs_active": 0}
+
+
+def test_a_finished_runs_recording_and_plot_are_served(client: httpx.Client) -> None:
+    run_id = _start(client, {"scenario": "empty"})
+    running = client.get(f"/runs/{run_id}/recording")
+    run = client.get(f"/runs/{run_id}", params={"wait": 30}, timeout=40).json()
+    assert run["status"] == "passed", run
+    if running.status_code != 200:  # asked before the end: refused, not half a file
+        assert running.status_code == 409, running.text
+        assert "not finished" in running.json()["error"]
+    assert run["links"] == {
+        "recording": f"/runs/{run_id}/recording",
+        "plot": f"/runs/{run_id}/plot",
+    }
+    recording = client.get(run["links"]["recording"])
+    assert recording.status_code == 200
+    assert recording.content.startswith(b"\x89MCAP0\r\n")
+    assert recording.content == Path(run["recording"]).read_bytes()
+    plot = client.get(run["links"]["plot"])
+    assert plot.status_code == 200
+    assert plot.headers["content-type"] == "image/png"
+    assert plot.content.startswith(b"\x89PNG")
+
+
+def test_a_running_runs_recording_is_refused(client: httpx.Client) -> None:
+    run_id = _start(client, {"scenario": ENDLESS})
+    _wait_status(client, run_id, lambda r: r["status"] == "running", within=10)
+    response = client.get(f"/runs/{run_id}/recording")
+    assert response.status_code == 409, response.text
+    assert response.json()["error"] == (
+        f"run {run_id} is running: its recording is not finished yet (ask again when it ends)"
+    )
+    assert client.delete(f"/runs/{run_id}").json()["status"] == "cancelled"
+
+
+def test_the_live_recording_is_capped_and_rotates(tmp_path: Path) -> None:
+    """A small cap (one MB) on a fast live robot: the file rotates, old ones go."""
+    cap = ["--live-scale", "20", "--live-record-mb", "1", "--live-record-keep", "1"]
+    process = subprocess.Popen(
+        [sys.executable, str(APP), "--port", "0", "--out", str(tmp_path), *cap],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        url = _first_line(process, START_CEILING_S).split()[-1]
+        with httpx.Client(base_url=url, timeout=10.0) as http:
+            assert http.post("/live/goal", json={"x": 4.0, "y": 1.5}).status_code == 202
+            deadline = time.monotonic() + 60.0
+            while not (tmp_path / "live.1.mcap").exists():  # ~40 s of sim: > 1 MB
+                assert time.monotonic() < deadline, "the live recording never rotated"
+                assert http.get("/health").json()["live"] == "running"
+    finally:
+        process.terminate()
+        process.communicate(timeout=20)
+    names = sorted(p.name for p in tmp_path.glob("live*.mcap"))
+    assert names == ["live.1.mcap", "live.mcap"]
+    for name in names:
+        summary = summarize(tmp_path / name)
+        assert not summary.truncated
+        assert "otonav.world" in summary.metadata
+    assert (tmp_path / "live.1.mcap").stat().st_size < 1.2 * 2**20
 
 
 def _figures(verdict: dict[str, Any]) -> dict[str, Any]:
@@ -309,3 +373,56 @@ def test_same_verdict_and_recording_from_cli_pytest_embedding_and_service(
     data = recordings["direct"].read_bytes()
     for name, path in recordings.items():
         assert path.read_bytes() == data, f"{name}: {path} differs from {recordings['direct']}"
+
+
+def test_adversarial_requests_get_4xx_and_reveal_no_files(
+    client: httpx.Client, tmp_path: Path
+) -> None:
+    # Issue 17, item 4. A scene path in an override made the server read a file the
+    # client named, and its errors told whether the path existed; these were 500s.
+    real = tmp_path / "real.xml"
+    real.write_text("<mujoco/>")
+    missing = tmp_path / "missing.xml"
+
+    def error(body: dict[str, Any]) -> str:
+        response = client.post("/runs", json=body)
+        assert response.status_code == 400, (body, response.text)
+        message: str = response.json()["error"]
+        assert "\n" not in message
+        return message
+
+    said_real = error({"set": [f"world.scene={real}"]})
+    said_missing = error({"set": [f"world.scene={missing}"]})
+    assert "reads no files" in said_real
+    assert said_real.replace(str(real), "P") == said_missing.replace(str(missing), "P")
+    for name in (str(real), "real.xml", "etc", "nothing-here"):  # no oracle in the cwd either
+        assert "reads no files" in error({"scenario": name}), name
+    said = [error({"scenario": {"scene": s}}) for s in (str(real), str(missing))]
+    assert said[0].replace(str(real), "P") == said[1].replace(str(missing), "P")
+    hardware = error({"set": ["hal.kind=can", "hal.can.interface=socketcan"]})
+    assert "hal.can.interface" in hardware
+
+    cases: list[tuple[str, str, dict[str, Any], int]] = [
+        ("POST", "/runs", {"content": b'{"scenario": "\xff\xfe"}'}, 400),  # not UTF-8
+        ("POST", "/runs", {"content": b"[" * 100_000 + b"]" * 100_000}, 400),  # deep JSON
+        ("POST", "/runs", {"json": {"scenario": "s" * 100_000}}, 400),  # a long name
+        ("POST", "/runs", {"json": {"scenario": {"name": "n" * 100_000}}}, 400),
+        ("POST", "/runs", {"json": {"set": ["world.scene=" + "x" * 100_000]}}, 400),
+        ("POST", "/runs", {"content": b'{"scenario": "' + b"s" * (2 << 20) + b'"}'}, 413),
+        ("GET", "/runs/x", {"params": {"wait": "nan"}}, 404),
+        ("GET", "/live/pose", {"params": {"hz": "nan"}}, 400),
+        ("POST", "/live/goal", {"json": {"x": 1e308, "y": 0}}, 400),
+    ]
+    for method, path, kwargs, status in cases:
+        response = client.request(method, path, **kwargs)
+        assert response.status_code == status, (path, response.status_code, response.text[:200])
+        message = response.json()["error"]
+        assert "\n" not in message
+        assert len(message) < 500, message[:600]
+    run_id = _start(client, {"scenario": "acceptance"})
+    for wait in ("nan", "inf", "-inf", "1e999", "soon"):
+        response = client.get(f"/runs/{run_id}", params={"wait": wait})
+        assert response.status_code == 400, (wait, response.text)
+        assert "wait=" in response.json()["error"]
+    client.delete(f"/runs/{run_id}")
+    assert client.get("/health").json()["status"] == "ok"

@@ -2,7 +2,7 @@
 
     python tests/sil/crash_child.py OUT_DIR MODE
 
-Runs a scenario that never ends on its own (kp_lin = 0, a huge budget) recording to
+Runs a scenario that does not end on its own soon (kp_lin = 0, the longest budget) recording to
 OUT_DIR/recording.mcap, prints ``ready`` once 30 s of sim time have passed, then either
 waits to be signalled (MODE=wait) or has an actor raise (MODE=raise).
 """
@@ -34,7 +34,7 @@ class Marker(Actor):
 def main() -> None:
     out, mode = Path(sys.argv[1]), sys.argv[2]
     run_scenario(
-        ScenarioConfig(sim_budget=1e6),
+        ScenarioConfig(sim_budget=1800.0),  # the most allowed; signalled at 30 s
         StackConfig(nav=NavConfig(kp_lin=0.0)),
         out_dir=out,
         plot=False,

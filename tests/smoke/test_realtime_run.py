@@ -33,6 +33,7 @@ def test_realtime_run_reaches_the_goal_paced_to_the_scaled_wall_clock(tmp_path: 
     assert Path(verdict.plot).is_file()
 
 
-def test_realtime_run_rejects_a_non_positive_scale() -> None:
-    with pytest.raises(ValueError, match="scale must be > 0"):
-        run_scenario_realtime(BUILTIN["empty"], scale=0.0, record=False, plot=False)
+@pytest.mark.parametrize("scale", [0.0, 1e308, 1e-9])
+def test_realtime_run_rejects_a_scale_it_cannot_honour(scale: float) -> None:
+    with pytest.raises(ValueError, match=r"scale .*must be a number in \[0.01, 100\]"):
+        run_scenario_realtime(BUILTIN["empty"], scale=scale, record=False, plot=False)

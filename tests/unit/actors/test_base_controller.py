@@ -7,16 +7,17 @@ control period is 20 ms. Every assertion is on sim time.
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Awaitable, Callable, Sequence
 from dataclasses import dataclass
 
 import anyio
 import pytest
 
-from otonav.actors import BaseController, BaseLimits, topics
+from otonav.actors import BaseController, BaseLimits, Bridge, topics
 from otonav.control import DiffDriveGeometry, twist_to_wheels, wheels_to_twist
 from otonav.hal import FakeHardware
-from otonav.msgs import Twist, WheelCommand
+from otonav.msgs import Log, Twist, WheelCommand
 from otonav.runtime import QoS, Reliability, System, virtual_loop_factory
 
 pytestmark = pytest.mark.unit
@@ -220,3 +221,64 @@ def test_no_command_no_motion_no_trip() -> None:
 def test_rate_and_timeout_must_be_positive() -> None:
     with pytest.raises(ValueError, match="cmd_timeout"):
         BaseController(GEOMETRY, cmd_timeout=0.0)
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+def test_a_non_finite_cmd_vel_is_rejected_and_logged_and_the_stack_runs_on(bad: float) -> None:
+    # Before: one NaN twist became a NaN wheel command, the HAL refused it, the bridge
+    # crashed and the whole stack stopped (issue 17, item 6).
+    hal = FakeHardware()
+    base = BaseController(GEOMETRY)
+    sent: list[tuple[float, float]] = []
+    logs: list[Log] = []
+
+    async def main() -> None:
+        async with System([Bridge(hal), base]) as system:
+            wheel_cmd = system.subscribe(topics.WHEEL_CMD, WheelCommand, OBSERVE)
+            rosout = system.subscribe(topics.ROSOUT, Log, OBSERVE)
+            cmd_vel = system.publisher(topics.CMD_VEL, Twist, topics.COMMAND_QOS)
+            for k in range(50):  # 1 s of commands every 20 ms, one of them bad
+                await anyio.sleep_until(k * PERIOD)
+                await cmd_vel.publish(Twist.planar(bad if k == 25 else 0.2, 0.0))
+            await anyio.sleep_until(1.0 + PERIOD / 4)
+            while (message := wheel_cmd.try_recv()) is not None:
+                sent.append((message.header.stamp.to_seconds(), message.left))
+            while (log := rosout.try_recv()) is not None:
+                logs.append(log)
+
+    _run(hal, main)  # raises if any actor crashed
+    assert sent[-1][0] == pytest.approx(1.0)  # the base kept publishing to the end
+    assert all(math.isfinite(left) for _t, left in sent)
+    # The bad command was dropped, the robot kept the last good one: no jump, no stop.
+    cruise = twist_to_wheels(0.2, 0.0, GEOMETRY)[0]
+    assert [left for t, left in sent if 0.5 <= t <= 1.0] == pytest.approx(
+        [cruise] * len([t for t, _ in sent if 0.5 <= t <= 1.0])
+    )
+    assert base.rejected_commands == 1
+    (warning,) = [log for log in logs if log.name == "base"]
+    assert warning.level == Log.WARN
+    assert "/cmd_vel" in warning.msg
+    assert "not finite" in warning.msg
+    assert warning.stamp.to_seconds() == pytest.approx(26 * PERIOD)
+
+
+def test_a_stream_of_bad_commands_is_logged_at_most_once_per_second() -> None:
+    hal = FakeHardware()
+    base = BaseController(GEOMETRY)
+    logs: list[Log] = []
+
+    async def main() -> None:
+        async with System([base]) as system:
+            rosout = system.subscribe(topics.ROSOUT, Log, OBSERVE)
+            cmd_vel = system.publisher(topics.CMD_VEL, Twist, topics.COMMAND_QOS)
+            for k in range(150):  # 3 s of NaN every 20 ms
+                await anyio.sleep_until(k * PERIOD)
+                await cmd_vel.publish(Twist.planar(math.nan, 0.0))
+            await anyio.sleep_until(3.0)
+            while (log := rosout.try_recv()) is not None:
+                logs.append(log)
+
+    _run(hal, main)
+    assert base.rejected_commands == 150
+    assert [round(log.stamp.to_seconds(), 2) for log in logs] == [0.02, 1.02, 2.02]
+    assert "(49 more since the last warning)" in logs[1].msg  # 0.04 .. 1.00 s

@@ -99,6 +99,7 @@ def test_expect_reached_fails_when_nav_gives_up_and_says_so() -> None:
 def test_expect_unreachable_fails_when_the_goal_is_reached() -> None:
     judge = _judge_states([])
     judge.time_to_goal = 2.0
+    judge.arrival_checked_at = 4.0  # arrived: the check 2 s after entry found no problem
     verdict = judge_verdict(WALLED, judge, 2.0, 0.1)
     assert not verdict.passed
     assert "reached a goal that was expected to be unreachable" in verdict.reason
@@ -107,6 +108,7 @@ def test_expect_unreachable_fails_when_the_goal_is_reached() -> None:
 def test_expect_reached_is_unchanged() -> None:
     judge = _judge_states([])
     judge.time_to_goal = 2.0
+    judge.arrival_checked_at = 4.0  # arrived: the check 2 s after entry found no problem
     assert judge.min_clearance == pytest.approx(0.9, abs=1e-6)  # the box 1 m ahead
     verdict = judge_verdict(OPEN, judge, 2.0, 0.1)
     assert verdict.passed, verdict.reason

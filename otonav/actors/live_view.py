@@ -1,0 +1,348 @@
+"""Live view: every topic served over the Foxglove WebSocket protocol while the stack
+runs, with the recordings' ROS 2 schemas and CDR payloads (so Foxglove's 3D panel draws
+the robot, its scan and /tf live), stamped with sim time.
+
+Two parts (docs/adr/0016-live-view-over-foxglove-sdk.md):
+
+- :class:`FoxgloveServer` wraps ``foxglove-sdk``'s WebSocket server (the optional extra
+  ``otonav[foxglove]``). The server runs on the SDK's own threads; handing it a message
+  copies the bytes and returns, and each client has a bounded backlog that drops its
+  oldest data message when the client does not keep up. Neither the loop nor the robot
+  ever waits for a client.
+- :class:`LiveView` is an actor that taps every topic (like the recorder, but lossy):
+  each tap is a best-effort mailbox that keeps the newest ``depth`` messages with their
+  publish instants and counts what it drops; every ``period`` s of sim time the actor
+  encodes what came in, for the channels some client subscribed to only, hands it to
+  the server and broadcasts the sim time. Latched topics (/tf_static, /goal) are sent
+  again to each client that subscribes to them, since the protocol has no latching.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from collections import deque
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+from otonav.msgs import Message
+from otonav.record.cdr import encode
+from otonav.record.schemas import schema_for
+from otonav.runtime import Actor, Bus, Durability, QoS, Reliability, run_blocking
+from otonav.runtime.mailbox import Endpoint, Subscription, Topic
+
+DEFAULT_HOST = "127.0.0.1"
+DEFAULT_PORT = 8765
+
+
+class LiveViewError(ValueError):
+    """The live view cannot start: one line saying why and what to do."""
+
+
+@dataclass(frozen=True, slots=True)
+class LiveViewOptions:
+    """Where to serve and how much to buffer."""
+
+    host: str = DEFAULT_HOST
+    """Interface to bind: loopback unless asked (``0.0.0.0`` serves every interface)."""
+    port: int = DEFAULT_PORT
+    """TCP port (Foxglove's convention, 8765); 0 picks a free one."""
+    backlog: int = 256
+    """Messages the server queues per client before dropping its oldest."""
+    depth: int = 64
+    """Messages each topic's tap keeps between two flushes before dropping its oldest."""
+    period: float = 0.02
+    """Seconds of sim time between flushes (50 Hz at 1x)."""
+    wait_for_subscriber: float | None = None
+    """Hold sim time at the start until a client subscribes, for at most this many
+    wall seconds (None: do not wait). Sim time does not move while it waits."""
+    wait_for_subscriptions: int = 1
+    """With ``wait_for_subscriber``: how many channel subscriptions to wait for."""
+
+    def __post_init__(self) -> None:
+        if not 0 <= self.port <= 65535:
+            raise LiveViewError(f"foxglove port {self.port}: must be 0..65535 (0: any free)")
+        if self.backlog < 1 or self.depth < 1:
+            raise LiveViewError("foxglove backlog and depth must be >= 1 message")
+        if not (self.period > 0 and math.isfinite(self.period)):
+            raise LiveViewError(f"foxglove period {self.period}: must be > 0 s of sim time")
+        wait = self.wait_for_subscriber
+        if wait is not None and not (wait > 0 and math.isfinite(wait)):
+            raise LiveViewError(f"--foxglove-wait {wait}: must be a number of seconds > 0")
+
+
+class FoxgloveServer:
+    """A Foxglove WebSocket server on ``options.host:options.port`` (started here;
+    :meth:`close` stops it). Raises :class:`LiveViewError` when the extra is not
+    installed or the address cannot be bound."""
+
+    def __init__(self, options: LiveViewOptions = LiveViewOptions()) -> None:
+        try:
+            import foxglove
+            from foxglove.websocket import Capability, ChannelView, Client, ServerListener
+        except ImportError:
+            raise LiveViewError(
+                "--foxglove needs the foxglove extra: pip install 'otonav[foxglove]'"
+            ) from None
+        self.options = options
+        self._foxglove = foxglove
+        self._context = foxglove.Context()
+        self._lock = threading.Lock()
+        self._channels: dict[str, Any] = {}
+        self._latched: dict[int, tuple[bytes, int]] = {}
+        self.subscriptions: dict[int, set[int]] = {}
+        """client id -> channel ids it subscribes to (kept by the SDK's callbacks)."""
+        self.clients_seen: set[int] = set()
+        self._changed = threading.Condition(self._lock)
+        self._subscribed_total = 0
+        server = self
+
+        class Listener(ServerListener):
+            """Callbacks from the SDK's threads: count subscriptions, re-send latched data."""
+
+            def on_subscribe(self, client: Client, channel: ChannelView) -> None:
+                server._subscribed(client.id, channel.id)
+
+            def on_unsubscribe(self, client: Client, channel: ChannelView) -> None:
+                server._unsubscribed(client.id, channel.id)
+
+        try:
+            self._server = foxglove.start_server(
+                name="otonav",
+                host=options.host,
+                port=options.port,
+                capabilities=[Capability.Time],
+                server_listener=Listener(),
+                context=self._context,
+                message_backlog_size=options.backlog,
+            )
+        except Exception as exc:  # the SDK raises its own error types; all mean "cannot bind"
+            raise LiveViewError(
+                f"foxglove server on {options.host}:{options.port}: cannot start ({exc}); "
+                "pick another --foxglove-port (0: any free one)"
+            ) from None
+        self.closed = False
+
+    @property
+    def port(self) -> int:
+        """The bound port (the one picked when ``options.port`` was 0)."""
+        return int(self._server.port)
+
+    @property
+    def url(self) -> str:
+        return f"ws://{self.options.host}:{self.port}"
+
+    def channel(self, topic: str, msg_type: type[Message]) -> Any:
+        """The channel of ``topic`` (advertised to clients when first made)."""
+        channel = self._channels.get(topic)
+        if channel is None:
+            name, definition = schema_for(msg_type)
+            schema = self._foxglove.Schema(name=name, encoding="ros2msg", data=definition.encode())
+            channel = self._foxglove.Channel(
+                topic, schema=schema, message_encoding="cdr", context=self._context
+            )
+            self._channels[topic] = channel
+        return channel
+
+    def latch(self, channel: Any, data: bytes, log_time: int) -> None:
+        """Remember the newest message of a latched topic, for clients that subscribe later."""
+        self._latched[int(channel.id())] = (data, log_time)
+
+    def broadcast_time(self, sim_time: float) -> None:
+        if not self.closed:
+            self._server.broadcast_time(round(sim_time * 1e9))
+
+    def _subscribed(self, client: int, channel_id: int) -> None:
+        with self._lock:
+            self.clients_seen.add(client)
+            self.subscriptions.setdefault(client, set()).add(channel_id)
+            self._subscribed_total += 1
+            self._changed.notify_all()
+        latched = self._latched.get(channel_id)
+        if latched is not None:
+            for channel in tuple(self._channels.values()):
+                if int(channel.id()) == channel_id:
+                    channel.log(latched[0], log_time=latched[1])
+
+    def wait_for_subscriptions(self, count: int = 1, timeout: float | None = None) -> bool:
+        """Block (a thread, never the loop) until clients made ``count`` channel
+        subscriptions in all since the server started; False on timeout."""
+        with self._changed:
+            return self._changed.wait_for(lambda: self._subscribed_total >= count, timeout)
+
+    def _unsubscribed(self, client: int, channel_id: int) -> None:
+        with self._lock:
+            channels = self.subscriptions.get(client)
+            if channels is not None:
+                channels.discard(channel_id)
+                if not channels:
+                    del self.subscriptions[client]
+
+    def close(self) -> None:
+        """Stop serving (clients are disconnected). Idempotent."""
+        if self.closed:
+            return
+        self.closed = True
+        for channel in self._channels.values():
+            channel.close()
+        self._server.stop()
+
+
+# Matches every publisher (ROS 2 rules): tapping a topic never makes wiring fail.
+_TAP_QOS = QoS(Reliability.BEST_EFFORT, depth=1)
+
+
+class _Tap(Subscription[Any]):
+    """A lossy mailbox that keeps (publish instant, message), newest ``keep``."""
+
+    __slots__ = ("_keep", "_now", "_stamped")
+
+    def __init__(self, topic: Topic[Any], endpoint: Endpoint, keep: int, now: Any) -> None:
+        super().__init__(topic.name, topic.msg_type, _TAP_QOS, endpoint)
+        self._keep = keep
+        self._now = now
+        self._stamped: deque[tuple[float, Any]] = deque()
+
+    def _offer(self, message: Any) -> bool:
+        stamped = self._stamped
+        if len(stamped) >= self._keep:
+            stamped.popleft()
+            self.dropped += 1
+        stamped.append((self._now(), message))
+        self.received += 1
+        return True
+
+    def _full(self) -> bool:
+        return False
+
+    def take_all(self) -> deque[tuple[float, Any]]:
+        taken, self._stamped = self._stamped, deque()
+        self.taken += len(taken)
+        return taken
+
+    def statistics(self) -> Any:
+        stats = super().statistics()
+        return stats._replace(queued=len(self._stamped), depth=self._keep)
+
+
+class LiveViewStatistics(NamedTuple):
+    """Counters of a live view."""
+
+    sent: int
+    """Messages handed to the server (for channels some client subscribed to)."""
+    dropped: int
+    """Messages the taps dropped because the live view fell behind (never the robot)."""
+    clients: int
+    """Clients subscribed to at least one channel now."""
+    clients_seen: int
+
+
+@dataclass(slots=True)
+class _TopicState:
+    topic: Topic[Any]
+    tap: _Tap
+    channel: Any
+    latched: bool
+    sent: int = 0
+    sent_bytes: int = 0
+
+
+class LiveView(Actor):
+    """Serves every topic of its system through ``server`` (see the module docstring)."""
+
+    def __init__(
+        self,
+        server: FoxgloveServer,
+        *,
+        depth: int | None = None,
+        period: float | None = None,
+        name: str = "foxglove",
+    ) -> None:
+        super().__init__(name)
+        self.server = server
+        self.depth = depth or server.options.depth
+        self.period = period or server.options.period
+        self._topics: dict[str, _TopicState] = {}
+        self.sent_bytes = 0
+
+    def on_wired(self, bus: Bus) -> None:
+        for topic in list(bus.topics.values()):
+            self._tap(topic)
+        bus.add_topic_listener(self._tap)
+
+    def _now(self) -> float:
+        # Until the System hands out clocks, time is the start (0).
+        clock = self._otonav_clock
+        return clock.now() if clock is not None else 0.0
+
+    def _tap(self, topic: Topic[Any]) -> None:
+        if topic.name in self._topics:
+            return
+        tap = _Tap(topic, Endpoint(self.name, topic.name), self.depth, self._now)
+        topic.subscriptions.append(tap)
+        latched = any(p.qos.durability is Durability.TRANSIENT_LOCAL for p in topic.publishers)
+        channel = self.server.channel(topic.name, topic.msg_type)
+        self._topics[topic.name] = _TopicState(topic, tap, channel, latched)
+        for publisher in topic.publishers:  # history a transient-local publisher kept
+            for message in publisher._history or ():
+                tap._offer(message)
+
+    async def on_start(self) -> None:
+        options = self.server.options
+        if options.wait_for_subscriber is not None:
+            # A worker thread waits; sim time holds still meanwhile (run_blocking).
+            await run_blocking(
+                self.server.wait_for_subscriptions,
+                options.wait_for_subscriptions,
+                options.wait_for_subscriber,
+            )
+
+    async def run(self) -> None:
+        rate = self.clock.rate(1.0 / self.period)
+        while True:
+            await rate.sleep()
+            self.flush()
+
+    def flush(self) -> None:
+        """Hand everything tapped since the last flush to the server."""
+        server = self.server
+        if server.closed:
+            return
+        for state in self._topics.values():
+            taken = state.tap.take_all()
+            if not taken:
+                continue
+            if not state.latched:
+                # A latched topic's publisher may arrive after the tap: look again.
+                state.latched = any(
+                    p.qos.durability is Durability.TRANSIENT_LOCAL for p in state.topic.publishers
+                )
+            channel = state.channel
+            if not (state.latched or channel.has_sinks()):
+                continue  # nobody watches: do not even encode
+            for instant, message in taken:
+                data = encode(message)
+                stamp = round(instant * 1e9)
+                channel.log(data, log_time=stamp)
+                state.sent += 1
+                state.sent_bytes += len(data)
+                self.sent_bytes += len(data)
+                if state.latched:
+                    server.latch(channel, data, stamp)
+        server.broadcast_time(self._now())
+
+    async def on_stop(self) -> None:
+        self.flush()
+
+    def statistics(self) -> LiveViewStatistics:
+        server = self.server
+        return LiveViewStatistics(
+            sent=sum(s.sent for s in self._topics.values()),
+            dropped=sum(s.tap.dropped for s in self._topics.values()),
+            clients=len(server.subscriptions),
+            clients_seen=len(server.clients_seen),
+        )
+
+    def topic_statistics(self) -> dict[str, tuple[int, int]]:
+        """topic -> (messages sent, messages dropped by its tap)."""
+        return {name: (s.sent, s.tap.dropped) for name, s in self._topics.items()}

@@ -1,0 +1,96 @@
+"""Ctrl-C and SIGTERM during ``otonav run``: the first one stops the run, every later
+one is ignored until the recording and the plot are finished.
+
+Python's default (a KeyboardInterrupt wherever the main thread happens to be) and
+asyncio's (a second Ctrl-C raises inside the loop, SIGTERM is restored to "kill" once
+the loop closes) both let a second signal cut the shutdown short: a traceback, an
+unindexed recording, no plot (issue 17). Here, while :class:`StopOnSignals` is active:
+
+- before the run is armed (loading configs): SIGINT/SIGTERM raise KeyboardInterrupt,
+  there is nothing to finish yet;
+- once armed: the first signal cancels the run's task (on its loop, thread-safely), so
+  every ``finally`` of the run executes, in order; if the task has not started yet it
+  is cancelled as it starts; if it has already finished, the shutdown simply goes on;
+- every further signal prints one note and is ignored (SIGKILL still kills).
+
+asyncio.Runner and ``run_task`` install their own handlers only over the defaults, so
+they leave these in place.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import signal
+import sys
+import threading
+from types import FrameType, TracebackType
+from typing import Any
+
+EXIT_CODES = {signal.SIGINT: 130, signal.SIGTERM: 143}
+_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+class StopOnSignals:
+    """Context manager; pass :meth:`attach` as the run's ``on_start``."""
+
+    def __init__(self) -> None:
+        self.received: signal.Signals | None = None
+        self._armed = False
+        self._noted = False
+        self._target: tuple[asyncio.AbstractEventLoop, asyncio.Task[Any]] | None = None
+        self._previous: dict[signal.Signals, Any] = {}
+
+    def __enter__(self) -> StopOnSignals:
+        if threading.current_thread() is threading.main_thread():
+            for sig in _SIGNALS:
+                self._previous[sig] = signal.signal(sig, self._handle)
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        for sig, previous in self._previous.items():
+            signal.signal(sig, previous)
+
+    def arm(self) -> None:
+        """From now on a signal stops the run instead of raising."""
+        self._armed = True
+
+    def attach(self, loop: asyncio.AbstractEventLoop, task: asyncio.Task[Any]) -> None:
+        """The run's ``on_start``: its loop and task, to cancel on the first signal."""
+        self._target = (loop, task)
+        if self.received is not None:
+            task.cancel()  # the signal came while the run was being set up
+
+    def _handle(self, signum: int, _frame: FrameType | None) -> None:
+        sig = signal.Signals(signum)
+        if self.received is None:
+            self.received = sig
+            if not self._armed:
+                raise KeyboardInterrupt
+            if self._target is not None:
+                loop, task = self._target
+                if not task.done() and not loop.is_closed():
+                    loop.call_soon_threadsafe(task.cancel)
+            return
+        if not self._noted:
+            self._noted = True
+            print(
+                f"otonav: {sig.name} again: still finishing the recording and the plot "
+                "(SIGKILL would lose the end of the recording)",
+                file=sys.stderr,
+                flush=True,
+            )
+
+    def report(self) -> int:
+        """One line on how the run ended, and its exit code (130 or 143)."""
+        sig = self.received or signal.SIGINT
+        what = "interrupted" if sig is signal.SIGINT else "terminated"
+        print(
+            f"otonav: {what}; the recording and the plot were finished; no summary written",
+            file=sys.stderr,
+        )
+        return EXIT_CODES[sig]

@@ -1,0 +1,153 @@
+"""What the stack can honour: the bounds of every configurable number and string.
+
+A value outside these bounds is refused when the config is loaded (exit 2, one line
+naming the key), because inside them the stack was measured to run, and outside them
+it crashed, hung or ran for hours (issue 17: ``lidar_range_max=1e300`` overflowed the
+float32 scan, ``timestep=1e-9`` and ``scan_hz=1e9`` livelocked the loop,
+``lidar_beams=1e7`` ran out of memory, a 10 MB name hung the plot). Each constant
+says why it is where it is; ADR 0019 records the trade and how to move a bound.
+
+Costs quoted below were measured on the 2-core development machine (2026-11-23,
+``python -m otonav run`` with ``--set``, noisy: shared with other jobs).
+"""
+
+from __future__ import annotations
+
+import math
+
+# -- world -------------------------------------------------------------------------------
+
+MIN_TIMESTEP_S = 1e-4
+"""Smallest physics step. Sim time advances one MuJoCo step per tick, and every step
+costs ~6-10 µs of wall time: at 1e-4 s the acceptance run already takes 9x longer than
+at the default 0.002 s (RTF 9x instead of 41x); 1e-6 s is a 20 s scenario of 20 million
+steps (about three minutes), 1e-9 s never finishes."""
+
+MAX_TIMESTEP_S = 0.01
+"""Largest physics step. Every timer fires on a tick, so the tick rate must be at least
+the fastest rate in the stack: the judge samples at 100 Hz. At 0.01 s the wheel
+contacts are still stable and the acceptance scenario passes; at 0.02 s it fails."""
+
+MAX_LIDAR_BEAMS = 3600
+"""0.1 degree resolution, the finest 2D lidars sold. A 3600-beam scan is 14.4 kB of
+float32 (under the recorder's 64 KiB chunk); 1e7 beams is 40 MB per scan."""
+
+MAX_LIDAR_RANGE_M = 1000.0
+"""Ranges travel as float32 (``sensor_msgs/LaserScan``): 1e300 overflowed the encoder.
+At 1 km float32 still resolves 61 µm; the built-in arenas are 10 m across and 2D lidars
+sold reach well under 1 km."""
+
+# -- rates -------------------------------------------------------------------------------
+# No absolute bound: every rate in Hz must be <= 1 / world.timestep (a timer cannot
+# fire more often than the world ticks; a faster one re-armed inside the same tick and
+# livelocked the loop). With MIN_TIMESTEP_S that is at most 10 kHz.
+
+# -- base --------------------------------------------------------------------------------
+
+MAX_BASE_V = 10.0
+"""m/s. 20x the default: the wheel speed v / r must stay finite (1e308 m/s gave an
+infinite wheel command, which the HAL refuses, and the stack stopped)."""
+
+MAX_BASE_OMEGA = 50.0
+"""rad/s, for the same reason as :data:`MAX_BASE_V` (33x the default)."""
+
+MAX_BASE_ACCEL = 100.0
+"""m/s², 100x the default; above it the limit no longer limits anything at 50 Hz."""
+
+MAX_BASE_ALPHA = 500.0
+"""rad/s², about 170x the default, for the same reason."""
+
+# -- scenario ----------------------------------------------------------------------------
+
+MAX_COORDINATE_M = 1000.0
+"""|x|, |y| of a start, goal or obstacle centre, and an obstacle's size: a world 2 km
+across. Far beyond any built-in arena (10 m), well inside what MuJoCo and the float32
+recording resolve."""
+
+MAX_YAW_RAD = 2 * math.pi
+"""A heading or box yaw is an angle: one full turn either way."""
+
+MAX_DISTANCE_M = 100.0
+"""``goal_tolerance`` and ``min_clearance``: a tolerance of 1e10 m made the plot draw a
+circle for 10 s, 1e20 m hung it; 100 m is ten arenas."""
+
+MAX_SIM_BUDGET_S = 1800.0
+"""Half an hour of sim time per scenario: at the measured 40-80x real time of the
+default stack, 22-45 s of wall time, well inside ``run_scenario``'s default 300 s
+wall-clock ceiling (1e6 s ran into it: a traceback, no summary). A heavier stack is
+held to :data:`WALL_BUDGET_S` by the estimate below. Longer missions are several
+scenarios."""
+
+MAX_OBSTACLES = 1000
+"""Extra boxes in one scenario: the judge measures the clearance to every box 100 times
+per sim second (5000 boxes made the acceptance run 10x slower, 14.6 s of wall time)."""
+
+MAX_SEED = 2**63 - 1
+"""Seeds are int64 wherever they are stored or passed on."""
+
+MAX_NAME_CHARS = 128
+"""A scenario name is a title and a file label: 10 MB hung matplotlib's title layout."""
+
+MAX_PATH_CHARS = 4096
+"""A scene path: Linux's PATH_MAX."""
+
+# -- real-time mode ----------------------------------------------------------------------
+
+MIN_SCALE = 0.01
+"""Sim seconds per wall second, slowest: a 20 s scenario then takes 33 minutes."""
+
+MAX_SCALE = 100.0
+"""Sim seconds per wall second, fastest: the whole stack measured 40-83x real time on
+the development machine, so beyond ~100 sim time only slips behind the wall clock;
+1e308 overflowed the clock."""
+
+# -- estimated cost of a scenario run ----------------------------------------------------
+
+WALL_BUDGET_S = 150.0
+"""The most wall time a scenario may be *estimated* to take (see
+:func:`estimated_wall_s`): half of ``run_scenario``'s default 300 s wall-clock ceiling,
+so a machine twice as loaded as the reference one still finishes."""
+
+_US_PER_STEP = 10.0
+"""Wall µs per physics step (measured 6-11 µs at timestep 1e-4)."""
+_US_PER_WAKE = 100.0
+"""Wall µs per Hz of actor rate per sim second: a wake, its messages (odometry also
+publishes /tf), their encoding and recording (measured 50-130 µs)."""
+_US_PER_BEAM = 0.5
+"""Wall µs per lidar beam cast, encoded and recorded (measured 0.36-0.45 µs)."""
+_US_PER_BOX_SAMPLE = 1.0
+"""Wall µs per box per judge sample (100 Hz)."""
+_JUDGE_HZ = 100.0
+
+
+def estimated_wall_s(
+    *,
+    sim_budget: float,
+    timestep: float,
+    rates_hz: float,
+    scan_hz: float,
+    lidar_beams: int,
+    boxes: int,
+) -> float:
+    """Wall seconds a run of ``sim_budget`` s is estimated to take on the reference
+    machine, from its physics steps, the sum of its actor rates (``rates_hz``), its lidar
+    beams and its judge's clearance checks. Deliberately pessimistic (1.2-1.5x the
+    measured figures): it refuses a run that would hit the wall-clock ceiling, never
+    times one."""
+    per_sim_s_us = (
+        _US_PER_STEP / timestep
+        + _US_PER_WAKE * rates_hz
+        + _US_PER_BEAM * scan_hz * lidar_beams
+        + _US_PER_BOX_SAMPLE * _JUDGE_HZ * boxes
+    )
+    return sim_budget * per_sim_s_us * 1e-6
+
+
+def check_scale(scale: float, source: str = "--scale") -> str | None:
+    """Why ``scale`` (sim s per wall s) cannot be honoured, or None."""
+    if not (math.isfinite(scale) and MIN_SCALE <= scale <= MAX_SCALE):
+        return (
+            f"{source} {scale:g}: must be a number in [{MIN_SCALE:g}, {MAX_SCALE:g}] "
+            "(sim seconds per wall second)"
+        )
+    return None
