@@ -45,9 +45,12 @@ def timed_sweep(runs: int, backend: str, workers: int, out: Path) -> dict[str, A
     tasks = plan_runs(spec)
     engine = make_backend(backend, workers=workers)
     prepared = prepare(out, tasks)
+    load = Path("/proc/loadavg").read_text().split()[0]
+    cpu_before = _cpu()
     start = time.perf_counter()
     records = execute(prepared, engine)
     wall = time.perf_counter() - start
+    cpu = _cpu() - cpu_before
     sim = sum(r["sim_time_s"] for r in records)
     sim_walls = [r["sim_wall_s"] for r in records]
     return {
@@ -58,6 +61,9 @@ def timed_sweep(runs: int, backend: str, workers: int, out: Path) -> dict[str, A
         "wall_s": wall,
         "sim_s": sim,
         "throughput": sim / wall,
+        "load_at_start": load,
+        # driver + reaped workers; Ray's workers are not our children (None)
+        "sim_per_cpu_s": sim / cpu if backend == "process" else None,
         "run_wall_p50_s": statistics.median(r["wall_time_s"] for r in records),
         "sim_wall_p50_s": statistics.median(sim_walls),
         "in_worker_overhead_p50_ms": 1e3
@@ -65,6 +71,12 @@ def timed_sweep(runs: int, backend: str, workers: int, out: Path) -> dict[str, A
         "total_overhead_per_run_ms": 1e3 * (wall * workers - sum(sim_walls)) / len(records),
         "hashes": sorted(r["recording_sha256"] for r in records),
     }
+
+
+def _cpu() -> float:
+    me = resource.getrusage(resource.RUSAGE_SELF)
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return me.ru_utime + me.ru_stime + kids.ru_utime + kids.ru_stime
 
 
 def shell_loop(runs: int, out: Path) -> dict[str, Any]:
@@ -131,14 +143,19 @@ def main() -> None:
 
     print(f"{args.runs}-run sweep of the acceptance scenario ({sim_per_run:.2f} s of sim each)")
     print(f"load average before: {' '.join(load_before)} (2 cores, shared machine)")
-    header = f"{'configuration':<28} {'wall s':>8} {'sim-s/wall-s':>13} {'run p50 ms':>11}"
+    header = (
+        f"{'configuration':<28} {'wall s':>8} {'sim-s/wall-s':>13} {'run p50 ms':>11} "
+        f"{'sim-s/CPU-s':>12} {'load':>5}"
+    )
     print(header)
     print("-" * len(header))
     for r in results:
         name = f"{r['backend']}, {r['workers']} worker{'s' if r['workers'] > 1 else ''}"
         print(
             f"{name:<28} {r['wall_s']:8.1f} {r['throughput']:13.1f} "
-            f"{1e3 * r['run_wall_p50_s']:11.0f}"
+            f"{1e3 * r['run_wall_p50_s']:11.0f} "
+            + (f"{r['sim_per_cpu_s']:12.1f}" if r["sim_per_cpu_s"] else f"{'-':>12}")
+            + f" {r['load_at_start']:>5}"
         )
     scaled = shell["wall_s"] * args.runs / shell["runs"]
     print(
@@ -156,6 +173,11 @@ def main() -> None:
         "(target >= 4)"
     )
     print(f"sweep (1 worker) / shell loop:   {p1['throughput'] / shell_throughput:.2f}x")
+    efficiency = p2["sim_per_cpu_s"] / p1["sim_per_cpu_s"]
+    print(
+        f"CPU efficiency, 2 workers / 1:   {efficiency:.2f}  (sim-s per CPU-s; with two idle "
+        f"cores the 2-worker speed-up would be about {2 * efficiency:.2f}x)"
+    )
     if len(results) > 2:
         ray_r = results[2]
         print(
