@@ -62,11 +62,16 @@ def add_parser(commands: Any) -> None:
     p.set_defaults(handler=main)
 
 
-def _scalar(text: str) -> Scalar:
+def _scalar(text: str, where: str) -> Scalar:
     import yaml
 
+    from otonav.stack import safe_yaml
+    from otonav.stack.files import ConfigFileError
+
     try:
-        value = yaml.safe_load(text)
+        value = safe_yaml.load(text)  # within the config files' limits (depth, size)
+    except safe_yaml.YamlLimitError as exc:
+        raise ConfigFileError(f"{where}: {exc}") from None
     except yaml.YAMLError:
         return text
     return value if isinstance(value, bool | int | float | str) else text
@@ -94,7 +99,7 @@ def quick_spec(args: argparse.Namespace) -> SweepSpec:
         if args.generate <= 0:
             raise ConfigFileError(f"--generate {args.generate}: must be a count > 0")
         params: dict[str, Scalar | tuple[Scalar, ...]] = {
-            k: _scalar(v) for k, v in _pairs(args.gen, "--gen")
+            k: _scalar(v, f"--gen {k}") for k, v in _pairs(args.gen, "--gen")
         }
         if args.density is not None:
             params["density"] = args.density
@@ -106,7 +111,7 @@ def quick_spec(args: argparse.Namespace) -> SweepSpec:
     if args.seeds is not None and args.seeds <= 0:
         raise ConfigFileError(f"--seeds {args.seeds}: must be a count > 0")
     grid = {
-        k: tuple(_scalar(v) for v in value.split(","))
+        k: tuple(_scalar(v, f"--set {k}") for v in value.split(","))
         for k, value in _pairs(args.overrides, "--set")
     }
     return SweepSpec(

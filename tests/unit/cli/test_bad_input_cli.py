@@ -123,3 +123,12 @@ def test_anchors_for_ordinary_reuse_still_work(tmp_path: Path) -> None:
     scenario = load_model(f, ScenarioConfig)
     assert scenario.obstacles[0] == scenario.obstacles[1]
     assert scenario.sim_budget == 10.0
+
+
+def test_sweep_set_values_are_parsed_within_the_same_limits(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    # A grid value is parsed as YAML too: 3000 levels were a RecursionError traceback.
+    deep = "[" * 3000 + "]" * 3000
+    argv = ["sweep", "--scenario", "acceptance", "--set", f"nav.kp_lin={deep}"]
+    _fails(capsys, [*argv, "--out", str(tmp_path)], "nav.kp_lin", "nested deeper than 32")
