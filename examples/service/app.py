@@ -27,22 +27,33 @@ OUT/live.mcap, rotates at ``--live-record-mb`` (64 MB): the finished file become
 live.1.mcap (older ones move up; ``--live-record-keep`` of them stay, default 2), so disk
 use stays under about (keep + 1) x the cap. The server binds to 127.0.0.1 unless told
 otherwise.
+
+What a client may ask is narrower than the CLI (issue 17): built-in scenes and scenarios
+only, so the server reads no file a client names and its errors never say whether a path
+exists; no hardware (a CAN run is the emulated bus); bodies of at most 1 MiB of UTF-8
+JSON. Ctrl-C or SIGTERM cancels every run at once (each finishes its recording), ends the
+pose streams, then closes the live robot and its recording; a second signal is ignored
+until that is done.
 """
 
 from __future__ import annotations
 
 import argparse
 import asyncio
+import contextlib
 import json
 import logging
 import math
+import signal
 import socket
 import sys
+import threading
 import uuid
-from collections.abc import AsyncIterator, Awaitable, Callable
+from collections.abc import AsyncIterator, Awaitable, Callable, Iterator
 from contextlib import AsyncExitStack, asynccontextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import FrameType
 from typing import Any
 
 import anyio
@@ -58,11 +69,13 @@ from otonav.actors import topics
 from otonav.cli.loading import load_stack
 from otonav.embed import LiveStack, check_run, open_live_stack, run_scenario_async
 from otonav.hal.mujoco import SceneError, scene_names
+from otonav.limits import check_scale
 from otonav.msgs import Odometry
 from otonav.record.rotating import RotatingRecordingWriter
 from otonav.runtime import QoS, Reliability
 from otonav.scenario import GoalSpec, ScenarioConfig, Verdict
 from otonav.scenario.builtin import BUILTIN
+from otonav.scenario.config import Coordinate
 from otonav.scenario.validate import check_goal
 from otonav.stack import StackConfig
 from otonav.stack.files import ConfigFileError, describe_validation_error, to_json
@@ -73,6 +86,16 @@ log = logging.getLogger("otonav.service")
 #: Latest pose only: a slow client skips poses, it never holds the robot back.
 POSE_QOS = QoS(Reliability.BEST_EFFORT, depth=1)
 MAX_WAIT_S = 60.0
+MAX_BODY_BYTES = 1 << 20
+"""A request body: a run request is a few hundred bytes, an inline scenario a few kB."""
+SHOWN_CHARS = 200
+"""How much of a client's string an error quotes (a path fits; 10 MB does not)."""
+
+
+def _short(value: str) -> str:
+    """``repr(value)``, cut to :data:`SHOWN_CHARS` (a 10 MB name stays a short error)."""
+    text = repr(value)
+    return text if len(text) <= SHOWN_CHARS else f"{text[: SHOWN_CHARS - 3]}..."
 
 
 class BadRequest(Exception):
@@ -97,8 +120,8 @@ class RunRequest(BaseModel):
 
 class GoalRequest(BaseModel):
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-    x: float
-    y: float
+    x: Coordinate  # bounded as in a scenario file
+    y: Coordinate
 
 
 def _parse(model: type[BaseModel], body: object, source: str) -> Any:
@@ -109,17 +132,49 @@ def _parse(model: type[BaseModel], body: object, source: str) -> Any:
 
 
 async def _json_body(request: Request) -> object:
-    raw = await request.body()
+    raw = bytearray()
+    async for chunk in request.stream():  # bounded: never holds more than the cap
+        raw += chunk
+        if len(raw) > MAX_BODY_BYTES:
+            raise BadRequest(f"request body: larger than {MAX_BODY_BYTES // 1024} KiB", 413)
     if not raw:
         return {}
     try:
-        return json.loads(raw)
+        text = bytes(raw).decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise BadRequest(
+            f"request body: not UTF-8 (byte 0x{raw[exc.start]:02x} at offset {exc.start})"
+        ) from None
+    try:
+        return json.loads(text)
     except json.JSONDecodeError as exc:
         raise BadRequest(f"request body: invalid JSON: {exc}") from None
+    except RecursionError:
+        raise BadRequest("request body: JSON nested too deeply") from None
 
 
-def _names_a_file(name: str, suffixes: tuple[str, ...]) -> bool:
-    return "/" in name or "\\" in name or name.endswith(suffixes) or Path(name).exists()
+def _no_files(what: str, value: str, valid: tuple[str, ...]) -> ConfigFileError:
+    """The same answer whatever ``value`` names, existing or not: no oracle."""
+    return ConfigFileError(
+        f"{what} {_short(value)} is not a built-in scene ({', '.join(valid)}); "
+        "the service reads no files"
+    )
+
+
+def check_client_stack(stack: StackConfig, base: StackConfig, source: str = "set") -> None:
+    """What a client's overrides (``stack``, made from the operator's ``base``) may not
+    ask of the server: a scene file (a read of a path the client names), real hardware
+    (a CAN interface other than the emulated one). What the operator configured stands."""
+    scene = stack.world.scene
+    if scene != base.world.scene and scene not in scene_names():
+        raise _no_files(f"{source}: world.scene", scene, scene_names())
+    can = stack.hal.can
+    hardware = stack.hal.kind == "can" and (can.interface != "virtual" or not can.emulate)
+    if hardware and stack.hal != base.hal:
+        raise ConfigFileError(
+            f"{source}: hal.can.interface {_short(can.interface)} (emulate: {can.emulate}): "
+            "the service simulates and opens no hardware; use interface virtual, emulate true"
+        )
 
 
 def resolve_scenario(spec: str | dict[str, Any], seed: int | None) -> tuple[ScenarioConfig, str]:
@@ -133,22 +188,14 @@ def resolve_scenario(spec: str | dict[str, Any], seed: int | None) -> tuple[Scen
             scenario = ScenarioConfig.model_validate_json(to_json(spec, source))
         except ValidationError as exc:
             raise ConfigFileError(describe_validation_error(source, exc)) from None
-        if scenario.scene is not None and _names_a_file(scenario.scene, (".xml",)):
-            raise ConfigFileError(
-                f"{source}: scene: {scenario.scene!r}: the service runs built-in scenes "
-                f"({', '.join(scene_names())}) and reads no files"
-            )
+        if scenario.scene is not None and scenario.scene not in scene_names():
+            raise _no_files(f"{source}: scene", scenario.scene, scene_names())
     elif spec in BUILTIN:
         scenario, source = BUILTIN[spec], f"scenario '{spec}'"
-    elif _names_a_file(spec, (".yaml", ".yml")):
+    else:  # never looked up on disk: the answer must not depend on what exists there
         raise ConfigFileError(
-            f"scenario: {spec!r}: the service runs built-in scenarios "
-            f"({', '.join(BUILTIN)}) or inline ones, and reads no files"
-        )
-    else:
-        raise ConfigFileError(
-            f"scenario: {spec!r} is not a built-in scenario ({', '.join(BUILTIN)}); "
-            "give one of those names or a scenario object"
+            f"scenario: {_short(spec)} is not a built-in scenario ({', '.join(BUILTIN)}); "
+            "give one of those names or a scenario object (the service reads no files)"
         )
     if seed is not None:
         data = scenario.model_dump()
@@ -259,10 +306,14 @@ class Runs:
             run.task.cancel()
         await run.done.wait()
 
-    async def shutdown(self) -> None:
+    def cancel_all(self) -> None:
+        """Cancel every run that has not ended (each then finishes its recording)."""
         for run in self.runs.values():
             if run.task is not None and not run.task.done():
                 run.task.cancel()
+
+    async def shutdown(self) -> None:
+        self.cancel_all()
         for run in self.runs.values():
             await run.done.wait()
 
@@ -326,10 +377,27 @@ class Service:
         self.live_record_keep = live_record_keep
         self.runs = Runs(out_root, max_runs)
         self.live: LiveStack | None = None
+        self.closing: asyncio.Event | None = None
+        """Set when the server stops: waits and pose streams end at once."""
+        self._loop: asyncio.AbstractEventLoop | None = None
+
+    def begin_shutdown(self) -> None:
+        """From a signal handler (any thread): cancel every run and end the waits and
+        pose streams now, not after uvicorn's grace period."""
+        loop = self._loop
+        if loop is not None and not loop.is_closed():
+            loop.call_soon_threadsafe(self._shut_down_now)
+
+    def _shut_down_now(self) -> None:
+        if self.closing is not None:
+            self.closing.set()
+        self.runs.cancel_all()
 
     @asynccontextmanager
     async def lifespan(self, _app: Starlette) -> AsyncIterator[None]:
         self.runs.limiter = anyio.CapacityLimiter(self.runs.max_runs)
+        self.closing = asyncio.Event()
+        self._loop = asyncio.get_running_loop()
         async with AsyncExitStack() as stack:
             if self.live_enabled:
                 # The live robot runs for as long as the service does: its recording
@@ -384,6 +452,7 @@ class Service:
         body: RunRequest = _parse(RunRequest, await _json_body(request), "request")
         scenario, source = resolve_scenario(body.scenario, body.seed)
         stack = apply_overrides(self.stack, body.set, source="set")
+        check_client_stack(stack, self.stack)
         # What the CLI would reject before running (scene, goal): a 400 now, not a
         # failed run later. Building the world takes milliseconds: off the loop.
         try:
@@ -400,7 +469,7 @@ class Service:
         run_id = request.path_params["run_id"]
         run = self.runs.runs.get(run_id)
         if run is None:
-            raise BadRequest(f"no run {run_id!r}", 404)
+            raise BadRequest(f"no run {_short(run_id)}", 404)
         return run
 
     async def get_run(self, request: Request) -> Response:
@@ -410,9 +479,14 @@ class Service:
             try:
                 seconds = float(wait)
             except ValueError:
-                raise BadRequest(f"wait={wait!r}: expected seconds, e.g. wait=10") from None
+                seconds = math.nan
+            if not math.isfinite(seconds):
+                raise BadRequest(
+                    f"wait={_short(wait)}: expected a number of seconds, e.g. wait=10 "
+                    f"(at most {MAX_WAIT_S:g} are waited)"
+                )
             with anyio.move_on_after(min(max(seconds, 0.0), MAX_WAIT_S)):
-                await run.done.wait()
+                await _either(run.done, self.closing)
         return _json(run.as_dict())
 
     def _artifact(self, request: Request, path: Path, what: str) -> Path:
@@ -457,9 +531,9 @@ class Service:
         except ValueError:
             hz = math.nan
         if not 0 < hz <= 100:
-            raise BadRequest(f"hz={raw!r}: expected a rate in (0, 100]")
+            raise BadRequest(f"hz={_short(raw)}: expected a rate in (0, 100]")
         return StreamingResponse(
-            _poses(live, 1.0 / hz),
+            _poses(live, 1.0 / hz, self.closing),
             media_type="text/event-stream",
             headers={"Cache-Control": "no-cache"},
         )
@@ -510,12 +584,30 @@ class Service:
         )
 
 
-async def _poses(live: LiveStack, period: float) -> AsyncIterator[str]:
+async def _either(first: asyncio.Event, second: asyncio.Event | None) -> None:
+    """Until either event is set."""
+    if second is None:
+        await first.wait()
+        return
+    waits = [asyncio.ensure_future(first.wait()), asyncio.ensure_future(second.wait())]
+    try:
+        await asyncio.wait(waits, return_when=asyncio.FIRST_COMPLETED)
+    finally:
+        for wait in waits:
+            wait.cancel()
+
+
+async def _poses(
+    live: LiveStack, period: float, closing: asyncio.Event | None = None
+) -> AsyncIterator[str]:
     """Odometry as SSE events, at most one per ``period`` s of sim time. Ends when the
-    client goes away (the stream is cancelled) or the live stack closes."""
+    client goes away (the stream is cancelled), the server stops (``closing``; poses
+    come at the odometry rate, so within 10 ms) or the live stack closes."""
     last = -math.inf
     async with live.subscribe(topics.ODOM, Odometry, POSE_QOS) as odom:
         async for message in odom:
+            if closing is not None and closing.is_set():
+                return
             t = message.header.stamp.to_seconds()
             if t - last < period - 1e-9:
                 continue
@@ -524,6 +616,48 @@ async def _poses(live: LiveStack, period: float) -> AsyncIterator[str]:
             data = {"t": t, "x": pose.position.x, "y": pose.position.y}
             data["yaw"] = pose.orientation.yaw()
             yield f"event: pose\ndata: {json.dumps(data)}\n\n"
+
+
+class _Server(uvicorn.Server):
+    """uvicorn, with the service's shutdown. The first SIGINT/SIGTERM starts it at once:
+    every run is cancelled (each finishes its recording), waits and pose streams end,
+    then the app's lifespan closes the live robot and its recording. uvicorn's own
+    second Ctrl-C would skip that lifespan shutdown (an unindexed live.mcap): here a
+    second signal is only acknowledged. The signal is not re-raised: :func:`main`
+    returns 130 or 143."""
+
+    def __init__(self, config: uvicorn.Config, service: Service) -> None:
+        super().__init__(config)
+        self.service = service
+        self.first_signal: int | None = None
+        self._noted = False
+
+    def handle_exit(self, sig: int, frame: FrameType | None) -> None:
+        if self.should_exit:
+            if not self._noted:
+                self._noted = True
+                print(
+                    "otonav service: still finishing the runs' and the live recordings",
+                    file=sys.stderr,
+                    flush=True,
+                )
+            return
+        self.first_signal = sig
+        self.should_exit = True
+        self.service.begin_shutdown()
+
+    @contextlib.contextmanager
+    def capture_signals(self) -> Iterator[None]:
+        if threading.current_thread() is not threading.main_thread():
+            yield
+            return
+        handled = (signal.SIGINT, signal.SIGTERM)
+        original = {sig: signal.signal(sig, self.handle_exit) for sig in handled}
+        try:
+            yield
+        finally:
+            for sig, handler in original.items():
+                signal.signal(sig, handler)
 
 
 def create_app(**options: Any) -> Starlette:
@@ -557,6 +691,11 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         stack = load_stack(args.config, args.overrides)
+        problem = check_scale(args.live_scale, "--live-scale")
+        if problem is not None:
+            raise ConfigFileError(problem)
+        if not 1 <= args.max_runs <= 64:
+            raise ConfigFileError(f"--max-runs {args.max_runs}: must be in [1, 64]")
         if not args.live_record_mb >= 0.1:
             raise ConfigFileError(f"--live-record-mb {args.live_record_mb:g}: must be >= 0.1")
         if args.live_record_keep < 0:
@@ -588,7 +727,14 @@ def main(argv: list[str] | None = None) -> int:
     config = uvicorn.Config(
         service.app(), log_level="warning", lifespan="on", timeout_graceful_shutdown=2
     )
-    uvicorn.Server(config).run(sockets=[sock])
+    server = _Server(config, service)
+    server.run(sockets=[sock])
+    if server.first_signal is not None:
+        print(
+            "otonav service: stopped; every run was cancelled and the recordings finished",
+            file=sys.stderr,
+        )
+        return 128 + server.first_signal
     return 0
 
 

@@ -34,6 +34,20 @@ def warn_cut_off(summary: RecordingSummary, doing: str) -> None:
     )
 
 
+def warn_damaged(summary: RecordingSummary, doing: str) -> bool:
+    """One line on stderr if chunks failed their CRC; True if there were any."""
+    if not summary.damaged:
+        return False
+    from otonav.record.verify import describe_damage
+
+    print(
+        f"otonav: warning: {describe_damage(summary.path, summary.damaged)}; {doing} the "
+        "intact chunks only; 'otonav salvage' copies them into a new file",
+        file=sys.stderr,
+    )
+    return True
+
+
 def _decoded(value: str) -> Any:
     try:
         return json.loads(value)
@@ -51,6 +65,7 @@ def as_json(summary: RecordingSummary) -> dict[str, Any]:
         "profile": summary.profile,
         "library": summary.library,
         "truncated": summary.truncated,
+        "damaged": [d.describe() for d in summary.damaged],
         "start_s": summary.start_ns / 1e9,
         "end_s": summary.end_ns / 1e9,
         "duration_s": summary.duration_s,
@@ -92,9 +107,11 @@ def info_main(args: argparse.Namespace) -> int:
     summary = summarize(args.file)
     if summary.truncated:
         warn_cut_off(summary, "showing")
+    # Exit 1 on damage: the facts shown are not the whole recording.
+    code = 1 if warn_damaged(summary, "rates and times are from") else 0
     if args.json:
         print(json.dumps(as_json(summary), indent=2))
-        return 0
+        return code
 
     from rich.console import Console
     from rich.table import Table
@@ -125,12 +142,22 @@ def info_main(args: argparse.Namespace) -> int:
         console.print(f"verdict:   {run['verdict']}", soft_wrap=True)
     elif run:
         console.print("verdict:   - (the run did not finish: no verdict was recorded)")
-    return 0
+    return code
 
 
 def salvage_main(args: argparse.Namespace) -> int:
     from otonav.record.salvage import salvage
+    from otonav.record.verify import Damage, describe_damage
 
-    count = salvage(args.source, args.target, overwrite=args.force)
+    damaged: list[Damage] = []
+    count = salvage(args.source, args.target, overwrite=args.force, damaged=damaged)
     print(f"salvaged {count} messages from {args.source} into {args.target}")
+    if damaged:  # exit 1: the copy is not all that was recorded
+        chunks = sum(1 for d in damaged if d.start_ns is not None)
+        print(
+            f"otonav: warning: skipped {chunks} damaged chunk{'s' if chunks != 1 else ''} "
+            f"(not copied): {describe_damage(args.source, damaged)}",
+            file=sys.stderr,
+        )
+        return 1
     return 0

@@ -74,13 +74,14 @@ def scenarios_main(_args: argparse.Namespace) -> int:
 
 
 def plot_main(args: argparse.Namespace) -> int:
-    from otonav.cli.info import warn_cut_off
+    from otonav.cli.info import warn_cut_off, warn_damaged
     from otonav.record.reader import summarize
     from otonav.scenario.replay import plot_recording
 
     summary = summarize(args.file)
     if summary.truncated:
         warn_cut_off(summary, "drawing")
+    damaged = warn_damaged(summary, "drawing")
     png = plot_recording(args.file, args.out)
     print(f"plot: {png}")
-    return 0
+    return 1 if damaged else 0  # the plot is not all that was recorded

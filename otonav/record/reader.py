@@ -3,7 +3,6 @@ topic in a time range, and the cut-off case (no footer: the process was killed).
 
 from __future__ import annotations
 
-import struct
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -12,23 +11,38 @@ from typing import Any
 from mcap.exceptions import McapError
 from mcap.reader import NonSeekingReader, make_reader
 from mcap.records import Channel, Message, Metadata, Schema
-from mcap.stream_reader import StreamReader
 from mcap_ros2.decoder import DecoderFactory
 
-MAGIC = b"\x89MCAP0\r\n"
+from otonav.record.verify import (
+    CUT_OFF_ERRORS,
+    MAGIC,
+    Damage,
+    _one_line,
+    describe_damage,
+    iter_verified,
+)
 
-#: What mcap's readers raise where a file was cut off (a record or its length field
-#: ends mid-way: struct.error; a chunk ends early: EndOfFile, an McapError; ...).
-CUT_OFF_ERRORS = (McapError, EOFError, ValueError, KeyError, AssertionError, struct.error)
+__all__ = [
+    "CUT_OFF_ERRORS",
+    "MAGIC",
+    "Damage",
+    "DamagedRecordingError",
+    "RecordingError",
+    "RecordingSummary",
+    "TopicSummary",
+    "iter_readable",
+    "read_messages",
+    "summarize",
+]
 
 
 class RecordingError(ValueError):
     """A file that is not a readable recording: one line naming it and why."""
 
 
-def _one_line(exc: BaseException) -> str:
-    text = " ".join(str(exc).split()) or type(exc).__name__
-    return text if len(text) <= 120 else text[:117] + "..."
+class DamagedRecordingError(RecordingError):
+    """A recording with a chunk that fails its CRC (or does not decode): reading it
+    would give damaged data as if it had been recorded."""
 
 
 @dataclass(slots=True)
@@ -59,6 +73,9 @@ class RecordingSummary:
     metadata: dict[str, dict[str, str]] = field(default_factory=dict)
     truncated: bool = False
     """True when the file has no footer/index (cut off); figures come from its complete chunks."""
+    damaged: tuple[Damage, ...] = ()
+    """Chunks that failed their CRC (or did not decode): their messages are counted by
+    the index but cannot be read."""
 
     @property
     def duration_s(self) -> float:
@@ -103,43 +120,52 @@ def summarize(path: str | Path) -> RecordingSummary:
                 for ch in summary.channels.values()
             ]
             by_topic = {t.topic: t for t in topics}
-            # First/last time per topic for the rate: from the chunk message indexes.
-            for _schema, channel, message in reader.iter_messages(log_time_order=False):
-                t = by_topic[channel.topic]
-                if t.first_ns is None or message.log_time < t.first_ns:
-                    t.first_ns = message.log_time
-                if t.last_ns is None or message.log_time > t.last_ns:
-                    t.last_ns = message.log_time
+            of_channel = {ch.id: by_topic[ch.topic] for ch in summary.channels.values()}
             metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
-            return RecordingSummary(
-                path,
-                size,
-                header.profile,
-                header.library,
-                stats.message_start_time,
-                stats.message_end_time,
-                sorted(topics, key=lambda t: t.topic),
-                metadata,
-            )
         except CUT_OFF_ERRORS:
-            pass
-    return _scan_truncated(path, size)
+            return _scan_truncated(path, size)
+    # First/last time per topic for the rate, reading every chunk and checking its CRC
+    # (the index alone would not notice a damaged chunk).
+    damage: list[Damage] = []
+    for record in iter_readable(path, damage):
+        if isinstance(record, Message) and record.channel_id in of_channel:
+            t = of_channel[record.channel_id]
+            if t.first_ns is None or record.log_time < t.first_ns:
+                t.first_ns = record.log_time
+            if t.last_ns is None or record.log_time > t.last_ns:
+                t.last_ns = record.log_time
+    return RecordingSummary(
+        path,
+        size,
+        header.profile,
+        header.library,
+        stats.message_start_time,
+        stats.message_end_time,
+        sorted(topics, key=lambda t: t.topic),
+        metadata,
+        damaged=tuple(damage),
+    )
 
 
-def iter_readable(path: Path) -> Iterator[Schema | Channel | Message | Metadata]:
+def iter_readable(
+    path: Path, damage: list[Damage] | None = None
+) -> Iterator[Schema | Channel | Message | Metadata]:
     """The schema, channel, message and metadata records of ``path`` in file order, up to
     where it was cut off (a cut-off file ends mid-record: the rest is not readable).
-    Works on a complete file too (it is read front to back, index ignored)."""
-    with path.open("rb") as f:
-        try:
-            for record in StreamReader(f).records:
-                if isinstance(record, Schema | Channel | Message | Metadata):
-                    yield record
-        except CUT_OFF_ERRORS:
-            return  # the cut: everything before it has been yielded
+    Works on a complete file too (it is read front to back, index ignored). Every chunk
+    is checked against its CRC: with a ``damage`` list a damaged chunk is skipped and
+    appended to it; without one it raises :class:`DamagedRecordingError`."""
+    found: list[Damage] = [] if damage is None else damage
+    for record in iter_verified(path, found):
+        if damage is None and found:
+            raise DamagedRecordingError(describe_damage(path, found))
+        yield record
+    if damage is None and found:
+        raise DamagedRecordingError(describe_damage(path, found))
 
 
 def _scan_truncated(path: Path, size: int) -> RecordingSummary:
+    damage: list[Damage] = []
     topics: dict[str, TopicSummary] = {}
     profile = library = ""
     start = end = 0
@@ -156,7 +182,7 @@ def _scan_truncated(path: Path, size: int) -> RecordingSummary:
     schemas: dict[int, str] = {}
     channels: dict[int, TopicSummary] = {}
     metadata: dict[str, dict[str, str]] = {}
-    for record in iter_readable(path):
+    for record in iter_readable(path, damage):
         if isinstance(record, Schema):
             schemas[record.id] = record.name
         elif isinstance(record, Channel):
@@ -187,6 +213,7 @@ def _scan_truncated(path: Path, size: int) -> RecordingSummary:
         sorted(topics.values(), key=lambda t: t.topic),
         metadata,
         truncated=True,
+        damaged=tuple(damage),
     )
 
 
@@ -196,14 +223,22 @@ def read_messages(
     *,
     start: float | None = None,
     end: float | None = None,
+    damage: list[Damage] | None = None,
 ) -> Iterator[tuple[str, float, Any]]:
     """Yield ``(topic, sim_time_s, decoded_message)`` in log-time order, for ``topics``
     (all when None) with ``start <= t < end`` (seconds of sim time). A cut-off file
-    yields the messages of its complete chunks, in file order."""
+    yields the messages of its complete chunks, in file order.
+
+    Every chunk read is checked against its CRC: a damaged one raises
+    :class:`DamagedRecordingError`, or, given a ``damage`` list, is skipped and appended
+    to it (the file is then read front to back, in file order)."""
     path = Path(path)
     _check_file(path)
+    if damage is not None:
+        yield from _read_cut_off(path, topics, start, end, damage)
+        return
     with path.open("rb") as f:
-        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        reader = make_reader(f, validate_crcs=True, decoder_factories=[DecoderFactory()])
         try:
             indexed = reader.get_summary() is not None
         except CUT_OFF_ERRORS:
@@ -211,16 +246,32 @@ def read_messages(
         if not indexed:
             yield from _read_cut_off(path, topics, start, end)
             return
-        for _schema, channel, message, decoded in reader.iter_decoded_messages(
+        messages = reader.iter_decoded_messages(
             topics=list(topics) if topics is not None else None,
             starting_at=None if start is None else round(start * 1e9),
             ending_before=None if end is None else round(end * 1e9),
-        ):
+        )
+        while True:
+            try:
+                _schema, channel, message, decoded = next(messages)
+            except StopIteration:
+                return
+            except Exception:  # a chunk that does not verify or decode: say which
+                found: list[Damage] = []
+                for _record in iter_verified(path, found):
+                    pass
+                if found:
+                    raise DamagedRecordingError(describe_damage(path, found)) from None
+                raise
             yield channel.topic, message.log_time / 1e9, decoded
 
 
 def _read_cut_off(
-    path: Path, topics: Sequence[str] | None, start: float | None, end: float | None
+    path: Path,
+    topics: Sequence[str] | None,
+    start: float | None,
+    end: float | None,
+    damage: list[Damage] | None = None,
 ) -> Iterator[tuple[str, float, Any]]:
     factory = DecoderFactory()
     schemas: dict[int, Schema] = {}
@@ -228,7 +279,7 @@ def _read_cut_off(
     wanted = None if topics is None else set(topics)
     first = None if start is None else round(start * 1e9)
     last = None if end is None else round(end * 1e9)
-    for record in iter_readable(path):
+    for record in iter_readable(path, damage):
         if isinstance(record, Schema):
             schemas[record.id] = record
         elif isinstance(record, Channel):

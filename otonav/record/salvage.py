@@ -2,7 +2,10 @@
 ``mcap recover`` does): every message of every complete chunk, same schemas and
 channels, and every metadata record that was written before the cut (``otonav``'s
 world and run records are written when the recording starts; the verdict's record at
-the end is lost with the end of the file)."""
+the end is lost with the end of the file).
+
+Only chunks that match their CRC are copied: a damaged chunk is skipped and reported,
+never rewritten under a fresh CRC (that would make damaged data look recorded)."""
 
 from __future__ import annotations
 
@@ -12,13 +15,28 @@ from mcap.reader import NonSeekingReader
 from mcap.records import Channel, Metadata, Schema
 from mcap.writer import CompressionType, Writer
 
-from otonav.record.reader import CUT_OFF_ERRORS, RecordingError, _check_file, iter_readable
+from otonav.record.reader import (
+    CUT_OFF_ERRORS,
+    DamagedRecordingError,
+    RecordingError,
+    _check_file,
+    iter_readable,
+)
+from otonav.record.verify import Damage, describe_damage
 from otonav.record.writer import CHUNK_SIZE
 
 
-def salvage(source: str | Path, target: str | Path, *, overwrite: bool = False) -> int:
+def salvage(
+    source: str | Path,
+    target: str | Path,
+    *,
+    overwrite: bool = False,
+    damaged: list[Damage] | None = None,
+) -> int:
     """Copy what can be read of ``source`` into ``target``; returns the message count.
-    An existing ``target`` is a :class:`RecordingError` unless ``overwrite``."""
+    An existing ``target`` is a :class:`RecordingError` unless ``overwrite``. Damaged
+    chunks are not copied: they are appended to ``damaged``, or, without that list,
+    reported by a :class:`DamagedRecordingError` once ``target`` is written."""
     source, target = Path(source), Path(target)
     _check_file(source)
     if source.resolve() == target.resolve():
@@ -33,6 +51,7 @@ def salvage(source: str | Path, target: str | Path, *, overwrite: bool = False) 
         except CUT_OFF_ERRORS as exc:
             raise RecordingError(f"{source}: no readable MCAP header ({exc})") from None
     count = 0
+    damage: list[Damage] = [] if damaged is None else damaged
     with target.open("wb") as out:
         writer = Writer(out, chunk_size=CHUNK_SIZE, compression=CompressionType.ZSTD)
         writer.start(profile=header.profile, library=header.library)
@@ -40,7 +59,7 @@ def salvage(source: str | Path, target: str | Path, *, overwrite: bool = False) 
         channels: dict[int, Channel] = {}
         schema_ids: dict[int, int] = {}
         channel_ids: dict[int, int] = {}
-        for record in iter_readable(source):
+        for record in iter_readable(source, damage):
             if isinstance(record, Schema):
                 schemas[record.id] = record
             elif isinstance(record, Channel):
@@ -70,4 +89,9 @@ def salvage(source: str | Path, target: str | Path, *, overwrite: bool = False) 
                 )
                 count += 1
         writer.finish()  # type: ignore[no-untyped-call]
+    if damaged is None and damage:
+        raise DamagedRecordingError(
+            f"{describe_damage(source, damage)}; {target} holds the {count} messages of "
+            "the intact chunks"
+        )
     return count

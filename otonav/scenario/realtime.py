@@ -131,9 +131,11 @@ def run_scenario_realtime(
     viewer: ViewerHandle | None = None
     if gui:
         try:
-            if not isinstance(hal, MujocoInterface):
+            # Over CAN the world is the interface's sensor source: view that.
+            world = hal if isinstance(hal, MujocoInterface) else getattr(hal, "sensors", None)
+            if not isinstance(world, MujocoInterface):
                 raise TypeError(f"gui=True needs the MuJoCo world, got {type(hal).__name__}")
-            viewer = hal.open_viewer()
+            viewer = world.open_viewer()
         except BaseException:
             session.close()
             raise

@@ -12,6 +12,7 @@ from otonav.actors import topics
 from otonav.hal import BoxObstacle
 from otonav.hal.mujoco import SceneError
 from otonav.record.reader import read_messages, summarize
+from otonav.record.verify import Damage
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.plot import plot_trajectory
 from otonav.scenario.run import effective_stack
@@ -19,11 +20,13 @@ from otonav.stack import StackConfig, build_world
 from otonav.stack.worldmeta import WORLD_METADATA, boxes_from_metadata
 
 
-def recorded_path(recording: Path) -> list[tuple[float, float, float]]:
-    """(sim time, x, y) of every /odom message."""
+def recorded_path(
+    recording: Path, damage: list[Damage] | None = None
+) -> list[tuple[float, float, float]]:
+    """(sim time, x, y) of every /odom message (``damage``: see ``read_messages``)."""
     return [
         (t, m.pose.pose.position.x, m.pose.pose.position.y)
-        for _topic, t, m in read_messages(recording, [topics.ODOM])
+        for _topic, t, m in read_messages(recording, [topics.ODOM], damage=damage)
     ]
 
 
@@ -33,10 +36,12 @@ def recorded_verdict(recording: Path) -> dict[str, Any] | None:
     return json.loads(meta["verdict"]) if "verdict" in meta else None
 
 
-def recorded_goal(recording: Path) -> tuple[float, float] | None:
+def recorded_goal(
+    recording: Path, damage: list[Damage] | None = None
+) -> tuple[float, float] | None:
     """The last goal published on /goal, (x, y) in the world frame; None if none was."""
     goal = None
-    for _topic, _t, m in read_messages(recording, [topics.GOAL]):
+    for _topic, _t, m in read_messages(recording, [topics.GOAL], damage=damage):
         goal = (m.pose.position.x, m.pose.position.y)
     return goal
 
@@ -52,6 +57,8 @@ class RecordedPlot:
     tolerance: float | None
     title: str
     truncated: bool
+    damaged: tuple[Damage, ...] = ()
+    """Chunks that failed their CRC: not drawn."""
 
 
 def recorded_plot(recording: Path) -> RecordedPlot:
@@ -65,7 +72,9 @@ def recorded_plot(recording: Path) -> RecordedPlot:
         if "scenario_config" in meta
         else None
     )
-    goal = recorded_goal(recording)
+    # Damaged chunks (summary.damaged) are skipped, not drawn: the caller warns.
+    damage: list[Damage] | None = [] if summary.damaged else None
+    goal = recorded_goal(recording, damage)
     if goal is None and scenario is not None:
         goal = (scenario.goal.x, scenario.goal.y)
     obstacles: tuple[BoxObstacle, ...] | None = None
@@ -76,13 +85,16 @@ def recorded_plot(recording: Path) -> RecordedPlot:
     title = f"{recording.name} (odometry)"
     if summary.truncated:
         title += ", cut off: complete chunks only"
+    if summary.damaged:
+        title += f", {len(summary.damaged)} damaged chunk(s) not drawn"
     return RecordedPlot(
-        recorded_path(recording),
+        recorded_path(recording, damage),
         obstacles,
         goal,
         scenario.goal_tolerance if scenario is not None else None,
         title,
         summary.truncated,
+        summary.damaged,
     )
 
 

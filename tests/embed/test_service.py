@@ -92,8 +92,8 @@ def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
             if process.stdout is not None:
                 process.stdout.close()
     log = (out / "stderr.log").read_text()
-    # After its graceful shutdown uvicorn re-raises the signal it caught: -SIGTERM.
-    assert code in (0, -signal.SIGTERM), log
+    # After its graceful shutdown the service exits 128 + the signal it caught.
+    assert code == 128 + signal.SIGTERM, log
     assert "Traceback" not in log, log
     live = summarize(out / "live.mcap")
     assert live.truncated is False
@@ -373,3 +373,56 @@ def test_same_verdict_and_recording_from_cli_pytest_embedding_and_service(
     data = recordings["direct"].read_bytes()
     for name, path in recordings.items():
         assert path.read_bytes() == data, f"{name}: {path} differs from {recordings['direct']}"
+
+
+def test_adversarial_requests_get_4xx_and_reveal_no_files(
+    client: httpx.Client, tmp_path: Path
+) -> None:
+    # Issue 17, item 4. A scene path in an override made the server read a file the
+    # client named, and its errors told whether the path existed; these were 500s.
+    real = tmp_path / "real.xml"
+    real.write_text("<mujoco/>")
+    missing = tmp_path / "missing.xml"
+
+    def error(body: dict[str, Any]) -> str:
+        response = client.post("/runs", json=body)
+        assert response.status_code == 400, (body, response.text)
+        message: str = response.json()["error"]
+        assert "\n" not in message
+        return message
+
+    said_real = error({"set": [f"world.scene={real}"]})
+    said_missing = error({"set": [f"world.scene={missing}"]})
+    assert "reads no files" in said_real
+    assert said_real.replace(str(real), "P") == said_missing.replace(str(missing), "P")
+    for name in (str(real), "real.xml", "etc", "nothing-here"):  # no oracle in the cwd either
+        assert "reads no files" in error({"scenario": name}), name
+    said = [error({"scenario": {"scene": s}}) for s in (str(real), str(missing))]
+    assert said[0].replace(str(real), "P") == said[1].replace(str(missing), "P")
+    hardware = error({"set": ["hal.kind=can", "hal.can.interface=socketcan"]})
+    assert "hal.can.interface" in hardware
+
+    cases: list[tuple[str, str, dict[str, Any], int]] = [
+        ("POST", "/runs", {"content": b'{"scenario": "\xff\xfe"}'}, 400),  # not UTF-8
+        ("POST", "/runs", {"content": b"[" * 100_000 + b"]" * 100_000}, 400),  # deep JSON
+        ("POST", "/runs", {"json": {"scenario": "s" * 100_000}}, 400),  # a long name
+        ("POST", "/runs", {"json": {"scenario": {"name": "n" * 100_000}}}, 400),
+        ("POST", "/runs", {"json": {"set": ["world.scene=" + "x" * 100_000]}}, 400),
+        ("POST", "/runs", {"content": b'{"scenario": "' + b"s" * (2 << 20) + b'"}'}, 413),
+        ("GET", "/runs/x", {"params": {"wait": "nan"}}, 404),
+        ("GET", "/live/pose", {"params": {"hz": "nan"}}, 400),
+        ("POST", "/live/goal", {"json": {"x": 1e308, "y": 0}}, 400),
+    ]
+    for method, path, kwargs, status in cases:
+        response = client.request(method, path, **kwargs)
+        assert response.status_code == status, (path, response.status_code, response.text[:200])
+        message = response.json()["error"]
+        assert "\n" not in message
+        assert len(message) < 500, message[:600]
+    run_id = _start(client, {"scenario": "acceptance"})
+    for wait in ("nan", "inf", "-inf", "1e999", "soon"):
+        response = client.get(f"/runs/{run_id}", params={"wait": wait})
+        assert response.status_code == 400, (wait, response.text)
+        assert "wait=" in response.json()["error"]
+    client.delete(f"/runs/{run_id}")
+    assert client.get("/health").json()["status"] == "ok"

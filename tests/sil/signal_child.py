@@ -4,7 +4,7 @@
 
 Runs ``otonav run`` (the CLI, in this process) on a scenario that does not end soon
 (kp_lin = 0) and signals itself, so the timing is deterministic: FIRST (INT or TERM)
-once 2 s of sim time have passed, then the same signal again at SECOND_AT:
+once 0.5 s of sim time have passed, then the same signal again at SECOND_AT:
 
 - ``none``: no second signal;
 - ``cancel``: right after the first, while the run is being cancelled;
@@ -22,7 +22,7 @@ import signal
 import sys
 from typing import Any
 
-FIRST_AT = 2.0
+FIRST_AT = 0.5
 
 
 class _InterruptImport(importlib.abc.MetaPathFinder):

@@ -395,3 +395,30 @@ async def test_a_wrong_node_id_at_startup_times_out_naming_it() -> None:
         estop=True,
         drive_first=False,
     )
+
+
+# -- the command line ---------------------------------------------------------------------
+
+
+def test_cli_runs_the_acceptance_scenario_over_can(tmp_path: Path) -> None:
+    from otonav.cli import main
+
+    assert main(["run", "--set", "hal.kind=can", "--out", str(tmp_path), "--no-record"]) == 0
+    assert '"passed": true' in (tmp_path / "summary.json").read_text()
+
+
+def test_cli_without_python_can_names_the_extra(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import sys
+
+    from otonav.cli import main
+
+    for name in [m for m in sys.modules if m == "can" or m.startswith(("can.", "otonav.hal.can"))]:
+        monkeypatch.delitem(sys.modules, name)
+    monkeypatch.setitem(sys.modules, "can", None)  # import can -> ImportError
+    assert main(["run", "--set", "hal.kind=can", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.strip().splitlines() == [
+        "otonav: error: hal.kind: can needs python-can (can is missing): pip install 'otonav[can]'"
+    ]

@@ -26,13 +26,10 @@ def _run(*args: str) -> subprocess.CompletedProcess[str]:
 @pytest.mark.timeout(120)
 @pytest.mark.parametrize(
     ("first", "second", "code"),
-    [
-        ("INT", "none", 130),
-        ("INT", "cancel", 130),
-        ("INT", "plot", 130),
-        ("TERM", "cancel", 143),
-        ("TERM", "plot", 143),
-    ],
+    # A single signal to the CLI is covered by test_cli_stale_artifacts.py; these are the
+    # cases that failed: a second Ctrl-C inside the loop (a traceback), a second Ctrl-C or
+    # SIGTERM while plotting (no plot; SIGTERM killed the process).
+    [("INT", "cancel", 130), ("INT", "plot", 130), ("TERM", "plot", 143)],
 )
 def test_a_second_signal_during_shutdown_still_exits_cleanly(
     tmp_path: Path, first: str, second: str, code: int
@@ -44,7 +41,7 @@ def test_a_second_signal_during_shutdown_still_exits_cleanly(
     recording = tmp_path / "recording.mcap"
     assert not summarize(recording).truncated, "the recording must be finished and indexed"
     clocks = [t for _topic, t, _m in read_messages(recording, ["/clock"])]
-    assert clocks[-1] >= 2.0
+    assert clocks[-1] >= 0.5
     assert (tmp_path / "trajectory.png").stat().st_size > 0, "the plot must be drawn"
     assert not (tmp_path / "summary.json").exists(), "an interrupted run has no summary"
 

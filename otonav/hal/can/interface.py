@@ -161,13 +161,20 @@ class CanBusInterface(RobotHardwareInterface):
             sensors.advance(nxt - now)
 
     def _service(self, now: int) -> None:
-        """One bus instant: the peer exchanges, we drain and decode, the monitor checks."""
+        """One bus instant: the peer exchanges, we drain and decode, the monitor checks.
+
+        At an instant already serviced (we only sent commands since), a simulated peer
+        just takes them in: it sends nothing more at that tick, and no time passed for
+        the monitor (saves a poll and a check every base period)."""
         t = now * self._tick
+        repeat = now == self._serviced_at
         self._serviced_at = now
         self._sent = False
+        monitor = self.monitor
         if self._peer is not None:
             self._peer.exchange(now)
-        monitor = self.monitor
+            if repeat:
+                return
         try:
             frames = self._endpoint.poll()
         except BusError as exc:
