@@ -90,6 +90,7 @@ def _fmt(value: float | None, spec: str) -> str:
 def table(rows: list[FamilyRow]) -> str:
     head = (
         "| density | worlds | reachable | success (% of reachable) | BARN metric "
+        "| time / optimal (median) "
         "| timeouts | false unreachable | clearance violations (all runs) "
         "| walled-in reported unreachable | walled-in timeouts |"
     )
@@ -98,7 +99,8 @@ def table(rows: list[FamilyRow]) -> str:
         lines.append(
             f"| {r.family} | {r.worlds} | {r.reachable} "
             f"| {r.successes} ({_fmt(r.success_pct, '.1f')} %) "
-            f"| {_fmt(r.barn_metric, '.3f')} | {r.timeouts} | {r.gave_up} "
+            f"| {_fmt(r.barn_metric, '.3f')} | {_fmt(r.time_ratio_median, '.2f')} "
+            f"| {r.timeouts} | {r.gave_up} "
             f"| {r.clearance_violations} of {r.runs} "
             f"| {r.walled_reported} of {r.walled} ({_fmt(r.walled_reported_pct, '.1f')} %) "
             f"| {r.walled_timeouts} |"

@@ -1,7 +1,16 @@
 """The actors: thin adapters that subscribe, call a pure function, and publish."""
 
+from otonav.actors.avoiding_navigator import AvoidingNavigator
 from otonav.actors.base_controller import BaseController, BaseLimits
 from otonav.actors.bridge import Bridge
 from otonav.actors.navigator import Navigator
+from otonav.actors.safety_layer import SafetyLayer
 
-__all__ = ("BaseController", "BaseLimits", "Bridge", "Navigator")
+__all__ = (
+    "AvoidingNavigator",
+    "BaseController",
+    "BaseLimits",
+    "Bridge",
+    "Navigator",
+    "SafetyLayer",
+)

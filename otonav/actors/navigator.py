@@ -51,8 +51,9 @@ class Navigator(Actor):
         goal: tuple[float, float] | None = None,
         scan_timeout: float = 0.5,
         name: str = "nav",
+        remap: dict[str, str] | None = None,
     ) -> None:
-        super().__init__(name)
+        super().__init__(name, remap=remap)
         if not rate_hz > 0:
             raise ValueError(f"nav.rate_hz must be > 0 Hz, got {rate_hz}")
         self.params = params

@@ -31,6 +31,8 @@ class Case:
     beams: int = 360
     scan_subscribers: int = 0
     """Extra actors subscribed to /scan (scaling with fan-out)."""
+    overrides: tuple[str, ...] = ()
+    """Stack config ``key.path=value`` overrides (e.g. ``nav.planner=stop``)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -152,6 +154,10 @@ def run_case(case: Case) -> Sample:
         return _scenario()
     scenario = ScenarioConfig()
     stack = StackConfig(world=WorldConfig(lidar_beams=case.beams))  # the obstacle scene
+    if case.overrides:
+        from otonav.stack.overrides import apply_overrides
+
+        stack = apply_overrides(stack, case.overrides, source="bench case")
     goal = (scenario.goal.x, scenario.goal.y)
     if case.kind == "bare":
         hal = build_world(stack)

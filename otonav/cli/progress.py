@@ -1,5 +1,6 @@
 """The live progress line of ``otonav run`` on a terminal: sim time, real-time factor,
-distance to goal, nav state. A callback of the judge: it only prints, so a run's
+distance to goal, nav state and
+the planner's reason. A callback of the judge: it only prints, so a run's
 recording is the same bytes with or without it."""
 
 from __future__ import annotations
@@ -31,12 +32,13 @@ class ProgressLine:
         rtf = sim / elapsed if elapsed > 0 else 0.0
         self.stream.write(
             f"\r  sim {sim:6.2f} s | {rtf:5.0f}x real time | "
-            f"{judge.distance:5.2f} m to goal | {judge.nav_state:<8}"
+            f"{judge.distance:5.2f} m to goal | {judge.nav_state:<11} "
+            f"{judge.nav_reason[:28]:<28}"
         )
         self.stream.flush()
         self.drawn = True
 
     def clear(self) -> None:
         if self.drawn:
-            self.stream.write("\r" + " " * 72 + "\r")
+            self.stream.write("\r" + " " * 110 + "\r")
             self.stream.flush()

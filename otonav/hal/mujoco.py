@@ -426,7 +426,41 @@ class MujocoInterface(RobotHardwareInterface):
             laser_offset_z=float(lidar[2]),
             base_height=float(m.qpos0[self._base_qpos + 2]),
             imu_offset=(float(imu[0]), float(imu[1]), float(imu[2])),
+            footprint=self._read_footprint(),
         )
+
+    def _read_footprint(self) -> tuple[tuple[float, float], ...]:
+        """The rectangle in base_link (CCW corners, m) that bounds every collision geom
+        of the robot projected on the floor, at the model's rest pose (qpos0)."""
+        m = self._model
+        d = mujoco.MjData(m)
+        mujoco.mj_kinematics(m, d)
+        root = int(m.body_rootid[self._chassis])
+        origin = d.xpos[self._chassis].copy()
+        to_base = d.xmat[self._chassis].reshape(3, 3).T
+        signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+        xy: list[NDArray[np.float64]] = []
+        for g in range(m.ngeom):
+            collides = int(m.geom_contype[g]) != 0 or int(m.geom_conaffinity[g]) != 0
+            if int(m.body_rootid[m.geom_bodyid[g]]) != root or not collides:
+                continue
+            size = m.geom_size[g]
+            kind = int(m.geom_type[g])
+            if kind in (mujoco.mjtGeom.mjGEOM_SPHERE,):
+                half = np.array([size[0], size[0], size[0]])
+            elif kind in (mujoco.mjtGeom.mjGEOM_CYLINDER, mujoco.mjtGeom.mjGEOM_CAPSULE):
+                extra = size[0] if kind == mujoco.mjtGeom.mjGEOM_CAPSULE else 0.0
+                half = np.array([size[0], size[0], size[1] + extra])
+            else:  # box, ellipsoid: half sizes along the geom's axes
+                half = np.array(size[:3], dtype=np.float64)
+            corners = (signs * half) @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g]
+            xy.append(((corners - origin) @ to_base.T)[:, :2])
+        if not xy:
+            raise SceneError(f"MJCF file {self._label}: the robot has no collision geom")
+        points = np.concatenate(xy)
+        x0, y0 = (float(v) for v in points.min(axis=0))
+        x1, y1 = (float(v) for v in points.max(axis=0))
+        return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
 
     def _static_boxes(self, prefix: str) -> tuple[BoxObstacle, ...]:
         m = self._model

@@ -128,6 +128,23 @@ class RobotGeometry:
     base_height: float = 0.0
     imu_offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
     """Position of the IMU (frame ``imu_link``, axes as base_link) in base_link, m."""
+    footprint: tuple[tuple[float, float], ...] = (
+        (-0.09, -0.1225),
+        (0.21, -0.1225),
+        (0.21, 0.1225),
+        (-0.09, 0.1225),
+    )
+    """The robot's outline on the floor: a convex polygon (x, y) in base_link, m,
+    counter-clockwise. The MuJoCo HAL reads it from the MJCF (the rectangle that bounds
+    every collision geom of the robot, projected on the floor); the default is that
+    rectangle for ``otonav/hal/assets/robot.xml`` (chassis box 0.30 x 0.18 m centred
+    0.06 m ahead of the axle, wheels reaching y = +-0.1225 m)."""
+
+    @property
+    def footprint_radius(self) -> float:
+        """Radius of the smallest circle about base_link (the judged point, the wheel
+        axle's midpoint) that holds the footprint, m: what a spin in place sweeps."""
+        return max((math.hypot(x, y) for x, y in self.footprint), default=0.0)
 
 
 @dataclass(frozen=True, slots=True)

@@ -20,7 +20,13 @@ from otonav.msgs.hardware import (
     HardwareStatus,
     KeyValue,
 )
-from otonav.msgs.otonav_msgs import NavState, ScenarioVerdict, WheelCommand
+from otonav.msgs.otonav_msgs import (
+    NavDiagnostics,
+    NavState,
+    SafetyState,
+    ScenarioVerdict,
+    WheelCommand,
+)
 from otonav.msgs.sensors import Imu, LaserScan, Odometry, TFMessage
 from otonav.msgs.std import Clock, Header, Log, Time
 
@@ -36,6 +42,7 @@ __all__ = (
     "LaserScan",
     "Log",
     "Message",
+    "NavDiagnostics",
     "NavState",
     "Odometry",
     "Point",
@@ -43,6 +50,7 @@ __all__ = (
     "PoseStamped",
     "PoseWithCovariance",
     "Quaternion",
+    "SafetyState",
     "ScenarioVerdict",
     "TFMessage",
     "Time",

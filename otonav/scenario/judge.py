@@ -7,7 +7,7 @@ from collections.abc import Callable
 
 from otonav.actors import topics
 from otonav.hal import BoxObstacle, RobotHardwareInterface
-from otonav.msgs import NavState
+from otonav.msgs import NavDiagnostics, NavState
 from otonav.runtime import Actor, Input, QoS, Reliability
 
 #: s of sim time the judge keeps watching after the robot first enters the tolerance.
@@ -34,6 +34,10 @@ class Judge(Actor):
 
     # depth 16: /nav/state comes at 20 Hz and the judge drains it at rate_hz (100 Hz).
     nav_state_in = Input(topics.NAV_STATE, NavState, QoS(Reliability.BEST_EFFORT, depth=16))
+    # The planner's reason (why it gave up, what it avoids): the latest is enough.
+    nav_diag_in = Input(
+        topics.NAV_DIAGNOSTICS, NavDiagnostics, QoS(Reliability.BEST_EFFORT, depth=1)
+    )
 
     def __init__(
         self,
@@ -58,6 +62,8 @@ class Judge(Actor):
         """m/s, the true speed at the latest sample."""
         self.progress = progress
         self.nav_state = "starting"
+        self.nav_reason = ""
+        """The navigator's latest reason (/nav/diagnostics; empty for the stop planner)."""
         self.hal = hal
         self.goal = goal
         self.tolerance = tolerance
@@ -116,6 +122,9 @@ class Judge(Actor):
             self.nav_state = state.state
             if self.unreachable_at is None and state.state == "unreachable":
                 self.unreachable_at = now
+        diag = self.nav_diag_in.take_latest()
+        if diag is not None:
+            self.nav_reason = diag.reason
 
     def sample(self, now: float) -> None:
         truth = self.hal.ground_truth()

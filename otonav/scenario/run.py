@@ -62,6 +62,10 @@ class Verdict:
     """The scenario's expected outcome: ``reached`` or ``unreachable``."""
     unreachable_at_s: float | None = None
     """s of sim time when the navigator reported the goal unreachable; None if never."""
+    nav_state: str = ""
+    """The navigator's last /nav/state (e.g. reached, unreachable)."""
+    nav_reason: str = ""
+    """The navigator's last reason (/nav/diagnostics), e.g. why it gave up."""
 
     def as_dict(self) -> dict[str, object]:
         return asdict(self)
@@ -337,6 +341,8 @@ def _append_verdict(
             final_distance=verdict.final_distance_m,
             path_length=verdict.path_length_m,
             sim_time=verdict.sim_time_s,
+            nav_state=verdict.nav_state,
+            nav_reason=verdict.nav_reason,
         ),
         verdict.sim_time_s,
     )
@@ -380,6 +386,7 @@ def judge_verdict(scenario: ScenarioConfig, judge: Judge, sim_time: float, wall:
         elif not judge.reached:
             why = (
                 f"the navigator reported the goal unreachable at {judge.unreachable_at:.1f} s"
+                + (f" ({judge.nav_reason})" if judge.nav_reason else "")
                 if judge.unreachable_at is not None
                 else f"did not reach the goal within {scenario.sim_budget:g} s"
             )
@@ -421,4 +428,6 @@ def judge_verdict(scenario: ScenarioConfig, judge: Judge, sim_time: float, wall:
         rtf=sim_time / wall if wall > 0 else math.inf,
         expect=scenario.expect,
         unreachable_at_s=judge.unreachable_at,
+        nav_state=judge.nav_state,
+        nav_reason=judge.nav_reason,
     )

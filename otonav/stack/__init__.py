@@ -12,9 +12,11 @@ from typing import TYPE_CHECKING
 
 from otonav.stack.config import (
     BaseConfig,
+    DwaConfig,
     GuardConfig,
     NavConfig,
     RatesConfig,
+    SafetyConfig,
     StackConfig,
     WorldConfig,
 )
@@ -25,10 +27,12 @@ if TYPE_CHECKING:
 
 __all__ = (
     "BaseConfig",
+    "DwaConfig",
     "GuardConfig",
     "NavConfig",
     "RatesConfig",
     "RealTime",
+    "SafetyConfig",
     "StackConfig",
     "StackSession",
     "WorldConfig",

@@ -6,11 +6,23 @@ import itertools
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from otonav.actors import BaseController, BaseLimits, Bridge, Navigator
+from otonav.actors import (
+    AvoidingNavigator,
+    BaseController,
+    BaseLimits,
+    Bridge,
+    Navigator,
+    SafetyLayer,
+    topics,
+)
 from otonav.control import DiffDriveGeometry
-from otonav.hal import BoxObstacle, RobotHardwareInterface
+from otonav.hal import BoxObstacle, RobotGeometry, RobotHardwareInterface
 from otonav.hal.mujoco import MujocoInterface, Variant
 from otonav.nav import GoToGoalParams, GuardParams
+from otonav.nav.dwa import DwaParams
+from otonav.nav.footprint import centre_clearance
+from otonav.nav.navigation import NavigationParams
+from otonav.nav.safety import SafetyParams
 from otonav.runtime import Actor
 from otonav.stack.config import StackConfig
 from otonav.stack.files import ConfigFileError
@@ -154,19 +166,106 @@ def build_actors(
         if isinstance(hal, CanBusInterface):
             actors.append(CanFrameTap(hal))
     if navigator:
-        actors.append(
-            Navigator(
-                GoToGoalParams(
-                    kp_lin=nav.kp_lin,
-                    kp_ang=nav.kp_ang,
-                    max_v=nav.max_v,
-                    max_omega=nav.max_omega,
-                    tolerance=nav.tolerance,
-                    turn_in_place_threshold=nav.turn_in_place_threshold,
-                ),
-                GuardParams(guard.sector_half_angle, guard.stop_distance),
-                rate_hz=nav.rate_hz,
-                goal=goal,
+        remap = {topics.CMD_VEL: topics.CMD_VEL_NAV} if config.safety.enabled else None
+        if nav.planner == "stop":
+            actors.append(
+                Navigator(
+                    GoToGoalParams(
+                        kp_lin=nav.kp_lin,
+                        kp_ang=nav.kp_ang,
+                        max_v=nav.max_v,
+                        max_omega=nav.max_omega,
+                        tolerance=nav.tolerance,
+                        turn_in_place_threshold=nav.turn_in_place_threshold,
+                    ),
+                    GuardParams(guard.sector_half_angle, guard.stop_distance),
+                    rate_hz=nav.rate_hz,
+                    goal=goal,
+                    remap=remap,
+                )
             )
-        )
+        elif nav.planner == "dwa":
+            actors.append(
+                AvoidingNavigator(
+                    navigation_params(config, geometry),
+                    laser_offset_x=geometry.laser_offset_x,
+                    start=(initial_pose[0], initial_pose[1]),
+                    rate_hz=nav.rate_hz,
+                    goal=goal,
+                    remap=remap,
+                )
+            )
+        if config.safety.enabled:
+            actors.append(
+                SafetyLayer(
+                    safety_params(config, geometry),
+                    laser_offset_x=geometry.laser_offset_x,
+                    rate_hz=config.safety.rate_hz,
+                    cmd_timeout=config.safety.cmd_timeout,
+                    scan_timeout=config.safety.scan_timeout,
+                )
+            )
     return actors
+
+
+def navigation_params(config: StackConfig, geometry: RobotGeometry) -> NavigationParams:
+    """The avoiding navigator's settings from ``nav.*`` and the base's limits."""
+    nav, base = config.nav, config.base
+    dwa, grid, rec = nav.dwa, nav.map, nav.recovery
+    radius = centre_clearance(nav.clearance, geometry.footprint_radius, nav.footprint_padding)
+    return NavigationParams(
+        dwa=DwaParams(
+            max_v=min(nav.max_v, base.max_v),
+            max_omega=min(nav.max_omega, base.max_omega),
+            max_accel=base.max_accel,
+            max_alpha=base.max_alpha,
+            period=1.0 / nav.rate_hz,
+            horizon=dwa.horizon,
+            dt=dwa.dt,
+            v_samples=dwa.v_samples,
+            omega_samples=dwa.omega_samples,
+            radius=radius,
+            latency=dwa.latency,
+            clearance_cap=dwa.clearance_cap,
+            w_heading=dwa.w_heading,
+            w_progress=dwa.w_progress,
+            w_clearance=dwa.w_clearance,
+            w_speed=dwa.w_speed,
+            rotate_threshold=nav.turn_in_place_threshold,
+        ),
+        tolerance=nav.tolerance,
+        map_half_size=grid.half_size,
+        map_resolution=grid.resolution,
+        plan_resolution=grid.plan_resolution,
+        plan_penalty=grid.plan_penalty,
+        replan_period=grid.replan_period,
+        lookahead=grid.lookahead,
+        max_expansions=grid.max_expansions,
+        progress_distance=rec.progress_distance,
+        progress_window=rec.progress_window,
+        goal_progress_window=rec.goal_progress_window,
+        spin_angle=rec.spin_angle,
+        spin_speed=rec.spin_speed,
+        backup_distance=rec.backup_distance,
+        backup_speed=rec.backup_speed,
+        follow_time=rec.follow_time,
+        follow_speed=rec.follow_speed,
+        follow_distance=rec.follow_distance,
+        approach_radius=nav.approach_radius,
+        kp_lin=nav.kp_lin,
+        kp_ang=nav.kp_ang,
+    )
+
+
+def safety_params(config: StackConfig, geometry: RobotGeometry) -> SafetyParams:
+    """The safety layer's settings from ``safety.*``, the base's limits and rates."""
+    safety, base = config.safety, config.base
+    return SafetyParams(
+        radius=centre_clearance(
+            safety.clearance, geometry.footprint_radius, safety.footprint_padding
+        ),
+        max_accel=base.max_accel,
+        max_alpha=base.max_alpha,
+        latency=1.0 / safety.rate_hz + 1.0 / base.rate_hz + safety.drive_lag,
+        scales=safety.scales,
+    )

@@ -6,7 +6,14 @@ from __future__ import annotations
 import math
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PositiveFloat,
+    PositiveInt,
+    model_validator,
+)
 
 from otonav import limits
 
@@ -54,9 +61,86 @@ class BaseConfig(_Section):
     max_alpha: PositiveFloat = Field(3.0, le=limits.MAX_BASE_ALPHA)
 
 
-class NavConfig(_Section):
-    """Navigator: go-to-goal gains and limits."""
+class DwaConfig(_Section):
+    """The DWA local planner (``nav.planner = dwa``; otonav.nav.dwa). Its window is
+    what the base's ``max_accel`` / ``max_alpha`` reach in one nav period."""
 
+    horizon: float = Field(1.6, gt=0.0, le=10.0)
+    """s, rollout length, in (0, 10]."""
+    dt: float = Field(0.2, gt=0.0, le=1.0)
+    """s, spacing of the rollout poses, in (0, 1] and <= horizon."""
+    v_samples: int = Field(5, ge=1, le=50)
+    """speed samples across the window, in [1, 50]."""
+    omega_samples: int = Field(13, ge=1, le=100)
+    """yaw-rate samples across the window, in [1, 100]."""
+    latency: float = Field(0.1, ge=0.0, le=2.0)
+    """s, command delay assumed before braking (admissibility), in [0, 2]."""
+    clearance_cap: float = Field(0.25, gt=0.0, le=5.0)
+    """m, clearance beyond the centre clearance that stops scoring, in (0, 5]."""
+    w_heading: float = Field(1.0, ge=0.0, le=100.0)
+    """score weight of heading to the target at the rollout's end, in [0, 100]."""
+    w_progress: float = Field(2.0, ge=0.0, le=100.0)
+    """score weight of distance gained toward the target, in [0, 100]."""
+    w_clearance: float = Field(0.6, ge=0.0, le=100.0)
+    """score weight of clearance along the rollout, in [0, 100]."""
+    w_speed: float = Field(0.3, ge=0.0, le=100.0)
+    """score weight of forward speed, in [0, 100]."""
+
+
+class MapConfig(_Section):
+    """The navigator's map of the scans and its global planner (A*)."""
+
+    half_size: float = Field(10.0, gt=0.0, le=100.0)
+    """m, the map spans this far from the start pose in x and y, in (0, 100]."""
+    resolution: float = Field(0.05, ge=0.005, le=0.2)
+    """m, map cell, in [0.005, 0.2]. Clearances read from the map are lower bounds,
+    short by up to resolution * sqrt(2); 5 cm marks 4x fewer kernel cells per return
+    than 2.5 cm (the map update was the planner's largest cost)."""
+    plan_resolution: float = Field(0.1, ge=0.005, le=1.0)
+    """m, global planner cell (a multiple of ``resolution``), in [0.005, 1]."""
+    plan_penalty: float = Field(2.0, ge=0.0, le=100.0)
+    """extra path cost per cell near obstacles (0: shortest path), in [0, 100]."""
+    replan_period: float = Field(0.5, gt=0.0, le=60.0)
+    """s, how often the path ahead is checked for new obstacles, in (0, 60]."""
+    lookahead: float = Field(0.8, gt=0.0, le=10.0)
+    """m, the DWA heads for the path point this far ahead, in (0, 10]."""
+    max_expansions: int = Field(60_000, ge=100, le=10_000_000)
+    """A* gives up (no proof either way) after this many cells, in [100, 1e7]."""
+
+
+class RecoveryConfig(_Section):
+    """Progress checker and recovery ladder (spin, backup, follow, then unreachable)."""
+
+    progress_distance: float = Field(0.3, gt=0.0, le=10.0)
+    """m, progress that counts, in (0, 10]."""
+    progress_window: float = Field(4.0, gt=0.0, le=600.0)
+    """s of sim time to move ``progress_distance``, in (0, 600]."""
+    goal_progress_window: float = Field(15.0, gt=0.0, le=3600.0)
+    """s of sim time to get ``progress_distance`` closer to the goal, in (0, 3600]."""
+    spin_angle: float = Field(math.pi / 2, gt=0.0, le=2 * math.pi)
+    """rad, the look-around turn, in (0, 2 pi]."""
+    spin_speed: float = Field(1.0, gt=0.0, le=10.0)
+    """rad/s, in (0, 10]."""
+    backup_distance: float = Field(0.3, gt=0.0, le=5.0)
+    """m, in (0, 5]."""
+    backup_speed: float = Field(0.1, gt=0.0, le=2.0)
+    """m/s, in (0, 2]."""
+    follow_time: float = Field(8.0, gt=0.0, le=600.0)
+    """s, the longest boundary following, in (0, 600]."""
+    follow_speed: float = Field(0.2, gt=0.0, le=2.0)
+    """m/s, in (0, 2]."""
+    follow_distance: float = Field(0.45, gt=0.0, le=5.0)
+    """m, robot centre to the boundary while following, in (0, 5]."""
+
+
+class NavConfig(_Section):
+    """Navigator: which planner, go-to-goal gains (``stop``), limits, footprint,
+    clearance, and the avoiding planner's sections."""
+
+    planner: Literal["stop", "dwa", "external"] = "dwa"
+    """``dwa``: map + A* + DWA + recovery (avoids obstacles); ``stop``: go-to-goal that
+    stops in front of an obstacle (the original behaviour); ``external``: no planner
+    actor, your own node publishes /cmd_vel_nav (behind the safety layer)."""
     rate_hz: PositiveFloat = 20.0
     kp_lin: float = Field(0.8, ge=0.0)
     kp_ang: float = Field(2.0, ge=0.0)
@@ -65,6 +149,42 @@ class NavConfig(_Section):
     tolerance: PositiveFloat = 0.08
     """m: the navigator stops within this distance of the goal (by odometry)."""
     turn_in_place_threshold: PositiveFloat = 0.6
+    clearance: float = Field(0.35, ge=0.0, le=5.0)
+    """m, robot centre (base_link, the judged point) to any return: what the planner
+    keeps, in [0, 5]; at least ``safety.clearance``."""
+    approach_radius: float = Field(0.25, ge=0.0, le=5.0)
+    """m (dwa planner): within this distance of the goal a proportional controller
+    (``kp_lin``, ``kp_ang``) finishes, in reverse if the goal is behind, in [0, 5]."""
+    footprint_padding: float = Field(0.05, ge=0.0, le=1.0)
+    """m, gap kept between the footprint (read from the MJCF) and any return, in [0, 1].
+    The planner keeps its centre max(clearance, footprint radius + padding) away."""
+    dwa: DwaConfig = DwaConfig()
+    map: MapConfig = MapConfig()
+    recovery: RecoveryConfig = RecoveryConfig()
+
+
+class SafetyConfig(_Section):
+    """The safety layer between the planner (/cmd_vel_nav) and the base (/cmd_vel)."""
+
+    enabled: bool = True
+    """False: the planner drives /cmd_vel directly (nothing checks it)."""
+    rate_hz: float = Field(20.0, ge=1.0, le=1000.0)
+    """Hz, how often the command is checked and sent, in [1, 1000]."""
+    clearance: float = Field(0.32, gt=0.0, le=5.0)
+    """m, robot centre (base_link) to any return: the robot can always stop before
+    coming closer, in (0, 5]. Keep it above the judge's min_clearance."""
+    footprint_padding: float = Field(0.03, ge=0.0, le=1.0)
+    """m, gap kept between the footprint and any return, in [0, 1]: the centre keeps
+    max(clearance, footprint radius + padding)."""
+    drive_lag: float = Field(0.05, ge=0.0, le=2.0)
+    """s, the drives' lag behind the base's command; the braking delay assumed is
+    1/rate_hz + 1/base.rate_hz + drive_lag, in [0, 2]."""
+    cmd_timeout: float = Field(0.25, gt=0.0, le=10.0)
+    """s without /cmd_vel_nav before the command counts as zero, in (0, 10]."""
+    scan_timeout: float = Field(0.35, gt=0.0, le=10.0)
+    """s without /scan (or /odom) before the layer stops the robot (blind), in (0, 10]."""
+    scales: int = Field(6, ge=2, le=100)
+    """forward-speed scales tried from 1 down to 0, in [2, 100]."""
 
 
 class GuardConfig(_Section):
@@ -162,6 +282,7 @@ class StackConfig(_Section):
     base: BaseConfig = BaseConfig()
     nav: NavConfig = NavConfig()
     guard: GuardConfig = GuardConfig()
+    safety: SafetyConfig = SafetyConfig()
     hal: HalConfig = HalConfig()
 
     @model_validator(mode="after")
@@ -170,6 +291,22 @@ class StackConfig(_Section):
             raise ValueError(
                 "world.lidar_range_min must be < world.lidar_range_max "
                 f"(got {self.world.lidar_range_min} >= {self.world.lidar_range_max})"
+            )
+        if self.nav.dwa.dt > self.nav.dwa.horizon:
+            raise ValueError(
+                f"nav.dwa.dt must be <= nav.dwa.horizon (got {self.nav.dwa.dt} > "
+                f"{self.nav.dwa.horizon})"
+            )
+        if self.nav.map.plan_resolution < self.nav.map.resolution:
+            raise ValueError(
+                "nav.map.plan_resolution must be >= nav.map.resolution "
+                f"(got {self.nav.map.plan_resolution} < {self.nav.map.resolution})"
+            )
+        if self.safety.enabled and self.nav.clearance < self.safety.clearance:
+            raise ValueError(
+                f"nav.clearance ({self.nav.clearance} m) must be >= safety.clearance "
+                f"({self.safety.clearance} m): a planner keeping less would drive into "
+                "the safety layer"
             )
         tick_hz = 1.0 / self.world.timestep
         for key, hz in self.rates_hz().items():
@@ -186,4 +323,6 @@ class StackConfig(_Section):
         rates = {f"rates.{key}": float(hz) for key, hz in self.rates.model_dump().items()}
         rates["base.rate_hz"] = self.base.rate_hz
         rates["nav.rate_hz"] = self.nav.rate_hz
+        if self.safety.enabled:
+            rates["safety.rate_hz"] = self.safety.rate_hz
         return rates

@@ -33,7 +33,10 @@ pytestmark = pytest.mark.smoke
 REPO = Path(__file__).resolve().parents[2]
 APP = REPO / "examples" / "service" / "app.py"
 START_CEILING_S = 30.0
-HEALTH_BUDGET_S = 0.050
+# Not a speed target (those live in benchmarks, PROTOCOL): the failure this catches is a
+# simulation on the host's loop, which holds every request for seconds. A 50 ms budget
+# failed at load average 11 on 2 cores (p90 56-58 ms) with nothing wrong.
+HEALTH_BUDGET_S = 0.5
 # Reaches no goal (the navigator stops 8 cm short of a 1 mm tolerance): it runs until
 # cancelled or its sim budget (minutes of sim time) is spent.
 ENDLESS: dict[str, Any] = {
@@ -123,7 +126,7 @@ def _wait_status(client: httpx.Client, run_id: str, until: Any, within: float) -
         assert time.monotonic() < deadline, f"run never satisfied the condition: {run}"
 
 
-def test_health_answers_within_50ms_while_simulations_run(client: httpx.Client) -> None:
+def test_health_answers_while_simulations_run(client: httpx.Client) -> None:
     runs = [_start(client, {"scenario": ENDLESS}) for _ in range(2)]
     for run_id in runs:
         _wait_status(client, run_id, lambda r: r["status"] == "running", within=10)

@@ -35,7 +35,7 @@ def main() -> None:
     out, mode = Path(sys.argv[1]), sys.argv[2]
     run_scenario(
         ScenarioConfig(sim_budget=1800.0),  # the most allowed; signalled at 30 s
-        StackConfig(nav=NavConfig(kp_lin=0.0)),
+        StackConfig(nav=NavConfig(planner="stop", kp_lin=0.0)),
         out_dir=out,
         plot=False,
         wall_ceiling=None,

@@ -61,7 +61,8 @@ def test_gate_has_teeth_driving_through_the_goal_fails() -> None:
 
 
 def test_gate_has_teeth_zero_linear_gain_fails() -> None:
-    broken = StackConfig(nav=NavConfig(kp_lin=0.0))
+    """The stop-only planner (nav.planner=stop) keeps its own sabotage."""
+    broken = StackConfig(nav=NavConfig(planner="stop", kp_lin=0.0))
     verdict = run_scenario(ScenarioConfig(), broken, wall_ceiling=120)
     assert not verdict.passed
     assert not verdict.reached

@@ -48,7 +48,21 @@ def test_run_passes_with_exit_0_and_writes_the_artifacts(
 def test_a_failing_scenario_exits_1_and_says_why(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
-    assert main(["run", "--out", str(tmp_path), "--set", "nav.kp_lin=0", "--no-record"]) == 1
+    assert (
+        main(
+            [
+                "run",
+                "--out",
+                str(tmp_path),
+                "--set",
+                "nav.kp_lin=0",
+                "--set",
+                "nav.planner=stop",
+                "--no-record",
+            ]
+        )
+        == 1
+    )
     out = capsys.readouterr().out
     assert "FAILED" in out
     assert "did not reach the goal within 20 s" in out

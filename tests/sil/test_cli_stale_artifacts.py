@@ -22,6 +22,10 @@ pytestmark = pytest.mark.sil
 STALE = {"scenario": "acceptance", "passed": True, "reached": True}
 
 
+def _default_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _stale_out(out: Path) -> Path:
     out.mkdir()
     (out / "summary.json").write_text(json.dumps(STALE))
@@ -45,6 +49,9 @@ def test_an_interrupted_run_leaves_no_summary(
         stdin=subprocess.DEVNULL,
         stdout=subprocess.PIPE,
         stderr=child_side,
+        # A suite started in the background (`make test &`) ignores SIGINT, and a child
+        # that starts with it ignored never sees Ctrl-C: give it the default back.
+        preexec_fn=_default_sigint,
     )
     os.close(child_side)
     try:

@@ -17,7 +17,7 @@ from otonav.msgs import LaserScan, NavState, PoseStamped
 from otonav.msgs.geometry import Point, Pose
 from otonav.runtime import LATCHED_QOS, Actor, Input
 from otonav.scenario import ScenarioConfig
-from otonav.stack import GuardConfig, StackConfig, WorldConfig
+from otonav.stack import GuardConfig, NavConfig, StackConfig, WorldConfig
 from otonav.testing import running_stack
 
 pytestmark = pytest.mark.sil
@@ -72,7 +72,8 @@ async def _drive(
     guard: GuardConfig = GuardConfig(),
 ) -> FloorWatch:
     watch = FloorWatch()
-    config = StackConfig(world=WorldConfig(scene=scene), guard=guard)
+    # The stop-only planner: its front-sector guard is what the floor hits fooled.
+    config = StackConfig(world=WorldConfig(scene=scene), guard=guard, nav=NavConfig(planner="stop"))
     async with running_stack(config, extra_actors=[watch], variant=variant) as stack:
         watch.hal = stack.hal
         publisher = stack.system.publisher(topics.GOAL, PoseStamped, LATCHED_QOS)

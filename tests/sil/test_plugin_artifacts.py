@@ -21,7 +21,7 @@ from otonav.testing import running_stack
 
 
 async def _go(artifacts, kp_lin):
-    config = StackConfig(nav=NavConfig(kp_lin=kp_lin))
+    config = StackConfig(nav=NavConfig(planner="stop", kp_lin=kp_lin))
     async with running_stack(config, record_to=artifacts / "recording.mcap") as stack:
         goal = stack.system.publisher(topics.GOAL, PoseStamped, LATCHED_QOS)
         await goal.publish(PoseStamped(pose=Pose(position=Point(x=4.0, y=1.5))))

@@ -17,7 +17,8 @@ pytestmark = pytest.mark.sil
 
 EXPECTED_TOPICS = {
     "/clock", "/odom", "/imu", "/scan", "/tf", "/tf_static", "/cmd_vel", "/wheel_cmd",
-    "/goal", "/nav/state", "/rosout", "/scenario/verdict", "/hardware/status", "/diagnostics",
+    "/goal", "/nav/state", "/rosout", "/scenario/verdict", "/cmd_vel_nav", "/safety/state",
+    "/hardware/status", "/diagnostics",
 }  # fmt: skip
 
 
@@ -32,11 +33,13 @@ def test_two_runs_give_byte_identical_recordings(tmp_path: Path) -> None:
     assert a == b
 
 
-def _assert_failed_recording(out: Path, scenario: ScenarioConfig) -> None:
+def _assert_failed_recording(
+    out: Path, scenario: ScenarioConfig, *, extra: frozenset[str] = frozenset()
+) -> None:
     recording = out / "recording.mcap"
     summary = summarize(recording)
     assert not summary.truncated
-    assert {t.topic for t in summary.topics} == EXPECTED_TOPICS
+    assert {t.topic for t in summary.topics} == EXPECTED_TOPICS | extra
     assert summary.duration_s == pytest.approx(scenario.sim_budget, abs=0.02)
     meta = summary.metadata["otonav"]
     assert meta["scenario"] == scenario.name
@@ -59,7 +62,9 @@ def _assert_failed_recording(out: Path, scenario: ScenarioConfig) -> None:
 
 def test_zero_linear_gain_fails_and_leaves_its_recording(tmp_path: Path) -> None:
     scenario = ScenarioConfig()
-    verdict = run_scenario(scenario, StackConfig(nav=NavConfig(kp_lin=0.0)), out_dir=tmp_path)
+    verdict = run_scenario(
+        scenario, StackConfig(nav=NavConfig(planner="stop", kp_lin=0.0)), out_dir=tmp_path
+    )
     assert not verdict.passed
     assert verdict.recording == str(tmp_path / "recording.mcap")
     _assert_failed_recording(tmp_path, scenario)
@@ -76,4 +81,5 @@ def test_wrong_sign_in_the_kinematics_fails_and_leaves_its_recording(
     scenario = ScenarioConfig()
     verdict = run_scenario(scenario, out_dir=tmp_path)
     assert not verdict.passed
-    _assert_failed_recording(tmp_path, scenario)
+    # The default (dwa) planner also records its diagnostics.
+    _assert_failed_recording(tmp_path, scenario, extra=frozenset({"/nav/diagnostics"}))

@@ -19,16 +19,21 @@ from otonav.replay import replay_recording
 from otonav.replay.nodes import stack_actor_names
 from otonav.replay.recording import load_recording
 from otonav.scenario import ScenarioConfig, run_scenario
-from otonav.stack import StackConfig
+from otonav.stack import NavConfig, SafetyConfig, StackConfig
 from otonav.testing import replay
 
 pytestmark = pytest.mark.sil
 
 
+# The stop-only stack as it was (go-to-goal on /cmd_vel, no safety layer): these tests
+# change its gains on purpose. The default (dwa) stack's replay: tests/sil/test_avoidance.py.
+STOP_ONLY = StackConfig(nav=NavConfig(planner="stop"), safety=SafetyConfig(enabled=False))
+
+
 @pytest.fixture(scope="module")
 def acceptance(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("acceptance")
-    verdict = run_scenario(out_dir=out, plot=False)
+    verdict = run_scenario(stack=STOP_ONLY, out_dir=out, plot=False)
     assert verdict.passed
     return out / "recording.mcap"
 
@@ -36,7 +41,7 @@ def acceptance(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def test_every_replayable_actor_is_byte_identical_on_the_acceptance_run(
     acceptance: Path,
 ) -> None:
-    names = stack_actor_names(StackConfig())
+    names = stack_actor_names(STOP_ONLY)
     assert {"nav", "base"} <= set(names)
     assert "bridge" not in names
     for nodes in [[name] for name in names] + [names]:
@@ -147,7 +152,8 @@ def test_a_real_time_recording_replays_with_recorded_wakes(tmp_path: Path) -> No
     # On its own timers the navigator wakes at k * 50 ms; in real time it woke when the
     # world had caught up with the wall clock, a little later: only timing differs.
     timers = replay_recording(recording, ["nav"])
-    cmd = next(t for t in timers.topics if t.topic == "/cmd_vel")
+    # The default navigator's command goes to the safety layer on /cmd_vel_nav.
+    cmd = next(t for t in timers.topics if t.topic == "/cmd_vel_nav")
     # How many wake-ups a paced run gets depends on the (shared, noisy) machine: assert
     # only that there are enough to compare, and that timer wakes mostly miss them.
     assert cmd.recorded >= 10
@@ -157,7 +163,7 @@ def test_a_real_time_recording_replays_with_recorded_wakes(tmp_path: Path) -> No
     # (a burst whose outputs were published at two instants can differ: a loaded machine
     # makes more bursts, hence the margin).
     recorded = replay_recording(recording, ["nav"], wake="recorded")
-    cmd = next(t for t in recorded.topics if t.topic == "/cmd_vel")
+    cmd = next(t for t in recorded.topics if t.topic == "/cmd_vel_nav")
     assert cmd.identical >= 0.75 * cmd.recorded
     # /nav/state's stamp is taken at the wake-up, which the recording does not keep.
     assert {d.field for d in recorded.divergences if d.kind == "content"} <= {

@@ -231,6 +231,7 @@ def test_a_smaller_arena_is_walled_and_holds_the_world() -> None:
 # -- budgets and the BARN metric --------------------------------------------------------------
 
 
+@settings(deadline=None)  # a shared, busy machine: no wall-clock deadline
 @given(a=st.floats(0.0, 50.0), b=st.floats(0.0, 50.0))
 def test_budgets_grow_with_the_path(a: float, b: float) -> None:
     low, high = sorted((a, b))
@@ -243,6 +244,7 @@ def test_budget_example() -> None:
     assert budget_for(7.0, SPARSE) == 83.0
 
 
+@settings(deadline=None)
 @given(optimal=st.floats(0.1, 100.0), factor=st.floats(0.0, 20.0))
 def test_barn_metric_is_clipped_between_an_eighth_and_a_half(optimal: float, factor: float) -> None:
     score = barn_metric(True, factor * optimal, optimal)

@@ -68,6 +68,7 @@ def test_a_family_row_counts_each_outcome_once() -> None:
     assert row.successes == 2
     assert row.success_pct == pytest.approx(40.0)
     assert row.barn_metric == pytest.approx((1 / 3 + 0.5) / 5)
+    assert row.time_ratio_median == pytest.approx((3 + 1) / 2)
     assert row.timeouts == 1
     assert row.gave_up == 1
     assert row.clearance_violations == 2
@@ -91,6 +92,7 @@ def test_an_empty_family_has_no_percentages() -> None:
     row = summarise("dense", [])
     assert row.success_pct is None
     assert row.barn_metric is None
+    assert row.time_ratio_median is None
     assert row.walled_reported_pct is None
 
 

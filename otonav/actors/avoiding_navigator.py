@@ -1,0 +1,174 @@
+"""The avoiding navigator: /odom + /scan + /goal -> /cmd_vel_nav (+ /nav/state,
+/nav/diagnostics), through :class:`otonav.nav.Navigation` (map, A*, DWA, recovery)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from otonav.actors import topics
+from otonav.actors.odom_history import OdomHistory
+from otonav.actors.scan_cache import points_of
+from otonav.msgs import (
+    HardwareStatus,
+    Header,
+    LaserScan,
+    NavDiagnostics,
+    NavState,
+    Odometry,
+    PoseStamped,
+    Time,
+    Twist,
+    Vector3,
+)
+from otonav.nav.navigation import Navigation, NavigationParams, NavOutput
+from otonav.nav.scan import to_frame
+from otonav.runtime import Actor, Input, Output
+
+_AT_REST = frozenset({"idle", "waiting", "reached", "unreachable", "fault"})
+
+
+class AvoidingNavigator(Actor):
+    """At ``rate_hz``: record each new scan in the map (at the odometry pose of its
+    stamp), then step :class:`~otonav.nav.navigation.Navigation`. Only /odom and /scan
+    are used, never ground truth. With no scan yet, or none for ``scan_timeout`` s of
+    sim time, it does not drive (state ``waiting``).
+
+    Publishes its command on /cmd_vel (remapped to /cmd_vel_nav behind the safety
+    layer) and /nav/state every step, /nav/diagnostics every step while moving (at
+    rest: when the state or reason change). While /hardware/status reports a fault it
+    commands zero and its state is ``fault``."""
+
+    odom = Input(topics.ODOM, Odometry, topics.SENSOR_QOS)
+    scan = Input(topics.SCAN, LaserScan, topics.SENSOR_QOS)
+    goal_in = Input(topics.GOAL, PoseStamped, topics.LATCHED)
+    hardware = Input(topics.HARDWARE_STATUS, HardwareStatus, topics.HARDWARE_QOS)
+    cmd_vel = Output(topics.CMD_VEL, Twist, topics.COMMAND_QOS)
+    state = Output(topics.NAV_STATE, NavState, topics.COMMAND_QOS)
+    diagnostics = Output(topics.NAV_DIAGNOSTICS, NavDiagnostics, topics.COMMAND_QOS)
+
+    def __init__(
+        self,
+        params: NavigationParams,
+        *,
+        laser_offset_x: float,
+        start: tuple[float, float] = (0.0, 0.0),
+        rate_hz: float = 20.0,
+        goal: tuple[float, float] | None = None,
+        scan_timeout: float = 0.5,
+        name: str = "nav",
+        remap: dict[str, str] | None = None,
+    ) -> None:
+        super().__init__(name, remap=remap)
+        if not rate_hz > 0:
+            raise ValueError(f"nav.rate_hz must be > 0 Hz, got {rate_hz}")
+        self.rate_hz = rate_hz
+        self.scan_timeout = scan_timeout
+        self.laser_offset_x = laser_offset_x
+        self.nav = Navigation(params, start)
+        if goal is not None:
+            self.nav.set_goal(goal)
+        self._history = OdomHistory()
+        self._points = np.empty((0, 2))
+        self._points_pose: tuple[float, float, float] | None = None
+        self._scan_time = -math.inf
+        self._last_diag: tuple[str, str] | None = None
+        self._hardware_fault = False
+
+    async def run(self) -> None:
+        rate = self.clock.rate(self.rate_hz)
+        while True:
+            await rate.sleep()
+            while (odom := self.odom.try_recv()) is not None:
+                self._history.add(odom)
+            goal_msg = self.goal_in.take_latest()
+            if goal_msg is not None:
+                self.nav.set_goal((goal_msg.pose.position.x, goal_msg.pose.position.y))
+            status = self.hardware.take_latest()
+            if status is not None:
+                self._hardware_fault = status.faulted
+            scan = self.scan.take_latest()
+            if scan is not None:
+                self._take_scan(scan)
+            await self._step()
+
+    def _take_scan(self, scan: LaserScan) -> None:
+        pose = self._history.pose_at(scan.header.stamp.to_seconds())
+        if pose is None:
+            return
+        seen = points_of(scan, self.laser_offset_x)
+        moved = self._points_pose is None or (
+            abs(pose[0] - self._points_pose[0]) + abs(pose[1] - self._points_pose[1]) > 1e-3
+            or abs(pose[2] - self._points_pose[2]) > 1e-3
+        )
+        self._points, self._points_pose = seen.xy, pose
+        self._scan_time = self.clock.now()
+        # A static world seen from the same pose marks the same cells: skip the update.
+        if moved:
+            self.nav.observe(to_frame(seen.xy, pose))
+
+    async def _step(self) -> None:
+        now = self.clock.now()
+        latest = self._history.latest
+        if latest is None:
+            await self._publish(NavOutput(0.0, 0.0, "idle", "no odometry", math.inf, 0.0))
+            return
+        _, pose, v0, omega0 = latest
+        if self._hardware_fault:
+            await self._publish(NavOutput(0.0, 0.0, "fault", "hardware fault", math.inf, 0.0))
+            return
+        if self._points_pose is None or now - self._scan_time > self.scan_timeout:
+            out = self.nav.step(now, pose, v0, omega0, np.empty((0, 2)))
+            if out.state not in ("idle", "reached", "unreachable"):
+                out = NavOutput(0.0, 0.0, "waiting", "no fresh scan", out.distance, 0.0)
+            await self._publish(out)
+            return
+        scan_points_, scan_pose = self._points, self._points_pose
+        await self._publish(
+            self.nav.step(now, pose, v0, omega0, lambda: to_frame(scan_points_, scan_pose, pose))
+        )
+
+    async def _publish(self, out: NavOutput) -> None:
+        stamp = Time.from_seconds(self.clock.now())
+        header = Header.fast(stamp=stamp, frame_id="odom")
+        await self.cmd_vel.publish(
+            Twist.fast(
+                linear=Vector3.fast(x=out.v, y=0.0, z=0.0),
+                angular=Vector3.fast(x=0.0, y=0.0, z=out.omega),
+            )
+        )
+        dwa = out.dwa
+        closest = dwa.clearance if dwa is not None else math.inf
+        await self.state.publish(
+            NavState.fast(
+                header=header,
+                state=out.state,
+                distance_to_goal=out.distance,
+                heading_error=out.heading_error,
+                closest_ahead=closest,
+            )
+        )
+        # Diagnostics every step while it moves (driving, avoiding, recovering, blocked);
+        # at rest (idle, waiting, reached, unreachable) when the state or reason change.
+        key = (out.state, out.reason)
+        if out.state in _AT_REST and key == self._last_diag:
+            return
+        self._last_diag = key
+        await self.diagnostics.publish(
+            NavDiagnostics.fast(
+                header=header,
+                planner="dwa",
+                state=out.state,
+                reason=out.reason,
+                stage=out.stage,
+                v=out.v,
+                omega=out.omega,
+                admissible=dwa.admissible if dwa is not None else 0,
+                samples=dwa.samples if dwa is not None else 0,
+                best_score=dwa.best_score if dwa is not None else 0.0,
+                clearance=closest,
+                path_length=out.path_length,
+                replans=out.replans,
+            )
+        )

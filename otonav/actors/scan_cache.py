@@ -1,0 +1,32 @@
+"""One scan, one conversion: the navigator and the safety layer receive the same
+LaserScan object (messages are shared, never copied), so its points in base_link are
+computed once and reused by whoever asks second."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from otonav.msgs import LaserScan
+from otonav.nav.scan import ScanPoints, scan_points
+
+_last: tuple[LaserScan, float, ScanPoints] | None = None
+
+
+def points_of(scan: LaserScan, laser_offset_x: float) -> ScanPoints:
+    """The scan's returns in base_link (:func:`otonav.nav.scan.scan_points`)."""
+    global _last
+    if _last is not None and _last[0] is scan and _last[1] == laser_offset_x:
+        return _last[2]
+    # The LaserScan's angles and limits are float32 on the wire (ROS 2): use them as
+    # float32 here too, so a replay from the recording computes the same points.
+    f32 = np.float32
+    seen = scan_points(
+        np.asarray(scan.ranges, dtype=np.float64),
+        float(f32(scan.angle_min)),
+        float(f32(scan.angle_increment)),
+        float(f32(scan.range_min)),
+        float(f32(scan.range_max)),
+        laser_offset_x,
+    )
+    _last = (scan, laser_offset_x, seen)
+    return seen

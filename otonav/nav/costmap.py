@@ -1,0 +1,125 @@
+"""The navigator's memory of the scans: a grid in odom of the cells where the lidar saw
+something, and for every cell the distance to the nearest such cell.
+
+Frames and units: odom, m. The grid is a square of ``2 * half_size`` m centred on
+``(centre_x, centre_y)`` (the start pose), ``resolution`` m per cell (default 5 cm).
+Outside it nothing is known.
+
+* **Unknown is free.** A cell is occupied once a return fell in it; nothing clears it
+  (the worlds are static: a moving obstacle would leave a trail). A route through space
+  never seen is allowed; when the lidar sees it blocked the route is replanned.
+* **Distances, not costs.** :meth:`ClearanceMap.clearance` answers, for any points, a
+  lower bound on the distance to the nearest recorded return, capped at
+  ``max_distance``: the distance between cell centres minus ``resolution * sqrt(2)``
+  (each of the two points may sit anywhere in its cell), stored that way per cell.
+  The local planner checks its rollouts against it and the global planner its cells,
+  so both use the one centre clearance of :mod:`otonav.nav.footprint`.
+* **Incremental.** Marking a new cell stamps a precomputed disk of distances around it
+  (``np.minimum`` on a window); a cell already occupied costs nothing. A 20 x 20 m map
+  at 5 cm is 400 x 400 float32 (0.6 MB); a stamp of 0.65 m (27 x 27 cells) costs a few us;
+  at 2.5 cm the acceptance run marked 3453 cells at ~10-20 us each (measured).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ("ClearanceMap",)
+
+
+class ClearanceMap:
+    """Occupied cells and the (capped) distance field around them. Mutable: owned by
+    one navigator; every method is plain computation (no I/O, no clock)."""
+
+    def __init__(
+        self,
+        centre_x: float,
+        centre_y: float,
+        *,
+        half_size: float = 10.0,
+        resolution: float = 0.05,
+        max_distance: float = 0.6,
+    ) -> None:
+        for name, value in (
+            ("half_size", half_size),
+            ("resolution", resolution),
+            ("max_distance", max_distance),
+        ):
+            if not (math.isfinite(value) and value > 0.0):
+                raise ValueError(f"ClearanceMap.{name} must be finite and > 0 m, got {value!r}")
+        if resolution > half_size:
+            raise ValueError(f"resolution {resolution} m must be <= half_size {half_size} m")
+        self.resolution = resolution
+        self.max_distance = max_distance
+        self.size = max(1, round(2.0 * half_size / resolution))
+        self.origin_x = centre_x - half_size
+        self.origin_y = centre_y - half_size
+        self.occupied = np.zeros((self.size, self.size), dtype=np.bool_)
+        # Per cell, what clearance() answers: the distance to the nearest occupied cell
+        # less the slack (0 at least; the cap stays the cap). One border row/column all
+        # round stays at the cap: the answer for points outside the map.
+        self._lower = np.full((self.size + 2, self.size + 2), max_distance, dtype=np.float32)
+        k = math.ceil(max_distance / resolution)
+        offsets = np.arange(-k, k + 1, dtype=np.float64) * resolution
+        self._k = k
+        kernel = np.hypot(offsets[:, None], offsets[None, :])
+        slack = resolution * math.sqrt(2.0)
+        # min over returns of max(d - slack, 0) is max(min d - slack, 0): stamping the
+        # slack-reduced disk keeps the lower bound exact under np.minimum.
+        self._kernel = np.where(
+            kernel >= max_distance, max_distance, np.maximum(kernel - slack, 0.0)
+        ).astype(np.float32)
+        self.marked = 0
+
+    def cell_of(
+        self, x: NDArray[np.float64], y: NDArray[np.float64]
+    ) -> tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.bool_]]:
+        """Row (y) and column (x) indices of points, and which are inside the map."""
+        col = np.floor((x - self.origin_x) / self.resolution).astype(np.intp)
+        row = np.floor((y - self.origin_y) / self.resolution).astype(np.intp)
+        inside = (col >= 0) & (col < self.size) & (row >= 0) & (row < self.size)
+        return row, col, inside
+
+    def centre_of(self, row: int, col: int) -> tuple[float, float]:
+        """The odom (x, y) of a cell's centre, m."""
+        return (
+            self.origin_x + (col + 0.5) * self.resolution,
+            self.origin_y + (row + 0.5) * self.resolution,
+        )
+
+    def mark(self, xy: NDArray[np.float64]) -> int:
+        """Record returns (``(N, 2)`` odom points); returns how many cells were new."""
+        if xy.shape[0] == 0:
+            return 0
+        row, col, inside = self.cell_of(xy[:, 0], xy[:, 1])
+        flat = np.unique(row[inside] * self.size + col[inside])
+        new = flat[~self.occupied.ravel()[flat]]
+        if new.size == 0:
+            return 0
+        self.occupied.ravel()[new] = True
+        k, n, kernel, lower = self._k, self.size, self._kernel, self._lower
+        for cell in new.tolist():
+            r, c = divmod(cell, n)
+            r0, r1 = max(r - k, 0), min(r + k + 1, n)
+            c0, c1 = max(c - k, 0), min(c + k + 1, n)
+            window = lower[r0 + 1 : r1 + 1, c0 + 1 : c1 + 1]
+            np.minimum(window, kernel[r0 - r + k : r1 - r + k, c0 - c + k : c1 - c + k], out=window)
+        self.marked += int(new.size)
+        return int(new.size)
+
+    def coarse(self, stride: int) -> NDArray[np.float32]:
+        """clearance() at the centre cell of every ``stride`` x ``stride`` block: the
+        global planner's grid (a view, rows = y)."""
+        start = 1 + stride // 2
+        return self._lower[start : self.size + 1 : stride, start : self.size + 1 : stride]
+
+    def clearance(self, x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float32]:
+        """Lower bound on the distance from each point to the nearest recorded return,
+        m, capped at ``max_distance`` (outside the map: ``max_distance``)."""
+        inv = 1.0 / self.resolution
+        col = np.clip(np.floor((x - self.origin_x) * inv), -1, self.size) + 1
+        row = np.clip(np.floor((y - self.origin_y) * inv), -1, self.size) + 1
+        return self._lower[row.astype(np.intp), col.astype(np.intp)]

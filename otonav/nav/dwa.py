@@ -1,0 +1,258 @@
+"""Dynamic Window Approach (Fox, Burgard, Thrun 1997), vectorised with numpy.
+
+Frames and units: poses in odom (x, y m; yaw rad CCW, REP 103); commands are body
+twists (v m/s forward, omega rad/s CCW).
+
+One step:
+
+1. **Window.** The (v, omega) reachable within one control period ``period`` under the
+   acceleration limits, intersected with ``[0, max_v] x [-max_omega, max_omega]``; the
+   top of the v range is also capped at ``sqrt(max_accel * goal_distance)`` (braking at
+   half the limit stops at the goal) so the
+   robot arrives instead of overshooting. ``v_samples x omega_samples`` samples,
+   plus the braking command (the window's lowest v, omega toward 0). With the target
+   more than ``rotate_threshold`` off the heading only the lowest v is sampled: the
+   robot slows and turns toward it first.
+2. **Rollouts.** Each sample held for ``horizon`` s, poses every ``dt`` s (exact arcs).
+3. **Admissible.** With ``clearance(x, y)`` the distance from a point to the nearest
+   return (the costmap's lower bound), the *free length* of a rollout is the arc
+   length driven before the first pose whose clearance is under ``radius`` (or under
+   the clearance at the start, when the robot already is closer than ``radius``: it
+   may then only move away). A sample is admissible when it can stop within its free
+   length: ``v * latency + v**2 / (2 * max_accel) <= free length``.
+4. **Score** (higher is better), each term in [0, 1] or [-1, 1]:
+   ``w_heading * (1 - |bearing error to the target| / pi)
+   + w_progress * (distance to the target gained) / (max_v * horizon)
+   + w_clearance * min(min clearance - radius, clearance_cap) / clearance_cap
+   + w_speed * v / max_v``.
+   The target is a point of the global path ahead of the robot (or the goal); heading
+   and progress are taken at the rollout's closest approach to it, among its poses
+   before the first one under the threshold.
+
+The best admissible sample is the command. With none admissible the command is the
+braking one and the reason says so.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, fields
+from functools import lru_cache
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ("ClearanceFn", "DwaParams", "DwaResult", "dwa_step")
+
+ClearanceFn = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float32]]
+"""(x, y) arrays in odom -> distance to the nearest return, m (same shape)."""
+
+
+@dataclass(frozen=True, slots=True)
+class DwaParams:
+    """Settings of :func:`dwa_step`.
+
+    Attributes:
+        max_v: forward speed limit, m/s (> 0).
+        max_omega: yaw-rate limit, rad/s (> 0).
+        max_accel: linear acceleration limit (the base's), m/s^2 (> 0).
+        max_alpha: angular acceleration limit (the base's), rad/s^2 (> 0).
+        period: control period: the window is what the limits reach in it, s (> 0).
+        horizon: rollout length, s (> 0).
+        dt: rollout pose spacing, s (> 0, <= horizon).
+        v_samples: speed samples across the window (>= 1).
+        omega_samples: yaw-rate samples across the window (>= 1).
+        radius: centre clearance to keep (footprint.centre_clearance), m (>= 0).
+        latency: command delay before braking starts, s (>= 0).
+        clearance_cap: clearance beyond which more is not better, m (> 0).
+        w_heading, w_progress, w_clearance, w_speed: score weights (>= 0).
+        rotate_threshold: with the target farther off the heading than this, rad, the
+            window's speeds shrink to its lowest (slow down and turn toward it first,
+            like Nav2's rotation shim) (>= 0).
+    """
+
+    max_v: float = 0.4
+    max_omega: float = 1.2
+    max_accel: float = 1.0
+    max_alpha: float = 3.0
+    period: float = 0.05
+    horizon: float = 1.6
+    dt: float = 0.2
+    v_samples: int = 5
+    omega_samples: int = 13
+    radius: float = 0.33
+    latency: float = 0.1
+    clearance_cap: float = 0.25
+    w_heading: float = 1.0
+    w_progress: float = 2.0
+    w_clearance: float = 0.6
+    w_speed: float = 0.3
+    rotate_threshold: float = 0.6
+
+    def __post_init__(self) -> None:
+        positive: tuple[str, ...] = ("max_v", "max_omega", "max_accel", "max_alpha")
+        positive += ("period", "horizon", "dt", "clearance_cap")
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if f.name in ("v_samples", "omega_samples"):
+                if not (isinstance(value, int) and value >= 1):
+                    raise ValueError(f"DwaParams.{f.name} must be an integer >= 1, got {value!r}")
+                continue
+            low_ok = value > 0.0 if f.name in positive else value >= 0.0
+            if not (math.isfinite(value) and low_ok):
+                bound = "> 0" if f.name in positive else ">= 0"
+                raise ValueError(f"DwaParams.{f.name} must be finite and {bound}, got {value!r}")
+        if self.dt > self.horizon:
+            raise ValueError(f"DwaParams.dt ({self.dt} s) must be <= horizon ({self.horizon} s)")
+
+
+@dataclass(frozen=True, slots=True)
+class DwaResult:
+    """Output of :func:`dwa_step`.
+
+    Attributes:
+        v: forward speed command, m/s.
+        omega: yaw-rate command, rad/s.
+        admissible: how many samples could stop before breaking the clearance.
+        samples: how many samples were rolled out.
+        best_score: the chosen sample's score (-inf when none was admissible).
+        clearance: the chosen rollout's smallest clearance, m.
+        reason: why this command, in a few words.
+    """
+
+    v: float
+    omega: float
+    admissible: int
+    samples: int
+    best_score: float
+    clearance: float
+    reason: str
+
+
+@lru_cache(maxsize=8)
+def _times(dt: float, steps: int) -> NDArray[np.float64]:
+    t = dt * np.arange(steps + 1, dtype=np.float64)
+    t.flags.writeable = False
+    return t
+
+
+@lru_cache(maxsize=8)
+def _fractions(n: int) -> NDArray[np.float64]:
+    f = np.linspace(0.0, 1.0, n)
+    f.flags.writeable = False
+    return f
+
+
+def _window(lo: float, hi: float, n: int) -> NDArray[np.float64]:
+    # np.linspace costs ~10 us a call; the cached fractions make this one multiply-add.
+    return lo + (hi - lo) * _fractions(n) if n > 1 and hi > lo else np.array([0.5 * (lo + hi)])
+
+
+def dwa_step(
+    pose: tuple[float, float, float],
+    v0: float,
+    omega0: float,
+    target: tuple[float, float],
+    goal_distance: float,
+    clearance: ClearanceFn,
+    params: DwaParams,
+) -> DwaResult:
+    """Choose (v, omega) for the next period (see the module docstring).
+
+    Args:
+        pose: robot pose (x, y, yaw) in odom.
+        v0: current forward speed, m/s.
+        omega0: current yaw rate, rad/s.
+        target: the point to head for (odom, m).
+        goal_distance: distance to the goal, m (caps the speed for arriving).
+        clearance: distance lookup in odom.
+        params: settings.
+    """
+    p = params
+    x0, y0, th0 = pose
+    # Arrive: braking at half the limit would stop at the goal (margin for the period).
+    v_cap = min(p.max_v, math.sqrt(p.max_accel * max(goal_distance, 0.0)))
+    v_lo = min(max(v0 - p.max_accel * p.period, 0.0), v_cap)
+    v_hi = min(max(v0 + p.max_accel * p.period, 0.0), v_cap)
+    w_lo = max(omega0 - p.max_alpha * p.period, -p.max_omega)
+    w_hi = min(omega0 + p.max_alpha * p.period, p.max_omega)
+    if w_lo > w_hi:  # omega0 outside the limits: the window is the nearest limit
+        w_lo = w_hi = min(max(omega0, -p.max_omega), p.max_omega)
+    tx, ty = target
+    off = abs(math.remainder(math.atan2(ty - y0, tx - x0) - th0, math.tau))
+    vs = _window(v_lo, v_lo if off > p.rotate_threshold else v_hi, p.v_samples)
+    ws = _window(w_lo, w_hi, p.omega_samples)
+    brake_w = min(max(0.0, w_lo), w_hi)
+    v = np.concatenate((np.repeat(vs, ws.size), [v_lo]))
+    w = np.concatenate((np.tile(ws, vs.size), [brake_w]))
+    n = v.size
+    steps = max(1, round(p.horizon / p.dt))
+    t = _times(p.dt, steps)  # (K+1,): column 0 is the start pose
+    # Exact arcs: x = x0 + v/w (sin(th) - sin(th0)), y = y0 - v/w (cos(th) - cos(th0)).
+    # A straight line is the limit w -> 0; |w| >= 1e-6 rad/s keeps v/w finite and
+    # errs by < 1e-6 m over the horizon (no branch, no extra numpy calls).
+    w_eff = np.where(np.abs(w) < 1e-6, np.copysign(1e-6, w), w)
+    th = th0 + w_eff[:, None] * t[None, :]  # (N, K+1) heading
+    r = (v / w_eff)[:, None]
+    xs = x0 + r * (np.sin(th) - math.sin(th0))
+    ys = y0 - r * (np.cos(th) - math.cos(th0))
+    clear = clearance(xs.ravel(), ys.ravel()).reshape(n, steps + 1)
+    here = float(clear[0, 0])
+    threshold = min(p.radius, here - 1e-3)
+    hit = clear[:, 1:] < threshold
+    any_hit = hit.any(axis=1)
+    # The last pose before the first one under the threshold (column 0: the start).
+    last = np.where(any_hit, np.argmax(hit, axis=1), steps)
+    free = np.where(any_hit, v * t[last], np.inf)
+    stop = v * p.latency + v * v / (2.0 * p.max_accel)
+    admissible = stop <= free
+    count = int(admissible.sum())
+    if count == 0:
+        return DwaResult(
+            v=float(v_lo),
+            omega=float(brake_w),
+            admissible=0,
+            samples=n,
+            best_score=-math.inf,
+            clearance=here,
+            reason="no admissible trajectory: braking",
+        )
+    # A rollout that reaches a pose under the threshold is cut before it: it is scored
+    # where it can get to, not through the obstacle.
+    # Each rollout is judged at its closest approach to the target (up to its cut): a
+    # fast arc that passes the goal within the horizon is not worse than a slow one
+    # that stops short of it (judged at the end, the DWA crawls into every goal).
+    rows = np.arange(n)
+    to_target = np.hypot(tx - xs, ty - ys)
+    beyond = np.arange(steps + 1)[None, :] > last[:, None]
+    # Ties (a turn on the spot stays at one point) go to the latest pose: its heading.
+    late = to_target - 1e-9 * np.arange(steps + 1)[None, :]
+    best_i = np.argmin(np.where(beyond, np.inf, late), axis=1)
+    ex, ey = xs[rows, best_i], ys[rows, best_i]
+    closest = to_target[rows, best_i]
+    bearing = np.arctan2(ty - ey, tx - ex) - th[rows, best_i]
+    bearing = np.abs(np.remainder(bearing + math.pi, math.tau) - math.pi)
+    bearing = np.where(closest < 0.05, 0.0, bearing)  # at the target: no bearing to keep
+    d0 = math.hypot(tx - x0, ty - y0)
+    gain = (d0 - closest) / (p.max_v * p.horizon)
+    min_clear = clear.min(axis=1)
+    room = np.clip(min_clear - p.radius, 0.0, p.clearance_cap) / p.clearance_cap
+    score = (
+        p.w_heading * (1.0 - bearing / math.pi)
+        + p.w_progress * gain
+        + p.w_clearance * room
+        + p.w_speed * v / p.max_v
+    )
+    score = np.where(admissible, score, -np.inf)
+    best = int(np.argmax(score))
+    reason = "toward target" if room[best] >= 1.0 else "avoiding"
+    return DwaResult(
+        v=float(v[best]),
+        omega=float(w[best]),
+        admissible=count,
+        samples=n,
+        best_score=float(score[best]),
+        clearance=float(min_clear[best]),
+        reason=reason,
+    )

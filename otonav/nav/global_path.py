@@ -1,0 +1,129 @@
+"""A lightweight global planner: A* over a coarse grid of free cells (8-connected).
+
+The grid is a boolean ``free`` array (rows = y, columns = x) and a ``penalty`` per cell
+(>= 0, added to the step cost: keeps paths off obstacles when there is room). The search
+runs **from the goal to the robot**: when the goal is walled in, the search exhausts the
+small enclosed region at once instead of flooding the whole map around the robot; it
+is cut at ``max_expansions`` (then the answer is "unknown", not "unreachable").
+
+Plain Python on flat lists (no per-node numpy calls): ~1 us per neighbour examined.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ("GridPath", "astar")
+
+_SQRT2 = math.sqrt(2.0)
+
+
+@dataclass(frozen=True, slots=True)
+class GridPath:
+    """Result of :func:`astar`.
+
+    Attributes:
+        cells: (row, col) from start to goal; empty when no path was found.
+        cost: path cost in cells (1 per straight step, sqrt 2 per diagonal, plus the
+            penalties); inf when none.
+        expansions: cells taken off the open list.
+        exhausted: the search proved there is no path (every cell reachable from the
+            goal was expanded); False when it found one or hit ``max_expansions``.
+    """
+
+    cells: tuple[tuple[int, int], ...]
+    cost: float
+    expansions: int
+    exhausted: bool
+
+    @property
+    def found(self) -> bool:
+        return bool(self.cells)
+
+
+def astar(
+    free: NDArray[np.bool_],
+    penalty: NDArray[np.float64],
+    start: tuple[int, int],
+    goal: tuple[int, int],
+    *,
+    max_expansions: int = 200_000,
+) -> GridPath:
+    """Shortest 8-connected path of free cells from ``start`` to ``goal``.
+
+    The start and goal cells count as free whatever ``free`` says (the robot is where it
+    is; a goal on an inflated cell is still the goal). A diagonal step needs both of its
+    side cells free (no corner cutting).
+
+    Raises:
+        ValueError: if the shapes differ or ``start``/``goal`` is outside the grid.
+    """
+    if free.shape != penalty.shape or free.ndim != 2:
+        raise ValueError(f"free {free.shape} and penalty {penalty.shape} must be one 2-D shape")
+    rows, cols = free.shape
+    for name, (r, c) in (("start", start), ("goal", goal)):
+        if not (0 <= r < rows and 0 <= c < cols):
+            raise ValueError(f"{name} {(r, c)} is outside the {rows} x {cols} grid")
+    # Pad with a blocked border: no bounds checks in the inner loop.
+    w = cols + 2
+    ok = np.zeros((rows + 2, w), dtype=np.bool_)
+    ok[1:-1, 1:-1] = free
+    s = (start[0] + 1) * w + start[1] + 1
+    g = (goal[0] + 1) * w + goal[1] + 1
+    ok[s // w, s % w] = True
+    ok[g // w, g % w] = True
+    okl: list[bool] = ok.ravel().tolist()
+    pen = np.zeros((rows + 2, w), dtype=np.float64)
+    pen[1:-1, 1:-1] = penalty
+    penl: list[float] = pen.ravel().tolist()
+    sr, sc = divmod(s, w)
+    straight = (1, -1, w, -w)
+    diagonal = ((w + 1, 1, w), (w - 1, -1, w), (-w + 1, 1, -w), (-w - 1, -1, -w))
+    best: dict[int, float] = {g: 0.0}
+    parent: dict[int, int] = {}
+    closed: set[int] = set()
+
+    def h(cell: int) -> float:
+        r, c = divmod(cell, w)
+        dr, dc = abs(r - sr), abs(c - sc)
+        return float((dr + dc) + (_SQRT2 - 2.0) * min(dr, dc))
+
+    open_list: list[tuple[float, float, int]] = [(h(g), 0.0, g)]
+    expansions = 0
+    while open_list:
+        _, cost, cell = heapq.heappop(open_list)
+        if cell in closed:
+            continue
+        closed.add(cell)
+        expansions += 1
+        if cell == s:
+            path = [cell]
+            while cell != g:
+                cell = parent[cell]
+                path.append(cell)
+            cells = tuple(((p // w) - 1, (p % w) - 1) for p in path)
+            return GridPath(cells, cost, expansions, False)
+        if expansions >= max_expansions:
+            return GridPath((), math.inf, expansions, False)
+        for step in straight:
+            n = cell + step
+            if okl[n] and n not in closed:
+                c2 = cost + 1.0 + penl[n]
+                if c2 < best.get(n, math.inf):
+                    best[n] = c2
+                    parent[n] = cell
+                    heapq.heappush(open_list, (c2 + h(n), c2, n))
+        for step, side_a, side_b in diagonal:
+            n = cell + step
+            if okl[n] and okl[cell + side_a] and okl[cell + side_b] and n not in closed:
+                c2 = cost + _SQRT2 + penl[n]
+                if c2 < best.get(n, math.inf):
+                    best[n] = c2
+                    parent[n] = cell
+                    heapq.heappush(open_list, (c2 + h(n), c2, n))
+    return GridPath((), math.inf, expansions, True)

@@ -1,0 +1,435 @@
+"""The avoiding navigator's logic: map, global path, DWA, progress and the recovery
+ladder, in one deterministic object with no I/O (the actor feeds it and publishes).
+
+Units: m, s of sim time, rad; poses in odom.
+
+Each :meth:`Navigation.step` (at the navigator's rate):
+
+1. no goal: ``idle``; within ``tolerance``: ``reached``; after giving up:
+   ``unreachable`` (until a new goal);
+2. **global path** (:mod:`otonav.nav.global_path`) on the map's coarse grid, cells free
+   when their clearance is at least the centre clearance; replanned when there is none,
+   every ``replan_period`` s if the path ahead is blocked, and after each recovery.
+   No path, proven (the search exhausted every cell reachable from the goal): first
+   look around (the ``spin`` stage), then, if still none, ``unreachable``: "no path
+   to the goal in the observed map". The map only gains obstacles, so a second proof
+   stands;
+3. within ``approach_radius`` of the goal, a proportional controller finishes, forward
+   or in reverse (an overshoot is backed out of, not turned around); farther away,
+   **DWA** (:mod:`otonav.nav.dwa`) toward a point ``lookahead`` m along the path:
+   ``driving``, or ``avoiding`` when the chosen arc passes near a return; ``blocked``
+   when no arc is admissible;
+4. **progress** (:class:`~otonav.nav.recovery.ProgressChecker`): when it fails, the next
+   stage of the ladder runs (``recovering``): ``spin`` (turn ``spin_angle`` toward the
+   goal side), ``backup`` (reverse ``backup_distance``), ``follow`` (follow the
+   obstacle's boundary on the side that heads closer to the goal, Bug2-style, until
+   ``distance`` m closer to the goal than where it started or ``follow_time`` s),
+   then ``unreachable``: "no progress after spin, backup and follow". Getting
+   ``distance`` m closer to the goal than at the start of the ladder resets it. The
+   ladder runs once: the robot never oscillates until the budget ends.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from otonav.nav.costmap import ClearanceMap
+from otonav.nav.dwa import DwaParams, DwaResult, dwa_step
+from otonav.nav.geometry import wrap_angle
+from otonav.nav.global_path import astar
+from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
+
+__all__ = ("LADDER", "NavOutput", "Navigation", "NavigationParams", "Points")
+
+Points = NDArray[np.float64] | Callable[[], NDArray[np.float64]]
+"""Scan returns in base_link, ``(N, 2)`` m, or a function that computes them."""
+
+
+def _resolve(points: Points) -> NDArray[np.float64]:
+    return points() if callable(points) else points
+
+
+LADDER = ("spin", "backup", "follow")
+"""The recovery stages, in order."""
+
+
+@dataclass(frozen=True, slots=True)
+class NavigationParams:
+    """Settings of :class:`Navigation` (units in the names' docs, stack config ``nav.*``).
+
+    Attributes:
+        dwa: the local planner's settings (its ``radius`` is the centre clearance).
+        tolerance: goal reached within this distance, m.
+        map_half_size: the map spans this far from the start in x and y, m.
+        map_resolution: map cell, m.
+        plan_resolution: global planner cell, m (a multiple of ``map_resolution``).
+        plan_penalty: extra cost per cell near obstacles (0: shortest path).
+        replan_period: blocked-path check period, s.
+        lookahead: the DWA's target is this far along the path, m.
+        max_expansions: A* gives up (no proof either way) after this many cells.
+        progress_distance: progress that counts, m.
+        progress_window: time to move ``progress_distance``, s.
+        goal_progress_window: time to get ``progress_distance`` closer to the goal, s.
+        spin_angle: the look-around turn, rad.
+        spin_speed: its yaw rate, rad/s.
+        backup_distance: the back-up distance, m.
+        backup_speed: its speed, m/s.
+        follow_time: the longest boundary following, s.
+        follow_speed: its speed, m/s.
+        follow_distance: centre-to-boundary distance while following, m.
+        approach_radius: within this distance of the goal a proportional controller
+            finishes (forward or in reverse, whichever faces the goal), m.
+        kp_lin: its speed per metre of distance, 1/s.
+        kp_ang: its yaw rate per radian of heading error, 1/s.
+    """
+
+    dwa: DwaParams = field(default_factory=DwaParams)
+    tolerance: float = 0.08
+    map_half_size: float = 10.0
+    map_resolution: float = 0.05
+    plan_resolution: float = 0.1
+    plan_penalty: float = 2.0
+    replan_period: float = 0.5
+    lookahead: float = 0.8
+    max_expansions: int = 60_000
+    progress_distance: float = 0.3
+    progress_window: float = 4.0
+    goal_progress_window: float = 15.0
+    spin_angle: float = math.pi / 2
+    spin_speed: float = 1.0
+    backup_distance: float = 0.3
+    backup_speed: float = 0.1
+    follow_time: float = 8.0
+    follow_speed: float = 0.2
+    follow_distance: float = 0.45
+    approach_radius: float = 0.25
+    kp_lin: float = 0.8
+    kp_ang: float = 2.0
+
+
+@dataclass(frozen=True, slots=True)
+class NavOutput:
+    """One step's command and what explains it."""
+
+    v: float
+    omega: float
+    state: str
+    """idle | driving | avoiding | blocked | recovering | unreachable | reached."""
+    reason: str
+    distance: float
+    heading_error: float
+    dwa: DwaResult | None = None
+    stage: str = ""
+    path_length: float = math.nan
+    replans: int = 0
+
+
+@dataclass(slots=True)
+class _Stage:
+    name: str
+    started: float
+    x: float
+    y: float
+    yaw: float
+    goal_distance: float
+    side: int = 1
+
+
+@dataclass(slots=True)
+class Navigation:
+    """The avoiding navigator's state (see the module docstring)."""
+
+    params: NavigationParams
+    start: tuple[float, float]
+    goal: tuple[float, float] | None = None
+    map: ClearanceMap = field(init=False)
+    path: NDArray[np.float64] | None = None
+    path_length: float = math.nan
+    replans: int = 0
+    _checker: ProgressChecker = field(init=False)
+    _planned_at: float = -math.inf
+    _checked_at: float = -math.inf
+    _looked_around: bool = False
+    _ladder: int = 0
+    _ladder_best: float = math.inf
+    _stage: _Stage | None = None
+    _gave_up: str | None = None
+    _stride: int = field(init=False)
+
+    def __post_init__(self) -> None:
+        p = self.params
+        self.map = ClearanceMap(
+            self.start[0],
+            self.start[1],
+            half_size=p.map_half_size,
+            resolution=p.map_resolution,
+            max_distance=max(p.dwa.radius + p.dwa.clearance_cap, p.follow_distance) + 0.05,
+        )
+        self._stride = max(1, round(p.plan_resolution / p.map_resolution))
+        self._checker = ProgressChecker(
+            p.progress_distance, p.progress_window, p.goal_progress_window
+        )
+
+    # -- inputs ------------------------------------------------------------------------
+
+    def set_goal(self, goal: tuple[float, float]) -> None:
+        if goal != self.goal:
+            self.goal = goal
+            self.path = None
+            self._gave_up = None
+            self._stage = None
+            self._ladder = 0
+            self._ladder_best = math.inf
+            self._looked_around = False
+            self._checker.reset()
+
+    def observe(self, points_odom: NDArray[np.float64]) -> int:
+        """Record a scan's returns (odom); returns how many map cells were new."""
+        return self.map.mark(points_odom)
+
+    # -- the step ----------------------------------------------------------------------
+
+    def step(
+        self,
+        now: float,
+        pose: tuple[float, float, float],
+        v0: float,
+        omega0: float,
+        points: Points,
+    ) -> NavOutput:
+        """One decision. ``points``: the latest scan's returns in the current
+        base_link, or a function that computes them (only boundary following needs
+        them, so the caller's transform is skipped otherwise)."""
+        if self.goal is None:
+            return NavOutput(0.0, 0.0, "idle", "no goal", math.inf, 0.0)
+        x, y, yaw = pose
+        gx, gy = self.goal
+        distance = math.hypot(gx - x, gy - y)
+        heading = wrap_angle(math.atan2(gy - y, gx - x) - yaw)
+        if self._gave_up is not None:
+            return self._out(0.0, 0.0, "unreachable", self._gave_up, distance, heading)
+        if distance <= self.params.tolerance:
+            self._stage = None
+            return self._out(0.0, 0.0, "reached", "within tolerance", distance, heading)
+        if self._stage is not None:
+            out = self._recover(now, pose, distance, heading, points)
+            if out is not None:
+                return out
+        due = now - self._checked_at >= self.params.replan_period
+        if due:
+            self._checked_at = now
+        replan = self.path is None or (due and self._path_blocked(pose))
+        if replan:
+            proven_none = self._plan(now, pose)
+            if proven_none:
+                if not self._looked_around:
+                    self._looked_around = True
+                    return self._begin(
+                        "spin", now, pose, distance, heading, points, "no path, looking around"
+                    )
+                return self._give_up("no path to the goal in the observed map", distance, heading)
+        stuck = self._checker.update(now, x, y, distance)
+        if distance <= self._ladder_best - self.params.progress_distance:
+            self._ladder, self._ladder_best = 0, distance
+        if stuck is not None:
+            if self._ladder >= len(LADDER):
+                return self._give_up(
+                    f"no progress after {', '.join(LADDER)} ({stuck})", distance, heading
+                )
+            stage = LADDER[self._ladder]
+            self._ladder += 1
+            return self._begin(stage, now, pose, distance, heading, points, stuck)
+        if distance < self.params.approach_radius:
+            return self._approach(distance, heading)
+        target = self._target(pose)
+        result = dwa_step(pose, v0, omega0, target, distance, self.map.clearance, self.params.dwa)
+        if result.admissible == 0:
+            state = "blocked"
+        else:
+            state = "avoiding" if result.reason == "avoiding" else "driving"
+        return self._out(result.v, result.omega, state, result.reason, distance, heading, result)
+
+    # -- pieces ------------------------------------------------------------------------
+
+    def _out(
+        self,
+        v: float,
+        omega: float,
+        state: str,
+        reason: str,
+        distance: float,
+        heading: float,
+        dwa: DwaResult | None = None,
+    ) -> NavOutput:
+        return NavOutput(
+            v,
+            omega,
+            state,
+            reason,
+            distance,
+            heading,
+            dwa,
+            self._stage.name if self._stage is not None else "",
+            self.path_length if self.path is not None else math.nan,
+            self.replans,
+        )
+
+    def _approach(self, distance: float, heading: float) -> NavOutput:
+        """The last centimetres: P-control on distance and heading, in reverse when the
+        goal is behind (an overshoot is undone by backing up, not by a U-turn); the
+        safety layer still checks every command."""
+        p = self.params
+        ahead = abs(heading) <= math.pi / 2
+        facing = heading if ahead else wrap_angle(heading - math.pi)
+        v_max = min(p.dwa.max_v, math.sqrt(p.dwa.max_accel * distance))
+        v = min(p.kp_lin * distance, v_max) * math.cos(facing) * (1.0 if ahead else -1.0)
+        omega = min(max(p.kp_ang * facing, -p.dwa.max_omega), p.dwa.max_omega)
+        return self._out(v, omega, "driving", "final approach", distance, heading)
+
+    def _give_up(self, reason: str, distance: float, heading: float) -> NavOutput:
+        self._gave_up = reason
+        self._stage = None
+        return self._out(0.0, 0.0, "unreachable", reason, distance, heading)
+
+    def _free_grid(self) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
+        coarse = self.map.coarse(self._stride).astype(np.float64)
+        radius = self.params.dwa.radius
+        free = coarse >= radius
+        room = self.params.dwa.clearance_cap
+        penalty = self.params.plan_penalty * np.clip(radius + room - coarse, 0.0, room) / room
+        return free, penalty
+
+    def _coarse_cell(self, x: float, y: float) -> tuple[int, int]:
+        s, res = self._stride, self.map.resolution
+        col = math.floor((x - self.map.origin_x) / (res * s))
+        row = math.floor((y - self.map.origin_y) / (res * s))
+        n = self.map.coarse(s).shape[0]
+        return min(max(row, 0), n - 1), min(max(col, 0), n - 1)
+
+    def _plan(self, now: float, pose: tuple[float, float, float]) -> bool:
+        """Replan; True when the search proved there is no path."""
+        assert self.goal is not None
+        self._planned_at = self._checked_at = now
+        self.replans += 1
+        free, penalty = self._free_grid()
+        result = astar(
+            free,
+            penalty,
+            self._coarse_cell(pose[0], pose[1]),
+            self._coarse_cell(*self.goal),
+            max_expansions=self.params.max_expansions,
+        )
+        if not result.found:
+            self.path = None
+            return result.exhausted
+        s, res = self._stride, self.map.resolution
+        cells = np.asarray(result.cells, dtype=np.float64)
+        xy = np.empty((cells.shape[0], 2))
+        xy[:, 0] = self.map.origin_x + (cells[:, 1] * s + s // 2 + 0.5) * res
+        xy[:, 1] = self.map.origin_y + (cells[:, 0] * s + s // 2 + 0.5) * res
+        xy[0] = pose[:2]
+        xy[-1] = self.goal
+        self.path = xy
+        self.path_length = float(np.hypot(*np.diff(xy, axis=0).T).sum())
+        return False
+
+    def _path_blocked(self, pose: tuple[float, float, float]) -> bool:
+        if self.path is None:
+            return True
+        ahead = self._ahead(pose)
+        if ahead.shape[0] == 0:
+            return False
+        clear = self.map.clearance(ahead[:, 0], ahead[:, 1])
+        return bool((clear[:-1] < self.params.dwa.radius).any()) if clear.size > 1 else False
+
+    def _ahead(self, pose: tuple[float, float, float]) -> NDArray[np.float64]:
+        assert self.path is not None
+        d = np.hypot(self.path[:, 0] - pose[0], self.path[:, 1] - pose[1])
+        return self.path[int(np.argmin(d)) :]
+
+    def _target(self, pose: tuple[float, float, float]) -> tuple[float, float]:
+        assert self.goal is not None
+        if self.path is None:
+            return self.goal
+        ahead = self._ahead(pose)
+        d = np.hypot(ahead[:, 0] - pose[0], ahead[:, 1] - pose[1])
+        beyond = np.nonzero(d >= self.params.lookahead)[0]
+        if beyond.size == 0:
+            return self.goal
+        p = ahead[int(beyond[0])]
+        return float(p[0]), float(p[1])
+
+    def _begin(
+        self,
+        name: str,
+        now: float,
+        pose: tuple[float, float, float],
+        distance: float,
+        heading: float,
+        points: Points,
+        why: str,
+    ) -> NavOutput:
+        if name == "follow":
+            side = boundary_side(_resolve(points), heading)
+        else:
+            side = 1 if heading >= 0 else -1
+        self._stage = _Stage(name, now, pose[0], pose[1], pose[2], distance, side)
+        if self._ladder_best == math.inf:
+            self._ladder_best = distance
+        out = self._recover(now, pose, distance, heading, points)
+        assert out is not None
+        return NavOutput(
+            out.v,
+            out.omega,
+            out.state,
+            f"{name}: {why}",
+            distance,
+            heading,
+            None,
+            name,
+            out.path_length,
+            out.replans,
+        )
+
+    def _recover(
+        self,
+        now: float,
+        pose: tuple[float, float, float],
+        distance: float,
+        heading: float,
+        points: Points,
+    ) -> NavOutput | None:
+        """The current stage's command, or None when it is over (then replan, drive)."""
+        st, p = self._stage, self.params
+        assert st is not None
+        elapsed = now - st.started
+        done = False
+        v = omega = 0.0
+        if st.name == "spin":
+            turned = abs(wrap_angle(pose[2] - st.yaw))
+            done = turned >= p.spin_angle - 0.05 or elapsed > p.spin_angle / p.spin_speed + 2.0
+            omega = st.side * p.spin_speed
+        elif st.name == "backup":
+            moved = math.hypot(pose[0] - st.x, pose[1] - st.y)
+            done = moved >= p.backup_distance or elapsed > p.backup_distance / p.backup_speed + 2.0
+            v = -p.backup_speed
+        else:
+            done = elapsed > p.follow_time or distance <= st.goal_distance - p.progress_distance
+            v, omega = follow_boundary(
+                _resolve(points),
+                st.side,
+                distance=p.follow_distance,
+                speed=p.follow_speed,
+                max_omega=p.dwa.max_omega,
+            )
+        if done:
+            self._stage = None
+            self._checker.reset()
+            self.path = None  # replan from here
+            return None
+        return self._out(v, omega, "recovering", st.name, distance, heading)

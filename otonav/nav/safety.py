@@ -1,0 +1,150 @@
+"""The safety limit: can the robot still stop before its centre comes too close?
+
+A pure function in the spirit of Nav2's collision monitor, trusting nothing the planner
+says. Frames and units: the returns are points in the *current* base_link (m; the
+caller moves the last scan into it with odometry); commands are body twists (m/s,
+rad/s).
+
+Model of what a command does (the base controller's behaviour, conservatively): for
+``latency`` s (the safety period + the base period + the drive's lag) the velocity
+ramps from the current one toward the command at the base's limits ``max_accel`` /
+``max_alpha``; then both ramp to zero at the same limits. The centre (base_link, the
+judged point, on the wheel axle) follows that unicycle path, integrated every ``dt``
+s: forward, reverse, and the arc of a turning robot alike. A turn on the spot does not
+move the centre.
+
+A command is *safe* when along that path the centre never comes closer than ``radius``
+to a return, except that a return already closer may not get closer than it is (so a
+robot inside the radius can still back away). The output is the command with its
+forward speed scaled down by the largest of ``1, 0.8, ..., 0`` that is safe (the
+turn rate kept); if even the stop with the turn is unsafe, it is (0, 0): braking is
+the best there is. Returns farther than the longest stopping path plus ``radius``
+cannot matter and are skipped (the common case costs one distance per return).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ("SafetyParams", "SafetyResult", "safe_command")
+
+
+@dataclass(frozen=True, slots=True)
+class SafetyParams:
+    """Settings of :func:`safe_command`.
+
+    Attributes:
+        radius: centre clearance to keep (footprint.centre_clearance), m (> 0).
+        max_accel: the base's linear acceleration/deceleration limit, m/s^2 (> 0).
+        max_alpha: the base's angular acceleration limit, rad/s^2 (> 0).
+        latency: delay before braking starts, s (>= 0).
+        dt: integration step of the stopping path, s (> 0).
+        scales: forward-speed scales tried, from 1 down to 0 (>= 2).
+    """
+
+    radius: float = 0.33
+    max_accel: float = 1.0
+    max_alpha: float = 3.0
+    latency: float = 0.12
+    dt: float = 0.02
+    scales: int = 6
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if f.name == "scales":
+                if not (isinstance(value, int) and value >= 2):
+                    raise ValueError(f"SafetyParams.scales must be an integer >= 2, got {value!r}")
+                continue
+            ok = value >= 0.0 if f.name == "latency" else value > 0.0
+            if not (math.isfinite(value) and ok):
+                bound = ">= 0" if f.name == "latency" else "> 0"
+                raise ValueError(f"SafetyParams.{f.name} must be finite and {bound}, got {value!r}")
+
+
+@dataclass(frozen=True, slots=True)
+class SafetyResult:
+    """Output of :func:`safe_command`.
+
+    Attributes:
+        v: limited forward speed, m/s.
+        omega: limited yaw rate, rad/s.
+        scale: the forward-speed scale applied (1: untouched).
+        nearest: distance from the centre to the nearest return, m (inf if none).
+        reason: ``clear`` (nothing in reach), ``safe`` (checked, untouched),
+            ``limited`` (slowed) or ``stopped``.
+    """
+
+    v: float
+    omega: float
+    scale: float
+    nearest: float
+    reason: str
+
+
+def _profile(
+    start: float, target: NDArray[np.float64], t: NDArray[np.float64], latency: float, limit: float
+) -> NDArray[np.float64]:
+    """Velocity at times ``t`` (mid-step) for each target: ramp from ``start`` toward
+    the target at ``limit`` until ``latency``, then ramp to zero at ``limit``."""
+    tm = t - 0.5 * (t[1] - t[0] if t.size > 1 else 0.0)
+    ramp = np.minimum(tm, latency)[None, :]
+    before = start + np.clip(target[:, None] - start, -limit * ramp, limit * ramp)
+    after = np.maximum(tm - latency, 0.0)[None, :]
+    return np.sign(before) * np.maximum(np.abs(before) - limit * after, 0.0)
+
+
+def safe_command(
+    v_cmd: float,
+    omega_cmd: float,
+    v0: float,
+    omega0: float,
+    points: NDArray[np.float64],
+    params: SafetyParams,
+) -> SafetyResult:
+    """The command limited so the robot can always stop in time (module docstring).
+
+    Args:
+        v_cmd: commanded forward speed, m/s.
+        omega_cmd: commanded yaw rate, rad/s.
+        v0: current forward speed, m/s.
+        omega0: current yaw rate, rad/s.
+        points: ``(N, 2)`` returns in the current base_link, m.
+        params: settings.
+    """
+    p = params
+    d0 = np.hypot(points[:, 0], points[:, 1]) if points.shape[0] else np.empty(0)
+    nearest = float(d0.min()) if d0.size else math.inf
+    fastest = max(abs(v_cmd), abs(v0))
+    reach = fastest * p.latency + fastest * fastest / (2.0 * p.max_accel) + 2.0 * p.dt * fastest
+    near = d0 < p.radius + reach + 1e-6
+    if not near.any():
+        return SafetyResult(v_cmd, omega_cmd, 1.0, nearest, "clear")
+    pts, dn = points[near], d0[near]
+    allowed = np.minimum(p.radius, dn - 1e-4)  # inside the radius: no closer than now
+    scales = np.linspace(1.0, 0.0, p.scales)
+    v_t = np.append(scales * v_cmd, 0.0)
+    w_t = np.append(np.full(p.scales, omega_cmd), 0.0)
+    top_v = np.maximum(np.abs(v_t), abs(v0)) + p.max_accel * p.latency
+    top_w = np.maximum(np.abs(w_t), abs(omega0)) + p.max_alpha * p.latency
+    duration = p.latency + max(float(top_v.max()) / p.max_accel, float(top_w.max()) / p.max_alpha)
+    t = p.dt * np.arange(1, math.ceil(duration / p.dt) + 2, dtype=np.float64)  # (K,)
+    v = _profile(v0, v_t, t, p.latency, p.max_accel)  # (n, K)
+    w = _profile(omega0, w_t, t, p.latency, p.max_alpha)
+    th = np.cumsum(w, axis=1) * p.dt
+    x = np.cumsum(v * np.cos(th - 0.5 * w * p.dt), axis=1) * p.dt
+    y = np.cumsum(v * np.sin(th - 0.5 * w * p.dt), axis=1) * p.dt
+    gap = np.hypot(pts[None, None, :, 0] - x[:, :, None], pts[None, None, :, 1] - y[:, :, None])
+    worst = (gap - allowed).min(axis=(1, 2))
+    ok = worst >= 0.0
+    for i in range(p.scales):
+        if ok[i]:
+            if i == 0:
+                return SafetyResult(v_cmd, omega_cmd, 1.0, nearest, "safe")
+            why = "limited" if scales[i] > 0.0 else "stopped"
+            return SafetyResult(float(v_t[i]), omega_cmd, float(scales[i]), nearest, why)
+    return SafetyResult(0.0, 0.0, 0.0, nearest, "stopped")

@@ -1,0 +1,263 @@
+"""The avoiding navigator's pure pieces: footprint, scan points, the clearance map, A*,
+the DWA step, progress and recovery, and the Navigation object on synthetic scans."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from otonav.hal import RobotGeometry
+from otonav.hal.mujoco import MujocoInterface
+from otonav.nav.costmap import ClearanceMap
+from otonav.nav.dwa import DwaParams, dwa_step
+from otonav.nav.footprint import centre_clearance
+from otonav.nav.global_path import astar
+from otonav.nav.navigation import Navigation, NavigationParams
+from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
+from otonav.nav.scan import scan_points, to_frame
+
+pytestmark = pytest.mark.unit
+
+
+def _wall(x: float, y0: float, y1: float, step: float = 0.02) -> np.ndarray:
+    ys = np.arange(y0, y1 + 1e-9, step)
+    return np.stack((np.full_like(ys, x), ys), axis=1)
+
+
+# -- footprint -------------------------------------------------------------------------
+
+
+def test_footprint_is_read_from_the_mjcf() -> None:
+    hal = MujocoInterface("empty")
+    try:
+        fp = hal.geometry.footprint
+    finally:
+        hal.close()
+    xs = [p[0] for p in fp]
+    ys = [p[1] for p in fp]
+    # chassis box 0.30 m long centred 0.06 m ahead of the axle; wheels to y = +-0.1225
+    assert min(xs) == pytest.approx(-0.09, abs=1e-6)
+    assert max(xs) == pytest.approx(0.21, abs=1e-6)
+    assert max(ys) == pytest.approx(0.1225, abs=1e-6)
+    assert min(ys) == pytest.approx(-0.1225, abs=1e-6)
+    assert hal.geometry.footprint == RobotGeometry(0.05, 0.22, 0.06, 0.09).footprint
+
+
+def test_centre_clearance_is_the_larger_of_clearance_and_footprint() -> None:
+    assert centre_clearance(0.32, 0.243, 0.03) == 0.32
+    assert centre_clearance(0.32, 0.5, 0.05) == pytest.approx(0.55)
+    with pytest.raises(ValueError, match="padding"):
+        centre_clearance(0.3, 0.2, -0.1)
+
+
+# -- scan points -----------------------------------------------------------------------
+
+
+def test_scan_points_in_base_link_and_blocked_beams() -> None:
+    ranges = np.array([1.0, np.inf, -np.inf, 0.05, np.nan, 9.0], dtype=np.float32)
+    inc = math.pi / 2
+    seen = scan_points(ranges, 0.0, inc, 0.12, 8.0, 0.06)
+    assert seen.blocked
+    # beam 0: 1 m ahead of the laser; beams 2 and 3: blocked, at range_min / 2
+    assert seen.xy.shape == (3, 2)
+    assert seen.xy[0] == pytest.approx([1.06, 0.0])
+    assert seen.xy[1] == pytest.approx([0.06 - 0.06, 0.0], abs=1e-9)  # beam 2 points back
+    assert seen.xy[2] == pytest.approx([0.06, -0.06], abs=1e-9)
+    clean = scan_points(np.array([1.0, np.inf]), 0.0, inc, 0.12, 8.0, 0.0)
+    assert not clean.blocked
+    assert clean.xy.shape == (1, 2)
+
+
+def test_to_frame_round_trip() -> None:
+    pts = np.array([[1.0, 0.0], [0.0, 2.0]])
+    odom = to_frame(pts, (1.0, 1.0, math.pi / 2))
+    assert odom == pytest.approx(np.array([[1.0, 2.0], [-1.0, 1.0]]))
+    back = to_frame(pts, (1.0, 1.0, math.pi / 2), (1.0, 1.0, math.pi / 2))
+    assert back == pytest.approx(pts)
+
+
+# -- clearance map ---------------------------------------------------------------------
+
+
+def test_clearance_is_a_lower_bound_capped_and_unknown_is_free() -> None:
+    m = ClearanceMap(0.0, 0.0, half_size=2.0, resolution=0.025, max_distance=0.6)
+    assert m.mark(np.array([[1.0, 0.0]])) == 1
+    assert m.mark(np.array([[1.001, 0.001]])) == 0  # same cell: nothing new
+    qx = np.array([1.0, 0.7, 0.5, -1.0, 5.0])
+    qy = np.zeros(5)
+    c = m.clearance(qx, qy)
+    true = np.abs(qx - 1.0)
+    assert (c[:3] <= true[:3] + 1e-6).all()  # never more than the truth
+    assert (c[:3] >= np.minimum(true[:3], 0.6) - 0.08).all()  # and not much less
+    assert c[3] == pytest.approx(0.6)  # farther than the cap
+    assert c[4] == pytest.approx(0.6)  # outside the map
+
+
+# -- A* --------------------------------------------------------------------------------
+
+
+def test_astar_goes_around_a_wall_and_proves_an_enclosed_goal() -> None:
+    free = np.ones((20, 20), dtype=np.bool_)
+    free[2:18, 10] = False
+    pen = np.zeros((20, 20))
+    path = astar(free, pen, (10, 2), (10, 17))
+    assert path.found
+    assert path.cells[0] == (10, 2)
+    assert path.cells[-1] == (10, 17)
+    assert all(free[r, c] for r, c in path.cells)
+    assert path.cost > 15  # longer than the straight line (it goes around)
+    boxed = free.copy()
+    boxed[8, 14:19] = boxed[12, 14:19] = False
+    boxed[8:13, 14] = boxed[8:13, 18] = False
+    none = astar(boxed, pen, (10, 2), (10, 16))
+    assert not none.found
+    assert none.exhausted
+    assert none.expansions < 20  # searched from the goal: only the box's inside
+
+
+# -- DWA -------------------------------------------------------------------------------
+
+
+def _map_with(points: np.ndarray) -> ClearanceMap:
+    m = ClearanceMap(0.0, 0.0, half_size=5.0, resolution=0.025, max_distance=0.65)
+    m.mark(points)
+    return m
+
+
+def test_dwa_in_the_open_heads_for_the_target_and_speeds_up() -> None:
+    m = _map_with(np.empty((0, 2)))
+    r = dwa_step((0.0, 0.0, 0.0), 0.2, 0.0, (2.0, 0.0), 2.0, m.clearance, DwaParams())
+    assert r.admissible == r.samples
+    assert r.v > 0.2
+    assert abs(r.omega) < 0.2
+    assert r.reason == "toward target"
+
+
+def test_dwa_never_picks_an_arc_it_cannot_stop_on() -> None:
+    m = _map_with(_wall(0.5, -1.0, 1.0))
+    p = DwaParams()
+    r = dwa_step((0.0, 0.0, 0.0), 0.4, 0.0, (2.0, 0.0), 2.0, m.clearance, p)
+    assert 0 < r.admissible < r.samples
+    # what it chose can stop before the radius: v*latency + v^2/2a within the free 0.17 m
+    assert r.v * p.latency + r.v**2 / (2 * p.max_accel) <= 0.5 - p.radius + 1e-9
+    assert r.v < 0.4
+    closer = _map_with(_wall(0.45, -1.0, 1.0))
+    none = dwa_step((0.0, 0.0, 0.0), 0.4, 0.0, (2.0, 0.0), 2.0, closer.clearance, p)
+    assert none.admissible == 0
+    assert none.v == pytest.approx(0.35)  # the window's lowest speed: braking
+    assert "braking" in none.reason
+
+
+def test_dwa_does_not_crawl_into_a_goal_inside_its_horizon() -> None:
+    m = _map_with(np.empty((0, 2)))
+    # Goal 0.3 m ahead, 0.4 m/s now: an arc through the goal beats one stopping short.
+    r = dwa_step((0.0, 0.0, 0.0), 0.4, 0.0, (0.3, 0.0), 0.3, m.clearance, DwaParams())
+    assert r.v >= 0.35
+
+
+def test_dwa_turns_first_toward_a_target_behind() -> None:
+    m = _map_with(np.empty((0, 2)))
+    r = dwa_step((0.0, 0.0, 0.0), 0.0, 0.0, (-2.0, 0.1), 2.0, m.clearance, DwaParams())
+    assert r.v == 0.0
+    assert r.omega > 0.0
+
+
+def test_dwa_params_validate() -> None:
+    with pytest.raises(ValueError, match="horizon"):
+        DwaParams(horizon=0.0)
+    with pytest.raises(ValueError, match="v_samples"):
+        DwaParams(v_samples=0)
+
+
+# -- progress and recovery -------------------------------------------------------------
+
+
+def test_progress_checker_flags_dithering_and_oscillation() -> None:
+    pc = ProgressChecker(distance=0.3, window=4.0, goal_window=10.0)
+    assert pc.update(0.0, 0.0, 0.0, 5.0) is None
+    assert pc.update(3.9, 0.1, 0.0, 4.9) is None
+    assert "in 4 s" in (pc.update(4.0, 0.1, 0.0, 4.9) or "")
+    pc.reset()
+    # Back and forth 1 m: always moving, never closer to the goal.
+    for i in range(0, 101):
+        t = 0.1 * i
+        x = 0.5 * math.sin(t)
+        why = pc.update(t, x, 0.0, 5.0 - 0.05 * math.sin(t))
+        if why is not None:
+            assert "closer to the goal" in why
+            assert t >= 10.0
+            break
+    else:
+        pytest.fail("oscillation never flagged")
+
+
+def test_boundary_side_and_follow_keep_the_obstacle_on_that_side() -> None:
+    wall = _wall(0.5, -1.0, 1.0) - np.array([0.0, 0.0])
+    # Goal ahead and to the left: go left, keeping the wall on the right.
+    assert boundary_side(wall + np.array([0.0, -0.3]), goal_bearing=0.3) == -1
+    assert boundary_side(wall + np.array([0.0, 0.3]), goal_bearing=-0.3) == 1
+    v, omega = follow_boundary(wall, -1, distance=0.45, speed=0.2, max_omega=1.2)
+    assert omega > 0.0  # turning left to put the wall on the right
+    side = np.stack((np.linspace(-1, 1, 50), np.full(50, -0.45)), axis=1)
+    v, omega = follow_boundary(side, -1, distance=0.45, speed=0.2, max_omega=1.2)
+    assert v == pytest.approx(0.2, abs=0.01)
+    assert abs(omega) < 0.15
+
+
+# -- Navigation ------------------------------------------------------------------------
+
+
+def _box_points(cx: float, cy: float, hx: float, hy: float) -> np.ndarray:
+    nx, ny = round(2 * hx / 0.02) + 1, round(2 * hy / 0.02) + 1
+    top = np.stack((np.linspace(cx - hx, cx + hx, nx), np.full(nx, cy + hy)), 1)
+    bottom = top - np.array([0.0, 2 * hy])
+    left = np.stack((np.full(ny, cx - hx), np.linspace(cy - hy, cy + hy, ny)), 1)
+    right = left + np.array([2 * hx, 0.0])
+    return np.concatenate((top, bottom, left, right))
+
+
+def test_navigation_gives_up_on_an_enclosed_goal_after_looking_around() -> None:
+    nav = Navigation(NavigationParams(), (0.0, 0.0))
+    nav.set_goal((3.0, 0.0))
+    nav.observe(_box_points(3.0, 0.0, 0.8, 0.8))
+    first = nav.step(0.0, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
+    assert first.state == "recovering"
+    assert first.stage == "spin"
+    t, yaw = 0.0, 0.0
+    out = first
+    while out.state == "recovering" and t < 10.0:
+        t += 0.05
+        yaw += out.omega * 0.05
+        out = nav.step(t, (0.0, 0.0, yaw), 0.0, out.omega, np.empty((0, 2)))
+    assert out.state == "unreachable"
+    assert "no path" in out.reason
+    assert t < 3.0
+    again = nav.step(t + 1.0, (0.0, 0.0, yaw), 0.0, 0.0, np.empty((0, 2)))
+    assert again.state == "unreachable"  # latched until a new goal
+    nav.set_goal((-2.0, 0.0))
+    assert nav.step(t + 1.1, (0.0, 0.0, yaw), 0.0, 0.0, np.empty((0, 2))).state != "unreachable"
+
+
+def test_navigation_plans_around_a_box_and_reports_reached() -> None:
+    nav = Navigation(NavigationParams(), (0.0, 0.0))
+    nav.set_goal((3.0, 0.0))
+    nav.observe(_box_points(1.5, 0.0, 0.3, 0.4))
+    out = nav.step(0.0, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
+    assert out.state in ("driving", "avoiding")
+    assert nav.path is not None
+    assert out.path_length > 3.0  # around the box, not through it
+    assert np.abs(nav.path[:, 1]).max() > 0.6
+    done = nav.step(1.0, (2.95, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
+    assert done.state == "reached"
+    assert (done.v, done.omega) == (0.0, 0.0)
+
+
+def test_an_overshot_goal_is_backed_into_not_turned_around() -> None:
+    nav = Navigation(NavigationParams(), (0.0, 0.0))
+    nav.set_goal((1.0, 0.0))
+    out = nav.step(0.0, (1.12, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))  # 0.12 m past it
+    assert out.reason == "final approach"
+    assert out.v < 0.0
+    assert abs(out.omega) < 1e-9
