@@ -102,8 +102,11 @@ def step_times() -> None:
                 ("planner tick (step + map update)", ticks),
                 ("  Navigation.step", steps),
                 ("  Navigation.observe (per scan)", observes),
-                ("safety check (safe_command)", checks),
+                ("safety check (safe_command, slow path)", checks),
             ):
+                if not values:  # the layer's fast path: nothing was ever within reach
+                    print(f"  {label:<36} never called (nothing within reach)")
+                    continue
                 print(
                     f"  {label:<36} median {1e3 * statistics.median(values):6.3f} ms   "
                     f"p95 {1e3 * _pct(values, 0.95):6.3f} ms   max {1e3 * max(values):6.2f} ms"
