@@ -41,6 +41,7 @@ RUNNERS: dict[str, str] = {
     "async for record in sweep_results": "the sweep from Python",
     "async def watch": "the live embedding",
     "async def simulate": "the fast simulations",
+    "generate_world(7, DENSE)": "the world generator",
 }
 
 
@@ -148,3 +149,10 @@ def test_an_embedding_example_runs(
     (tmp_path / "sweep.yaml").write_text("name: readme\nscenarios: [empty]\nseeds: [0]\n")
     out = _run_async(_block(marker), call)
     assert check(out, tmp_path), out
+
+
+def test_the_world_generator_example_runs() -> None:
+    namespace: dict[str, Any] = {}
+    exec(compile(_block("generate_world(7, DENSE)"), "README.md", "exec"), namespace)
+    assert namespace["world"].reachable
+    assert [w.scenario.expect for w in namespace["family"]] == ["unreachable"] * 3
