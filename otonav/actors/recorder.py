@@ -94,9 +94,12 @@ class Recorder(Actor):
     def drain(self) -> None:
         """Write everything still queued (on stop, and before a verdict is appended)."""
         funnel, writer = self.funnel, self.writer
-        while (delivery := funnel.try_recv()) is not None:
-            if not writer.finished:
-                writer.write(delivery.topic, delivery.message, delivery.time)
+        deliveries = iter(funnel.try_recv, None)
+        if writer.finished:
+            for _ in deliveries:  # taken, and nowhere to write them
+                pass
+            return
+        writer.write_all(deliveries)
 
     async def on_stop(self) -> None:
         self.drain()

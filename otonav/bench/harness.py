@@ -7,7 +7,7 @@ import asyncio
 import resource
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from tempfile import TemporaryDirectory
 
@@ -22,7 +22,9 @@ from otonav.stack.session import StackSession
 
 @dataclass(frozen=True, slots=True)
 class Case:
-    """What to run: ``kind`` is bare | stack | recorded."""
+    """What to run: ``kind`` is bare | stack | recorded (``duration`` s of sim), fixed
+    (a run of no sim time: the fixed costs) or scenario (the acceptance scenario, as
+    ``otonav run`` runs it; ``duration`` unused)."""
 
     kind: str
     duration: float = 30.0
@@ -38,6 +40,11 @@ class Sample:
     wall_s: float
     sim_s: float
     peak_rss_mb: float
+    cpu_s: float = 0.0
+    """This process's CPU time over the same span as ``wall_s`` (on a shared, loaded
+    machine the steadier figure: time spent waiting for a core is not in it)."""
+    phases: tuple[tuple[str, float], ...] = ()
+    """fixed: wall seconds per phase; scenario: the summary's RTF."""
 
 
 class ScanReader(Actor):
@@ -56,24 +63,95 @@ class ScanReader(Actor):
 
 async def _stack(
     case: Case, stack: StackConfig, goal: tuple[float, float], out: Path | None
-) -> float:
+) -> tuple[float, float]:
     hal = build_world(stack)
     actors: list[Actor] = [*build_actors(stack, hal)]
     actors += [ScanReader(i) for i in range(case.scan_subscribers)]
     session = StackSession(hal, actors, record_to=out / "bench.mcap" if out else None)
+    cpu = time.process_time()
     wall = time.perf_counter()
     try:
         async with session.running(close=False) as system:
             goal_pub = system.publisher(topics.GOAL, PoseStamped, LATCHED_QOS)
             await goal_pub.publish(PoseStamped(pose=Pose(position=Point(x=goal[0], y=goal[1]))))
             await system.clock.sleep(case.duration)
-        return time.perf_counter() - wall  # the run and its stop, not finishing the file
+        # The run and its stop, not finishing the file.
+        return time.perf_counter() - wall, time.process_time() - cpu
     finally:
         session.close()
 
 
+def _fixed_costs() -> Sample:
+    """A run of no sim time, phase by phase: what a run costs besides its sim seconds
+    and its imports. The stack imports some modules lazily on first use (anyio's
+    asyncio backend, importlib.resources): one warm-up run pays them, as a sweep
+    worker's first run does; the second run is measured."""
+    cold = _fixed_run()
+    warm = _fixed_run()
+    return replace(warm, phases=(*warm.phases, ("first run in a process", cold.wall_s)))
+
+
+def _fixed_run() -> Sample:
+    scenario = ScenarioConfig()
+    goal = (scenario.goal.x, scenario.goal.y)
+    phases: list[tuple[str, float]] = []
+    wall0, cpu0 = time.perf_counter(), time.process_time()
+    mark = (wall0, cpu0)
+
+    def lap(name: str) -> None:
+        nonlocal mark
+        now = (time.perf_counter(), time.process_time())
+        phases.append((name, now[0] - mark[0]))
+        phases.append((f"{name} (CPU)", now[1] - mark[1]))
+        mark = now
+
+    with TemporaryDirectory() as tmp:
+        stack = StackConfig()
+        hal = build_world(stack)
+        lap("world build")
+        session = StackSession(hal, build_actors(stack, hal), record_to=Path(tmp) / "f.mcap")
+        lap("actors + wiring + file open")
+
+        async def start_stop() -> None:
+            try:
+                async with session.running(close=False) as system:
+                    goal_pub = system.publisher(topics.GOAL, PoseStamped, LATCHED_QOS)
+                    await goal_pub.publish(
+                        PoseStamped(pose=Pose(position=Point(x=goal[0], y=goal[1])))
+                    )
+                    lap("loop + actor start")
+            finally:
+                lap("actor stop")
+                session.close()
+                lap("finish file + close world")
+
+        with asyncio.Runner(loop_factory=virtual_loop_factory(wall_ceiling=600)) as runner:
+            runner.run(start_stop())
+        lap("loop close")
+        wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return Sample(wall, 0.0, rss, cpu, tuple(phases))
+
+
+def _scenario() -> Sample:
+    """The acceptance scenario as ``otonav run`` runs it (recorded, no plot): its
+    summary's RTF (wall from the loop's start to the verdict, fixed costs included)."""
+    from otonav.scenario.run import run_scenario
+
+    with TemporaryDirectory() as tmp:
+        wall0, cpu0 = time.perf_counter(), time.process_time()
+        verdict = run_scenario(ScenarioConfig(), StackConfig(), out_dir=Path(tmp), plot=False)
+        wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return Sample(wall, verdict.sim_time_s, rss, cpu, (("summary_rtf", verdict.rtf),))
+
+
 def run_case(case: Case) -> Sample:
     """Run ``case`` once in this process; wall time excludes building the world."""
+    if case.kind == "fixed":
+        return _fixed_costs()
+    if case.kind == "scenario":
+        return _scenario()
     scenario = ScenarioConfig()
     stack = StackConfig(world=WorldConfig(lidar_beams=case.beams))  # the obstacle scene
     if case.overrides:
@@ -83,17 +161,19 @@ def run_case(case: Case) -> Sample:
     goal = (scenario.goal.x, scenario.goal.y)
     if case.kind == "bare":
         hal = build_world(stack)
+        cpu = time.process_time()
         wall = time.perf_counter()
         run_bare(hal, stack, goal, case.duration)
         wall = time.perf_counter() - wall
+        cpu = time.process_time() - cpu
         hal.close()
     else:
         with TemporaryDirectory() as tmp:
             out = Path(tmp) if case.kind == "recorded" else None
             with asyncio.Runner(loop_factory=virtual_loop_factory(wall_ceiling=600)) as runner:
-                wall = runner.run(_stack(case, stack, goal, out))
+                wall, cpu = runner.run(_stack(case, stack, goal, out))
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    return Sample(wall, case.duration, rss)
+    return Sample(wall, case.duration, rss, cpu)
 
 
 def run_in_children(cases: Sequence[Case]) -> list[Sample]:

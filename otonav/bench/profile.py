@@ -15,6 +15,7 @@ STAGES: tuple[tuple[str, str], ...] = (
     ("world: sensor reads, HAL", "otonav/hal/"),
     ("message construction (pydantic)", "pydantic"),
     ("encoding (CDR)", "otonav/record/cdr"),
+    ("encoding (CDR)", "<cdr encoder of"),  # the generated encoders' pseudo-file
     ("writing (mcap)", "/mcap/"),
     ("recorder + writer glue", "otonav/record/"),
     ("mailboxes + funnel", "otonav/runtime/mailbox"),

@@ -28,6 +28,7 @@ class Row:
     rtf: float
     us_per_10ms_sim: float
     peak_rss_mb: float
+    cpu_median_s: float = 0.0
 
 
 def _row(label: str, samples: list[Sample]) -> Row:
@@ -44,25 +45,56 @@ def _row(label: str, samples: list[Sample]) -> Row:
         sim / median,
         median / (sim / 0.01) * 1e6,
         max(s.peak_rss_mb for s in samples),
+        statistics.median(s.cpu_s for s in samples),
     )
+
+
+def _fixed(samples: list[Sample]) -> dict[str, object]:
+    """Medians of the fixed-cost runs: the total and each phase (ms)."""
+    names = [name for name, _ in samples[0].phases]
+    return {
+        "total_ms": 1e3 * statistics.median(s.wall_s for s in samples),
+        "cpu_ms": 1e3 * statistics.median(s.cpu_s for s in samples),
+        "phases_ms": {
+            name: 1e3 * statistics.median(dict(s.phases)[name] for s in samples) for name in names
+        },
+        "peak_rss_mb": max(s.peak_rss_mb for s in samples),
+    }
+
+
+def _scenario(samples: list[Sample]) -> dict[str, object]:
+    rtfs = [dict(s.phases)["summary_rtf"] for s in samples]
+    return {
+        "summary_rtf_median": statistics.median(rtfs),
+        "summary_rtf_min": min(rtfs),
+        "summary_rtf_max": max(rtfs),
+        "sim_s": samples[0].sim_s,
+        "cpu_rtf_median": statistics.median(s.sim_s / s.cpu_s for s in samples if s.cpu_s > 0),
+        "peak_rss_mb": max(s.peak_rss_mb for s in samples),
+    }
 
 
 def run_bench(duration: float, reps: int, *, scaling: bool, profile: bool) -> dict[str, object]:
     kinds = ("bare", "stack", "recorded")
-    # Interleave a, b, c, a, b, c, ... so slow phases of this shared machine hit all three.
-    cases = [Case(kind, duration) for _ in range(reps) for kind in kinds]
+    extra = ("fixed", "scenario")
+    # Interleave a, b, c, ... a, b, c, ... so slow phases of this shared machine hit all.
+    cases = [Case(kind, duration) for _ in range(reps) for kind in (*kinds, *extra)]
     samples = run_in_children(cases)
-    rows = {
-        k: _row(LABELS[k], [s for c, s in zip(cases, samples, strict=True) if c.kind == k])
-        for k in kinds
+    by_kind = {
+        k: [s for c, s in zip(cases, samples, strict=True) if c.kind == k] for k in (*kinds, *extra)
     }
-    base = rows["bare"].wall_median_s
+    rows = {k: _row(LABELS[k], by_kind[k]) for k in kinds}
+    base, cpu_base = rows["bare"].wall_median_s, rows["bare"].cpu_median_s or 1.0
     result: dict[str, object] = {
         "duration_s": duration,
         "reps": reps,
         "rows": [asdict(r) for r in rows.values()],
         "ratio_b_over_a": rows["stack"].wall_median_s / base,
         "ratio_c_over_a": rows["recorded"].wall_median_s / base,
+        "cpu_ratio_b_over_a": rows["stack"].cpu_median_s / cpu_base,
+        "cpu_ratio_c_over_a": rows["recorded"].cpu_median_s / cpu_base,
+        "fixed_cost": _fixed(by_kind["fixed"]),
+        "acceptance_scenario": _scenario(by_kind["scenario"]),
     }
     if profile:
         import multiprocessing
@@ -113,17 +145,43 @@ def format_report(result: dict[str, object]) -> str:
         f"otonav bench: acceptance world, {result['duration_s']:g} s of sim time, "
         f"median of {result['reps']} runs each (interleaved, one process per run)",
         f"{'configuration':<26}{'wall (s)':>10}{'min':>8}{'max':>8}{'RTF':>8}"
-        f"{'us/10ms':>10}{'RSS MB':>9}",
+        f"{'us/10ms':>10}{'CPU (s)':>9}{'RSS MB':>9}",
     ]
     for r in result["rows"]:  # type: ignore[attr-defined]
         lines.append(
             f"{r['label']:<26}{r['wall_median_s']:>10.3f}{r['wall_min_s']:>8.3f}{r['wall_max_s']:>8.3f}"
-            f"{r['rtf']:>7.0f}x{r['us_per_10ms_sim']:>10.0f}{r['peak_rss_mb']:>9.0f}"
+            f"{r['rtf']:>7.0f}x{r['us_per_10ms_sim']:>10.0f}{r['cpu_median_s']:>9.3f}"
+            f"{r['peak_rss_mb']:>9.0f}"
         )
     lines.append(
-        f"ratios: (b)/(a) = {result['ratio_b_over_a']:.2f}   "
+        f"ratios (wall): (b)/(a) = {result['ratio_b_over_a']:.2f}   "
         f"(c)/(a) = {result['ratio_c_over_a']:.2f}"
     )
+    if "cpu_ratio_c_over_a" in result:
+        lines.append(
+            f"ratios (CPU):  (b)/(a) = {result['cpu_ratio_b_over_a']:.2f}   "
+            f"(c)/(a) = {result['cpu_ratio_c_over_a']:.2f}"
+        )
+    fixed = result.get("fixed_cost")
+    if isinstance(fixed, dict):
+        lines.append(
+            f"fixed cost of a run, no imports (median): {fixed['total_ms']:.1f} ms wall, "
+            f"{fixed['cpu_ms']:.1f} ms CPU; per phase, ms wall / CPU:"
+        )
+        phases = fixed["phases_ms"]
+        for name, ms in phases.items():
+            if name == "first run in a process":
+                lines.append(f"  {'(a first run, lazy imports included:':<34}{ms:>7.1f} ms wall)")
+            elif not name.endswith(" (CPU)"):
+                lines.append(f"  {name:<34}{ms:>7.1f}{phases[name + ' (CPU)']:>7.1f}")
+    acceptance = result.get("acceptance_scenario")
+    if isinstance(acceptance, dict):
+        lines.append(
+            f"acceptance scenario ({acceptance['sim_s']:.1f} s sim, recorded): summary RTF "
+            f"{acceptance['summary_rtf_median']:.0f}x median "
+            f"({acceptance['summary_rtf_min']:.0f}-{acceptance['summary_rtf_max']:.0f}), "
+            f"{acceptance['cpu_rtf_median']:.0f}x per CPU second"
+        )
     stages = result.get("stages_recorded")
     if isinstance(stages, dict):
         total = sum(stages.values()) or 1.0

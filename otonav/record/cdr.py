@@ -1,11 +1,13 @@
 """Fast CDR encoding of otonav messages: the bytes ROS 2 puts on the wire and in bags.
 
 Each message class is compiled once, from its layout (:func:`~otonav.record.schemas.
-layout_for`), into a short *plan*: a list of steps that append to a ``bytearray``.
-Nested messages are flattened into attribute paths (``header.stamp.sec``), and every
-run of fixed-size fields between two variable-size ones (strings, sequences) becomes
-one precompiled :class:`struct.Struct` -- Odometry after its two strings is a single
-``pack`` of 85 doubles.
+layout_for`), into one generated Python function (:class:`_Source`; read it in the
+function's ``__doc__``). Nested messages are flattened into attribute paths
+(``header.stamp.sec``), each nested message is read once into a local, and every run of
+fixed-size fields between two variable-size ones (strings, sequences) becomes one
+precompiled :class:`struct.Struct` -- Odometry after its two strings is a single
+``pack`` of 85 doubles, /clock one ``pack`` of two integers. The generated code follows
+the same rules as the step-per-run plan it replaced (ADR 0025): the bytes are the same.
 
 The CDR rules implemented (plain CDR / XCDR1, little endian, as Fast-CDR writes it):
 
@@ -144,87 +146,12 @@ def _run_format(run: list[_Fixed], start: int) -> str:
     return fmt
 
 
-Getter = Callable[[Any], Any]
-
-
-def _segment(path: str, names: list[str], count: int) -> tuple[Getter | None, Getter, int, str]:
-    """``(parent getter, value getter, kind, path)`` of one segment of a fixed run; kind
-    n > 0: a fixed array of n at ``path``; 0: a tuple of scalars ``names`` of the
-    message at ``path``; -1: one scalar."""
-    if count:
-        return None, attrgetter(path), count, path
-    parent = attrgetter(path) if path else None
-    if len(names) == 1:
-        return parent, attrgetter(names[0]), -1, path
-    return parent, attrgetter(*names), 0, path
-
-
-def _fixed_run_step(run: list[_Fixed]) -> Step:
-    """One ``pack`` for a run of fixed-size fields; the padding inside the run depends
-    on where it starts, so there is a precompiled Struct per start offset mod 8."""
-    packs = tuple(struct.Struct(_run_format(run, start)).pack for start in range(8))
-    if all(leaf.count is None for leaf in run):
-        if len(run) == 1:
-            get_one = attrgetter(run[0].path)
-
-            def scalar(m: Any, buf: bytearray) -> None:
-                buf += packs[(len(buf) - 4) & 7](get_one(m))
-
-            return scalar
-        get_all = attrgetter(*(leaf.path for leaf in run))
-
-        def scalars(m: Any, buf: bytearray) -> None:
-            buf += packs[(len(buf) - 4) & 7](*get_all(m))
-
-        return scalars
-
-    # Fixed arrays among the scalars: gather the values segment by segment. Scalars are
-    # grouped by parent message (``pose.pose.position`` -> x, y, z): one walk down the
-    # path, then one C-level getter for the group.
-    groups: list[tuple[str, list[str], int]] = []
-    for leaf in run:
-        parent, _, name = leaf.path.rpartition(".")
-        if leaf.count is not None:
-            groups.append((leaf.path, [], leaf.count))
-        elif groups and groups[-1][2] == 0 and groups[-1][0] == parent:
-            groups[-1][1].append(name)
-        else:
-            groups.append((parent, [name], 0))
-    segments = [_segment(path, names, count) for path, names, count in groups]
-
-    def mixed(m: Any, buf: bytearray) -> None:
-        values: list[Any] = []
-        for get_parent, get, count, path in segments:
-            part = get(m) if get_parent is None else get(get_parent(m))
-            if count == -1:  # one scalar
-                values.append(part)
-                continue
-            if count > 0 and len(part) != count:
-                raise ValueError(f"{path}: fixed array of {count}, got {len(part)}")
-            values.extend(part)
-        buf += packs[(len(buf) - 4) & 7](*values)
-
-    return mixed
-
-
 def _write_string(buf: bytearray, text: str) -> None:
     """CDR string: uint32 length (aligned to 4) counting the NUL, bytes, NUL."""
     data = text.encode()
     buf += _COUNT[-len(buf) & 3](len(data) + 1)
     buf += data
     buf += b"\x00"
-
-
-def _string_step(path: str) -> Step:
-    get = attrgetter(path)
-
-    def string(m: Any, buf: bytearray) -> None:  # _write_string, inlined: hot path
-        data = get(m).encode()
-        buf += _COUNT[-len(buf) & 3](len(data) + 1)
-        buf += data
-        buf += b"\x00"
-
-    return string
 
 
 def _sequence_step(path: str, code: str) -> Step:
@@ -298,8 +225,8 @@ def _empty_step(m: Any, buf: bytearray) -> None:
 
 
 def _var_step(leaf: _Var) -> Step:
-    if leaf.kind == "string":
-        return _string_step(leaf.path)
+    """The step of a variable-size field other than a string (strings are generated
+    inline, :class:`_Source`)."""
     if leaf.kind == "sequence":
         return _sequence_step(leaf.path, leaf.code)
     if leaf.kind == "strings":
@@ -315,39 +242,141 @@ def _var_step(leaf: _Var) -> Step:
 _PLANS: dict[type[Message], tuple[Step, ...]] = {}
 
 
-def _compile(message: type[Message]) -> tuple[Step, ...]:
-    """Group the leaves: each run of fixed-size leaves -> one step, others -> a step."""
-    steps: list[Step] = []
+class _Source:
+    """The source of one message type's generated encoder, built leaf by leaf."""
+
+    def __init__(self, *, top_level: bool) -> None:
+        self.lines: list[str] = []
+        self.names: dict[str, object] = {"_COUNT": _COUNT, "ValueError": ValueError}
+        self.locals: dict[str, str] = {"": "m"}
+        self.offset: int | None = 0 if top_level else None
+        """Payload offset mod 8 while it is known statically: from the start of a
+        top-level message until its first variable-size field. Otherwise (and always
+        for an element of an array) the packs are picked by ``len(buf)`` at run time."""
+
+    def name(self, value: object, prefix: str) -> str:
+        key = f"{prefix}{len(self.names)}"
+        self.names[key] = value
+        return key
+
+    def ref(self, path: str) -> str:
+        """An expression for the value at ``path`` of ``m``; each nested message on the
+        way is read once into a local."""
+        parent, _, attr = path.rpartition(".")
+        if parent not in self.locals:
+            self.locals[parent] = f"_v{len(self.locals)}"
+            self.lines.append(f"{self.locals[parent]} = {self.ref(parent)}")
+        return f"{self.locals[parent]}.{attr}"
+
+    def fixed_run(self, run: list[_Fixed]) -> None:
+        """One pack for the run; fixed arrays are length-checked and spliced in."""
+        args: list[str] = []
+        for leaf in run:
+            if leaf.count is None:
+                args.append(self.ref(leaf.path))
+                continue
+            array = f"_a{len(self.lines)}"
+            self.lines.append(f"{array} = {self.ref(leaf.path)}")
+            self.lines.append(
+                f"if len({array}) != {leaf.count}: raise ValueError("
+                f"'{leaf.path}: fixed array of {leaf.count}, got %d' % len({array}))"
+            )
+            args.append(f"*{array}")
+        if self.offset is not None:
+            packer = struct.Struct(_run_format(run, self.offset))
+            pack = self.name(packer.pack, "_p")
+            self.lines.append(f"buf += {pack}({', '.join(args)})")
+            self.offset = (self.offset + packer.size) & 7
+            return
+        packs = tuple(struct.Struct(_run_format(run, start)).pack for start in range(8))
+        table = self.name(packs, "_P")
+        self.lines.append(f"buf += {table}[(len(buf) - 4) & 7]({', '.join(args)})")
+
+    def string(self, path: str) -> None:
+        count = "_COUNT[-len(buf) & 3]" if self.offset is None else f"_COUNT[{-self.offset & 3}]"
+        text = f"_s{len(self.lines)}"
+        self.lines.append(f"{text} = {self.ref(path)}.encode()")
+        self.lines.append(f"buf += {count}(len({text}) + 1)")
+        self.lines.append(f"buf += {text}")
+        self.lines.append("buf += b'\\x00'")
+        self.offset = None
+
+    def var(self, leaf: _Var) -> None:
+        if leaf.kind == "messages":
+            assert leaf.message is not None
+            items = f"_a{len(self.lines)}"
+            self.lines.append(f"{items} = {self.ref(leaf.path)}")
+            self.lines.append(
+                f"{self.name(_count_check(leaf.path, leaf.count), '_head')}({items}, buf)"
+            )
+            element = self.name(_plan(leaf.message)[0], "_encode")
+            self.lines.append(f"for _item in {items}: {element}(_item, buf)")
+        else:
+            self.lines.append(f"{self.name(_var_step(leaf), '_step')}(m, buf)")
+        self.offset = None
+
+    def compile(self, message: type[Message]) -> Step:
+        body = "\n".join(f"    {line}" for line in self.lines) or "    pass"
+        source = f"def encode_{message.__name__}(m, buf):\n{body}\n"
+        namespace = dict(self.names)
+        exec(compile(source, f"<cdr encoder of {message.__name__}>", "exec"), namespace)
+        step: Step = namespace[f"encode_{message.__name__}"]  # type: ignore[assignment]
+        step.__doc__ = source
+        return step
+
+
+def _compile(message: type[Message], *, top_level: bool) -> Step:
+    """One generated function per message type: every field of the flattened layout in
+    wire order, nested messages read once into locals, each run of fixed-size fields
+    one precompiled ``Struct.pack`` (its padding resolved at compile time while the
+    offset is known, else picked by offset mod 8), strings inline. Sequences and arrays
+    of messages call their step (an element type has its own generated function).
+    Measured against the step-per-run plan it replaces: Odometry 6.0 -> 3.3 us."""
+    source = _Source(top_level=top_level)
     run: list[_Fixed] = []
     for leaf in _leaves(message):
         if isinstance(leaf, _Fixed):
             run.append(leaf)
             continue
         if run:
-            steps.append(_fixed_run_step(run))
+            source.fixed_run(run)
             run = []
-        steps.append(_var_step(leaf))
+        if leaf.kind == "string":
+            source.string(leaf.path)
+        else:
+            source.var(leaf)
     if run:
-        steps.append(_fixed_run_step(run))
-    return tuple(steps)
+        source.fixed_run(run)
+    return source.compile(message)
+
+
+_TOP: dict[type[Message], Step] = {}
 
 
 def _plan(message: type[Message]) -> tuple[Step, ...]:
+    """The steps of ``message`` anywhere in a buffer (an element of an array)."""
     steps = _PLANS.get(message)
     if steps is None:
-        steps = _PLANS[message] = _compile(message)
+        steps = _PLANS[message] = (_compile(message, top_level=False),)
     return steps
+
+
+def _top(message: type[Message]) -> Step:
+    """The encoder of ``message`` right after the encapsulation header."""
+    step = _TOP.get(message)
+    if step is None:
+        step = _TOP[message] = _compile(message, top_level=True)
+    return step
 
 
 def encode(message: Message) -> bytes:
     """The CDR bytes (with encapsulation header) of ``message``, as ROS 2 would write
     them for its ``ros_type``. Raises ValueError for a value the ROS type cannot hold
     (out-of-range integer, wrong fixed-array length, float too large for float32)."""
-    steps = _PLANS.get(type(message)) or _plan(type(message))
+    step = _TOP.get(type(message)) or _top(type(message))
     buf = bytearray(ENCAPSULATION)
     try:
-        for step in steps:
-            step(message, buf)
+        step(message, buf)
     except (struct.error, OverflowError) as error:
         raise ValueError(f"cannot encode {message.ros_type}: {error}") from error
     return bytes(buf)

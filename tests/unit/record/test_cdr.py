@@ -694,3 +694,38 @@ def test_decoder_refuses_big_endian_and_short_data() -> None:
         decode_cdr(Odometry, data[: len(data) // 2])
     with pytest.raises(ValueError, match="cannot decode"):
         decode_cdr(NavState, encode(NavState(state="driving"))[:10] + b"\xff" * 4)
+
+
+# --- the generated encoders: an element starts anywhere -----------------------------
+
+
+def test_array_elements_at_every_offset_match_mcap_ros2_bytes() -> None:
+    # A top-level encoder resolves its padding when it is compiled; an element of an
+    # array starts wherever the previous element ended, so its padding must follow the
+    # buffer. Elements with strings of every length mod 8 before them (and inside).
+    transforms = tuple(
+        TransformStamped(
+            header=HEADERS[i % len(HEADERS)],
+            child_frame_id="x" * i,
+            transform=Transform(
+                translation=Vector3(x=i + 0.5, y=-1.0, z=2.0),
+                rotation=Quaternion(x=0.0, y=0.0, z=math.sin(i), w=math.cos(i)),
+            ),
+        )
+        for i in range(9)
+    )
+    statuses = tuple(
+        DiagnosticStatus(
+            level=i % 4,
+            name="n" * i,
+            message="m" * (7 - i % 8),
+            hardware_id="",
+            values=tuple(DiagKeyValue(key="k" * j, value="v" * (i + j)) for j in range(i % 3)),
+        )
+        for i in range(9)
+    )
+    for message in (
+        TFMessage(transforms=transforms),
+        DiagnosticArray(header=HEADERS[5], status=statuses),
+    ):
+        check(message)
