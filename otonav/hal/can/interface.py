@@ -108,6 +108,10 @@ class CanBusInterface(RobotHardwareInterface):
         self._axes = (left, right)
         self._index = {left.node_id: 0, right.node_id: 1}
         self._scale = (left.turns_per_rad(), right.turns_per_rad())
+        self._vel_ids = (
+            p.arbitration_id(left.node_id, p.CMD_SET_INPUT_VEL),
+            p.arbitration_id(right.node_id, p.CMD_SET_INPUT_VEL),
+        )
         self.monitor = DriveMonitor(
             (NodeLabel(left.node_id, left.label), NodeLabel(right.node_id, right.label)),
             limits,
@@ -180,17 +184,29 @@ class CanBusInterface(RobotHardwareInterface):
         except BusError as exc:
             monitor.bus_off(t, str(exc))
             frames = []
+        if frames:
+            self._receive(frames, t)
+        self._apply(monitor.check(t), t)
+
+    def _receive(self, frames: list[RawFrame], t: float) -> None:
+        """Log and decode the frames of one bus instant (the hot path: two encoder
+        frames every 10 ms; the id split and dispatch are inlined)."""
+        monitor, log = self.monitor, self._log
+        maxlen = log.maxlen
         for frame in frames:
-            self._record(t, frame)
+            if len(log) == maxlen:
+                self.frames_dropped_from_log += 1
+            log.append((t, frame))
+            ident = frame.arbitration_id
             if frame.is_error:
-                if frame.arbitration_id & CAN_ERR_BUSOFF:
+                if ident & CAN_ERR_BUSOFF:
                     monitor.bus_off(t, "error frame from the controller (CAN_ERR_BUSOFF)")
-                if frame.arbitration_id & CAN_ERR_RESTARTED:
+                if ident & CAN_ERR_RESTARTED:
                     monitor.bus_restarted(t)
                 continue
             if frame.is_remote:
                 continue
-            node, cmd = p.split_id(frame.arbitration_id)
+            node, cmd = ident >> 5 & p.MAX_NODE_ID, ident & 0x1F
             try:
                 if cmd == p.CMD_GET_ENCODER_ESTIMATES:
                     self._on_encoder(node, frame.data, t)
@@ -199,7 +215,6 @@ class CanBusInterface(RobotHardwareInterface):
                     monitor.heartbeat(node, beat.axis_error, beat.axis_state, t)
             except ValueError:  # a short payload: ignored, like a bad frame on the wire
                 continue
-        self._apply(monitor.check(t), t)
 
     def _on_encoder(self, node: int, data: bytes, t: float) -> None:
         self.monitor.encoder(node, t)
@@ -243,9 +258,6 @@ class CanBusInterface(RobotHardwareInterface):
             self.monitor.bus_off(t, str(exc))
             return
         self._sent = True
-        self._record(t, frame)
-
-    def _record(self, t: float, frame: RawFrame) -> None:
         log = self._log
         if len(log) == log.maxlen:
             self.frames_dropped_from_log += 1
@@ -267,10 +279,11 @@ class CanBusInterface(RobotHardwareInterface):
             raise ValueError(f"wheel command must be finite, got {cmd}")
         drivable = self.monitor.health.drivable
         t = self._sensors.ticks * self._tick
-        left, right = self._axes
+        left, right = self._vel_ids
         sl, sr = self._scale
-        self._send(*p.set_input_vel(left.node_id, cmd.left * sl if drivable else 0.0), t)
-        self._send(*p.set_input_vel(right.node_id, cmd.right * sr if drivable else 0.0), t)
+        pack = p.pack_two_f32
+        self._send(left, pack(cmd.left * sl if drivable else 0.0, 0.0), t)
+        self._send(right, pack(cmd.right * sr if drivable else 0.0, 0.0), t)
 
     def read_wheels(self) -> WheelState:
         wheels = self._wheels

@@ -15,7 +15,8 @@ import anyio
 from otonav.hal.can.bus import RawFrame
 from otonav.hal.can.interface import CanBusInterface
 from otonav.msgs import Frame, Header, Time
-from otonav.runtime import Actor, Output, QoS
+from otonav.runtime import Actor, Bus, Output, QoS
+from otonav.runtime.mailbox import Topic
 
 __all__ = ["FRAMES_QOS", "FRAMES_TOPIC", "CanFrameTap"]
 
@@ -40,6 +41,10 @@ class CanFrameTap(Actor):
             raise ValueError(f"can tap rate must be > 0 Hz, got {rate_hz}")
         self.hal = hal
         self.rate_hz = rate_hz
+        self._topic: Topic[Frame] | None = None
+
+    def on_wired(self, bus: Bus) -> None:
+        self._topic = bus.topics[self.topic_of(CanFrameTap.frames)]
 
     async def run(self) -> None:
         rate = self.clock.rate(self.rate_hz)
@@ -55,6 +60,11 @@ class CanFrameTap(Actor):
                 self.frames.publish_nowait(_frame(header, raw))
 
     async def flush(self) -> None:
+        if self._topic is not None and not self._topic.subscriptions:
+            # Nobody listens (no recorder, no live view): building ~330 messages per
+            # simulated second for nobody was ~3 % of a CAN run's CPU time.
+            self.hal.take_frames()
+            return
         channel = self.hal.channel
         publish = self.frames.publish
         header: Header | None = None
