@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from otonav.nav.costmap import ClearanceMap
-from otonav.nav.dwa import DwaParams, DwaResult, dwa_step
+from otonav.nav.dwa import DwaParams, DwaResult, clear_arc, dwa_step
 from otonav.nav.geometry import wrap_angle
 from otonav.nav.global_path import astar
 from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
@@ -247,7 +247,12 @@ class Navigation:
         if distance < self.params.approach_radius:
             return self._approach(distance, heading)
         target = self._target(pose)
-        result = dwa_step(pose, v0, omega0, target, distance, self.map.clearance, self.params.dwa)
+        dwa = self.params.dwa
+        result = (
+            clear_arc(pose, v0, omega0, target, distance, self.map.clearance, dwa)
+            if dwa.fast_path
+            else None
+        ) or dwa_step(pose, v0, omega0, target, distance, self.map.clearance, dwa)
         if result.admissible == 0:
             state = "blocked"
         else:
