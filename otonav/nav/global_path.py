@@ -14,6 +14,7 @@ from __future__ import annotations
 import heapq
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -48,7 +49,7 @@ class GridPath:
 
 def astar(
     free: NDArray[np.bool_],
-    penalty: NDArray[np.float64],
+    penalty: NDArray[np.floating[Any]],
     start: tuple[int, int],
     goal: tuple[int, int],
     *,

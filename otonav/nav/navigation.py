@@ -301,12 +301,15 @@ class Navigation:
         self._stage = None
         return self._out(0.0, 0.0, "unreachable", reason, distance, heading)
 
-    def _free_grid(self) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
-        coarse = self.map.coarse(self._stride).astype(np.float64)
+    def _free_grid(self) -> tuple[NDArray[np.bool_], NDArray[np.float32]]:
+        # float32 like the map, np.minimum/np.maximum for np.clip: on the 200 x 200
+        # grid the conversions were most of a replan's set-up.
+        coarse = self.map.coarse(self._stride)
         radius = self.params.dwa.radius
         free = coarse >= radius
         room = self.params.dwa.clearance_cap
-        penalty = self.params.plan_penalty * np.clip(radius + room - coarse, 0.0, room) / room
+        gap = np.minimum(np.maximum(np.float32(radius + room) - coarse, 0.0), room)
+        penalty = gap * np.float32(self.params.plan_penalty / room)
         return free, penalty
 
     def _coarse_cell(self, x: float, y: float) -> tuple[int, int]:
@@ -358,15 +361,18 @@ class Navigation:
         return self.path[int(np.argmin(d)) :]
 
     def _target(self, pose: tuple[float, float, float]) -> tuple[float, float]:
+        """The first path point at least ``lookahead`` from the robot, after the one
+        nearest it (one distance pass serves both searches)."""
         assert self.goal is not None
-        if self.path is None:
+        path = self.path
+        if path is None:
             return self.goal
-        ahead = self._ahead(pose)
-        d = np.hypot(ahead[:, 0] - pose[0], ahead[:, 1] - pose[1])
-        beyond = np.nonzero(d >= self.params.lookahead)[0]
+        d = np.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1])
+        i = int(np.argmin(d))
+        beyond = np.flatnonzero(d[i:] >= self.params.lookahead)
         if beyond.size == 0:
             return self.goal
-        p = ahead[int(beyond[0])]
+        p = path[i + int(beyond[0])]
         return float(p[0]), float(p[1])
 
     def _begin(
