@@ -123,6 +123,7 @@ def _can_world(config: StackConfig, world: MujocoInterface) -> CanBusInterface:
             WheelAxis(can.right.node_id, can.right.sign, can.right.gear_ratio, "right wheel"),
             limits,
             peer=peer,
+            command_keepalive=can.command_keepalive,
         )
     except BaseException:
         host.close()
@@ -164,7 +165,9 @@ def build_actors(
         from otonav.hal.can.tap import CanFrameTap
 
         if isinstance(hal, CanBusInterface):
-            actors.append(CanFrameTap(hal))
+            # First: actors stop in reverse order, so the tap stops after the bridge
+            # and its on_stop records the drives' IDLE frames (ADR 0028).
+            actors.insert(0, CanFrameTap(hal))
     if navigator:
         remap = {topics.CMD_VEL: topics.CMD_VEL_NAV} if config.safety.enabled else None
         if nav.planner == "stop":

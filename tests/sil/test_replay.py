@@ -5,6 +5,7 @@ divergence, and the CLI exits 1; bad input is one line and exit 2."""
 from __future__ import annotations
 
 import dataclasses
+import struct
 from pathlib import Path
 
 import pytest
@@ -13,7 +14,7 @@ from otonav.cli import main as cli_main
 from otonav.msgs import Message, Odometry, PoseStamped, Twist
 from otonav.nav import GoalCommand, go_to_goal
 from otonav.record.cdr_decode import decode
-from otonav.record.reader import read_messages, summarize
+from otonav.record.reader import MAGIC, read_messages, summarize
 from otonav.record.writer import RecordingWriter
 from otonav.replay import replay_recording
 from otonav.replay.nodes import stack_actor_names
@@ -132,7 +133,20 @@ def test_cli_bad_files_are_exit_2(
     with RecordingWriter(no_scan) as writer:
         for m in load_recording(acceptance, list(kinds)).messages:
             writer.write(m.topic, decode(kinds[m.topic], m.data), m.time_ns / 1e9)
+    # Damaged, not cut off: a chunk's CRC, and a byte of a chunk's compressed records.
+    crc, flipped = tmp_path / "crc.mcap", tmp_path / "flipped.mcap"
+    data = acceptance.read_bytes()
+    chunk = _chunk_offsets(data)[3]
+    (name_len,) = struct.unpack_from("<I", data, chunk + 9 + 28)
+    for path, at in [(crc, chunk + 9 + 24), (flipped, chunk + 9 + 28 + 4 + name_len + 8 + 40)]:
+        damaged = bytearray(data)
+        damaged[at] ^= 0x10
+        path.write_bytes(bytes(damaged))
     for path, expected in [
+        (crc, f"{crc}: 1 damaged chunk: chunk at byte {chunk} (sim time"),
+        (crc, "CRC mismatch"),
+        (flipped, f"{flipped}: 1 damaged chunk: chunk at byte {chunk} (sim time"),
+        (flipped, "a replay would feed damaged data as recorded"),
         (cut, f"otonav salvage {cut} RECOVERED.mcap"),
         (no_scan, "has no /scan, which nav reads (sensor_msgs/msg/LaserScan)"),
         (tmp_path / "missing.mcap", "no such file"),
@@ -142,6 +156,17 @@ def test_cli_bad_files_are_exit_2(
         err = capsys.readouterr().err
         assert expected in err, err
         assert len(err.strip().splitlines()) == 1
+
+
+def _chunk_offsets(data: bytes) -> list[int]:
+    """Offsets of the chunk records (opcode 0x06) of an MCAP file."""
+    offsets, pos = [], len(MAGIC)
+    while pos < len(data) - len(MAGIC):
+        opcode, (length,) = data[pos], struct.unpack_from("<Q", data, pos + 1)
+        if opcode == 0x06:
+            offsets.append(pos)
+        pos += 9 + length
+    return offsets
 
 
 def test_a_real_time_recording_replays_with_recorded_wakes(tmp_path: Path) -> None:
