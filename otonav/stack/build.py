@@ -235,6 +235,8 @@ def navigation_params(config: StackConfig, geometry: RobotGeometry) -> Navigatio
             w_clearance=dwa.w_clearance,
             w_speed=dwa.w_speed,
             rotate_threshold=nav.turn_in_place_threshold,
+            fast_path=dwa.fast_path,
+            fast_margin=dwa.fast_margin,
         ),
         tolerance=nav.tolerance,
         map_half_size=grid.half_size,

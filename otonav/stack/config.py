@@ -108,6 +108,11 @@ class DwaConfig(_Section):
     """score weight of clearance along the rollout, in [0, 100]."""
     w_speed: float = Field(0.3, ge=0.0, le=100.0)
     """score weight of forward speed, in [0, 100]."""
+    fast_path: bool = True
+    """try the pure-pursuit arc to the target first and skip the sampling when it
+    provably keeps ``fast_margin`` beyond the centre clearance (otonav.nav.dwa)."""
+    fast_margin: float = Field(0.05, ge=0.0, le=5.0)
+    """m, clearance beyond the centre clearance the fast path's arc keeps, in [0, 5]."""
 
 
 class MapConfig(_Section):
