@@ -188,8 +188,10 @@ def main() -> None:
         if not args.no_ray:
             import ray
 
+            from otonav.sweep.backends.ray import init_local
+
             start = time.perf_counter()
-            ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+            init_local(2)  # as `--backend ray` starts one: nothing written to ~/.ray
             figures["ray_start_s"] = time.perf_counter() - start
             try:
                 results.append(timed_sweep(args.runs, "ray", 2, root / "ray"))
