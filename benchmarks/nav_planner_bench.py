@@ -11,7 +11,8 @@ with it against the stop-only stack, measured in the same run.
 2. Figure (b) of ``otonav bench`` (acceptance world, stack without recorder, 30 s of sim
    time): stop-only (nav.planner=stop, no safety layer: the stack as it was), stop-only
    behind the safety layer, and dwa behind the safety layer (the default), interleaved,
-   each run in a fresh process; medians and ratios to stop-only.
+   each run in a fresh process; medians and ratios to stop-only, of wall time and of
+   the process's CPU time (the steadier figure on a shared machine).
 """
 
 from __future__ import annotations
@@ -131,16 +132,18 @@ def bench_b(duration: float, reps: int) -> None:
         for overrides in CONFIGS.values()
     ]
     samples = run_in_children(cases)
-    medians = {}
+    walls: dict[str, float] = {}
+    cpus: dict[str, float] = {}
     for name, overrides in CONFIGS.items():
-        walls = [s.wall_s for c, s in zip(cases, samples, strict=True) if c.overrides == overrides]
-        medians[name] = statistics.median(walls)
-    base = medians["stop-only, no safety layer"]
+        mine = [s for c, s in zip(cases, samples, strict=True) if c.overrides == overrides]
+        walls[name] = statistics.median(s.wall_s for s in mine)
+        cpus[name] = statistics.median(s.cpu_s for s in mine)
+    base, cpu_base = walls["stop-only, no safety layer"], cpus["stop-only, no safety layer"]
     print(f"figure (b), stack without recorder, {duration:g} s of sim, median of {reps}:")
-    for name, wall in medians.items():
+    for name, wall in walls.items():
         print(
             f"  {name:<30} wall {wall:6.3f} s   RTF {duration / wall:5.0f}x   "
-            f"ratio {wall / base:5.2f}"
+            f"ratio {wall / base:5.2f}   CPU {cpus[name]:6.3f} s ratio {cpus[name] / cpu_base:5.2f}"
         )
 
 

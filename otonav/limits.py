@@ -57,6 +57,44 @@ MAX_BASE_ACCEL = 100.0
 MAX_BASE_ALPHA = 500.0
 """rad/s², about 170x the default, for the same reason."""
 
+# -- CAN bus (hal.can, hal.sim) ---------------------------------------------------------
+
+MIN_CAN_PERIOD_S = 0.001
+"""Shortest cyclic frame period (encoder estimates, heartbeat): ODrive sets these rates
+in whole milliseconds (``encoder_msg_rate_ms``), and two axes at 1 kHz already put
+~222 kbit/s on a 250 kbit/s bus. Also at least one physics tick (a cross-field check):
+the emulator sends at most once per tick."""
+
+MAX_CAN_PERIOD_S = 1.0
+"""Longest cyclic frame period: ten times ODrive's slowest default (the 100 ms
+heartbeat). A drive heard less often than once a second cannot be watched within the
+control periods the base reacts in (ADR 0017)."""
+
+MAX_CAN_TIMEOUT_S = 10.0
+"""Longest CAN wait (startup, heartbeat and encoder timeouts, loss window, recovery
+delay, keepalive, the emulated watchdog and arming): 40x the default heartbeat timeout;
+a longer one hides a dead drive for half of a 20 s scenario."""
+
+MAX_RECOVERY_ATTEMPTS = 100
+"""Recovery attempts in a row before the interface gives up (default 3)."""
+
+MIN_GEAR_RATIO = 0.01
+MAX_GEAR_RATIO = 100.0
+"""Motor turns per wheel turn: hub motors are 1, gearboxes rarely pass 100:1. The
+setpoint travels as float32 turns/s: gear_ratio 1e300 overflowed the Set_Input_Vel
+encoder (OverflowError: a traceback at sim time 0)."""
+
+MAX_DRIVE_VEL_TURNS_S = 200.0
+"""The emulated drive's ``vel_limit``: 12,000 rpm, beyond the motors ODrive drives."""
+
+MAX_DRIVE_RAMP_TURNS_S2 = 100_000.0
+"""The emulated drive's ``vel_ramp_rate``: at 1e5 turns/s² the ramp reaches the
+fastest ``vel_limit`` in 2 ms, one physics tick: no limit at all beyond it."""
+
+MAX_CAN_NAME_CHARS = 64
+"""``hal.can.interface`` / ``channel``: python-can's interface names are short words
+and a SocketCAN link name is at most 15 characters (IFNAMSIZ)."""
+
 # -- scenario ----------------------------------------------------------------------------
 
 MAX_COORDINATE_M = 1000.0

@@ -26,6 +26,10 @@ from otonav.nav.navigation import Navigation, NavigationParams, NavOutput
 from otonav.nav.scan import to_frame
 from otonav.runtime import Actor, Input, Output
 
+_STOP = Twist.fast(
+    linear=Vector3.fast(x=0.0, y=0.0, z=0.0), angular=Vector3.fast(x=0.0, y=0.0, z=0.0)
+)
+"""(0, 0): messages are immutable and shared, so one object serves every stop."""
 _AT_REST = frozenset({"idle", "waiting", "reached", "unreachable", "fault"})
 
 
@@ -70,7 +74,7 @@ class AvoidingNavigator(Actor):
         if goal is not None:
             self.nav.set_goal(goal)
         self._history = OdomHistory()
-        self._points = np.empty((0, 2))
+        self._scan: LaserScan | None = None
         self._points_pose: tuple[float, float, float] | None = None
         self._scan_time = -math.inf
         self._last_diag: tuple[str, str] | None = None
@@ -80,8 +84,7 @@ class AvoidingNavigator(Actor):
         rate = self.clock.rate(self.rate_hz)
         while True:
             await rate.sleep()
-            while (odom := self.odom.try_recv()) is not None:
-                self._history.add(odom)
+            self._history.extend(self.odom.drain())
             goal_msg = self.goal_in.take_latest()
             if goal_msg is not None:
                 self.nav.set_goal((goal_msg.pose.position.x, goal_msg.pose.position.y))
@@ -97,16 +100,16 @@ class AvoidingNavigator(Actor):
         pose = self._history.pose_at(scan.header.stamp.to_seconds())
         if pose is None:
             return
-        seen = points_of(scan, self.laser_offset_x)
         moved = self._points_pose is None or (
             abs(pose[0] - self._points_pose[0]) + abs(pose[1] - self._points_pose[1]) > 1e-3
             or abs(pose[2] - self._points_pose[2]) > 1e-3
         )
-        self._points, self._points_pose = seen.xy, pose
+        self._scan, self._points_pose = scan, pose
         self._scan_time = self.clock.now()
-        # A static world seen from the same pose marks the same cells: skip the update.
+        # A static world seen from the same pose marks the same cells: skip the update
+        # (and the points: at rest a scan costs nothing here).
         if moved:
-            self.nav.observe(to_frame(seen.xy, pose))
+            self.nav.observe(to_frame(points_of(scan, self.laser_offset_x).xy, pose))
 
     async def _step(self) -> None:
         now = self.clock.now()
@@ -124,16 +127,25 @@ class AvoidingNavigator(Actor):
                 out = NavOutput(0.0, 0.0, "waiting", "no fresh scan", out.distance, 0.0)
             await self._publish(out)
             return
-        scan_points_, scan_pose = self._points, self._points_pose
+        scan, scan_pose, offset = self._scan, self._points_pose, self.laser_offset_x
+        assert scan is not None
         await self._publish(
-            self.nav.step(now, pose, v0, omega0, lambda: to_frame(scan_points_, scan_pose, pose))
+            self.nav.step(
+                now,
+                pose,
+                v0,
+                omega0,
+                lambda: to_frame(points_of(scan, offset).xy, scan_pose, pose),
+            )
         )
 
     async def _publish(self, out: NavOutput) -> None:
         stamp = Time.from_seconds(self.clock.now())
         header = Header.fast(stamp=stamp, frame_id="odom")
         await self.cmd_vel.publish(
-            Twist.fast(
+            _STOP
+            if out.v == 0.0 and out.omega == 0.0
+            else Twist.fast(
                 linear=Vector3.fast(x=out.v, y=0.0, z=0.0),
                 angular=Vector3.fast(x=0.0, y=0.0, z=out.omega),
             )

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Iterable
 
 from otonav.msgs import Odometry
 
@@ -28,6 +29,10 @@ class OdomHistory:
 
     def add(self, odom: Odometry) -> None:
         self._items.append(odom)
+
+    def extend(self, odoms: Iterable[Odometry]) -> None:
+        """Add messages, oldest first (``Subscription.drain``)."""
+        self._items.extend(odoms)
 
     @property
     def latest(self) -> tuple[float, Pose, float, float] | None:

@@ -7,15 +7,18 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from otonav.actors import topics
 from otonav.actors.odom_history import OdomHistory
-from otonav.actors.scan_cache import points_of
+from otonav.actors.scan_cache import nearest_of, points_of
 from otonav.msgs import Header, LaserScan, Odometry, SafetyState, Time, Twist, Vector3
 from otonav.nav.safety import SafetyParams, safe_command
 from otonav.nav.scan import to_frame
 from otonav.runtime import Actor, Input, Output
+
+_STOP = Twist.fast(
+    linear=Vector3.fast(x=0.0, y=0.0, z=0.0), angular=Vector3.fast(x=0.0, y=0.0, z=0.0)
+)
+"""(0, 0): messages are immutable and shared, so one object serves every stop."""
 
 
 class SafetyLayer(Actor):
@@ -23,7 +26,8 @@ class SafetyLayer(Actor):
     ``cmd_timeout`` s), move the last scan's returns into the current base_link with
     odometry, and publish on /cmd_vel the command limited by
     :func:`~otonav.nav.safety.safe_command`. With no scan or odometry for
-    ``scan_timeout`` s of sim time it sends (0, 0) (``blind``). /safety/state says
+    ``scan_timeout`` s of sim time it sends (0, 0) (``blind``); a zero command (or
+    none) goes through as it is (``idle``). /safety/state says
     what it did whenever that changes, and at least once a second."""
 
     cmd_in = Input(topics.CMD_VEL_NAV, Twist, topics.COMMAND_QOS)
@@ -53,7 +57,7 @@ class SafetyLayer(Actor):
         self.limited = 0
         """Periods in which the command was slowed or stopped (for tests and reports)."""
         self._history = OdomHistory()
-        self._points = np.empty((0, 2))
+        self._scan: LaserScan | None = None
         self._points_pose: tuple[float, float, float] | None = None
         self._nearest = math.inf  # centre to the nearest return, at the scan's pose
         self.report_period = 1.0
@@ -68,8 +72,7 @@ class SafetyLayer(Actor):
         while True:
             await rate.sleep()
             now = self.clock.now()
-            while (odom := self.odom.try_recv()) is not None:
-                self._history.add(odom)
+            self._history.extend(self.odom.drain())
             latest = self.cmd_in.take_latest()
             if latest is not None:
                 command, received = latest, now
@@ -85,16 +88,27 @@ class SafetyLayer(Actor):
         pose = self._history.pose_at(scan.header.stamp.to_seconds())
         if pose is None:
             return
-        seen = points_of(scan, self.laser_offset_x)
-        self._points, self._points_pose, self._scan_time = seen.xy, pose, now
-        xy = seen.xy
-        self._nearest = float(np.hypot(xy[:, 0], xy[:, 1]).min()) if xy.shape[0] else math.inf
+        # The points only when a return is within reach (_send); the fast-path test
+        # needs the nearest distance, which costs a third of the points.
+        self._scan, self._points_pose, self._scan_time = scan, pose, now
+        self._nearest = math.nan  # computed when first needed (_nearest_return)
+
+    def _nearest_return(self) -> float:
+        """Centre to the last scan's nearest return at the scan's pose, m."""
+        if math.isnan(self._nearest) and self._scan is not None:
+            self._nearest = nearest_of(self._scan, self.laser_offset_x)
+        return self._nearest
 
     async def _send(self, now: float, v_in: float, w_in: float) -> None:
         odom = self._history.latest
         fresh_odom = odom is not None and now - odom[0] <= self.scan_timeout
         if self._points_pose is None or now - self._scan_time > self.scan_timeout or not fresh_odom:
             v, w, scale, nearest, reason = 0.0, 0.0, 0.0, math.inf, "blind"
+        elif v_in == 0.0 and w_in == 0.0:
+            # A zero command (or none) goes through: braking is all there is, whatever
+            # the scan says (safe_command would send the same (0, 0)); the scan is
+            # only looked at if a report goes out. At rest this is every period.
+            v, w, scale, nearest, reason = 0.0, 0.0, 1.0, math.nan, "idle"
         else:
             assert odom is not None
             _, pose, v0, w0 = odom
@@ -104,10 +118,11 @@ class SafetyLayer(Actor):
             moved = math.hypot(pose[0] - scan_pose[0], pose[1] - scan_pose[1])
             fastest = max(abs(v_in), abs(v0))
             reach = fastest * p.latency + fastest * fastest / (2.0 * p.max_accel) + 0.05
-            if self._nearest - moved > p.radius + reach:
-                v, w, scale, nearest, reason = v_in, w_in, 1.0, self._nearest - moved, "clear"
+            if (least := self._nearest_return()) - moved > p.radius + reach:
+                v, w, scale, nearest, reason = v_in, w_in, 1.0, least - moved, "clear"
             else:
-                points = to_frame(self._points, scan_pose, pose)
+                assert self._scan is not None
+                points = to_frame(points_of(self._scan, self.laser_offset_x).xy, scan_pose, pose)
                 result = safe_command(v_in, w_in, v0, w0, points, p)
                 v, w, scale, nearest, reason = (
                     result.v,
@@ -119,7 +134,9 @@ class SafetyLayer(Actor):
         if reason in ("limited", "stopped", "blind") and (v, w) != (v_in, w_in):
             self.limited += 1
         await self.cmd_out.publish(
-            Twist.fast(
+            _STOP
+            if v == 0.0 and w == 0.0
+            else Twist.fast(
                 linear=Vector3.fast(x=v, y=0.0, z=0.0),
                 angular=Vector3.fast(x=0.0, y=0.0, z=w),
             )
@@ -133,6 +150,8 @@ class SafetyLayer(Actor):
             return
         self._last_report = (reason, v == v_in and w == w_in)
         self._reported_at = now
+        if math.isnan(nearest):
+            nearest = self._nearest_return()
         await self.state.publish(
             SafetyState.fast(
                 header=Header.fast(stamp=Time.from_seconds(now), frame_id="base_link"),

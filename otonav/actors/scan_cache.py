@@ -1,13 +1,15 @@
 """One scan, one conversion: the navigator and the safety layer receive the same
 LaserScan object (messages are shared, never copied), so its points in base_link are
-computed once and reused by whoever asks second."""
+computed once and reused by whoever asks second. Both ask only when they need the
+points (the navigator when the robot moved, the safety layer when a return is within
+reach); the nearest return's distance has its own cheaper function."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from otonav.msgs import LaserScan
-from otonav.nav.scan import ScanPoints, scan_points
+from otonav.nav.scan import ScanPoints, nearest_return, scan_points
 
 _last: tuple[LaserScan, float, ScanPoints] | None = None
 
@@ -30,3 +32,16 @@ def points_of(scan: LaserScan, laser_offset_x: float) -> ScanPoints:
     )
     _last = (scan, laser_offset_x, seen)
     return seen
+
+
+def nearest_of(scan: LaserScan, laser_offset_x: float) -> float:
+    """Base_link origin to the scan's nearest return, m (:func:`nearest_return`)."""
+    f32 = np.float32
+    return nearest_return(
+        np.asarray(scan.ranges, dtype=np.float64),
+        float(f32(scan.angle_min)),
+        float(f32(scan.angle_increment)),
+        float(f32(scan.range_min)),
+        float(f32(scan.range_max)),
+        laser_offset_x,
+    )

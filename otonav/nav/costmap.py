@@ -59,10 +59,15 @@ class ClearanceMap:
         self.origin_y = centre_y - half_size
         self.occupied = np.zeros((self.size, self.size), dtype=np.bool_)
         # Per cell, what clearance() answers: the distance to the nearest occupied cell
-        # less the slack (0 at least; the cap stays the cap). One border row/column all
-        # round stays at the cap: the answer for points outside the map.
-        self._lower = np.full((self.size + 2, self.size + 2), max_distance, dtype=np.float32)
+        # less the slack (0 at least; the cap stays the cap). A border of k + 1 cells
+        # all round: a stamp never needs clipping (~1 us less per new cell), the k
+        # cells next to the map hold true bounds for points just outside it, and the
+        # outermost ring, never stamped, stays at the cap: the answer farther out.
         k = math.ceil(max_distance / resolution)
+        self._pad = k + 1
+        self._lower = np.full(
+            (self.size + 2 * self._pad, self.size + 2 * self._pad), max_distance, dtype=np.float32
+        )
         offsets = np.arange(-k, k + 1, dtype=np.float64) * resolution
         self._k = k
         kernel = np.hypot(offsets[:, None], offsets[None, :])
@@ -91,35 +96,45 @@ class ClearanceMap:
         )
 
     def mark(self, xy: NDArray[np.float64]) -> int:
-        """Record returns (``(N, 2)`` odom points); returns how many cells were new."""
+        """Record returns (``(N, 2)`` odom points); returns how many cells were new.
+
+        Cheap test first: a static world seen again marks cells it already holds, and
+        then the update is a dozen numpy calls on the N points (no sort: ``np.unique``
+        runs on the new cells only). Measured on the acceptance course: 87 -> ~35 us
+        per scan in the stack."""
         if xy.shape[0] == 0:
             return 0
-        row, col, inside = self.cell_of(xy[:, 0], xy[:, 1])
-        flat = np.unique(row[inside] * self.size + col[inside])
-        new = flat[~self.occupied.ravel()[flat]]
-        if new.size == 0:
+        inv, n = 1.0 / self.resolution, self.size
+        col = np.floor((xy[:, 0] - self.origin_x) * inv).astype(np.intp)
+        row = np.floor((xy[:, 1] - self.origin_y) * inv).astype(np.intp)
+        # Negative indices wrap to huge unsigned values: one comparison per axis.
+        inside = (col.view(np.uintp) < n) & (row.view(np.uintp) < n)
+        flat = (row * n + col)[inside]
+        occupied = self.occupied.ravel()
+        fresh = flat[~occupied[flat]]
+        if fresh.size == 0:
             return 0
-        self.occupied.ravel()[new] = True
-        k, n, kernel, lower = self._k, self.size, self._kernel, self._lower
+        new = np.unique(fresh)
+        occupied[new] = True
+        span, kernel, lower = 2 * self._k + 1, self._kernel, self._lower
         for cell in new.tolist():
-            r, c = divmod(cell, n)
-            r0, r1 = max(r - k, 0), min(r + k + 1, n)
-            c0, c1 = max(c - k, 0), min(c + k + 1, n)
-            window = lower[r0 + 1 : r1 + 1, c0 + 1 : c1 + 1]
-            np.minimum(window, kernel[r0 - r + k : r1 - r + k, c0 - c + k : c1 - c + k], out=window)
+            r, c = divmod(cell, n)  # the stamp's corner: (r + pad - k, c + pad - k)
+            window = lower[r + 1 : r + 1 + span, c + 1 : c + 1 + span]
+            np.minimum(window, kernel, out=window)
         self.marked += int(new.size)
         return int(new.size)
 
     def coarse(self, stride: int) -> NDArray[np.float32]:
         """clearance() at the centre cell of every ``stride`` x ``stride`` block: the
         global planner's grid (a view, rows = y)."""
-        start = 1 + stride // 2
-        return self._lower[start : self.size + 1 : stride, start : self.size + 1 : stride]
+        start, stop = self._pad + stride // 2, self._pad + self.size
+        return self._lower[start:stop:stride, start:stop:stride]
 
     def clearance(self, x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float32]:
         """Lower bound on the distance from each point to the nearest recorded return,
         m, capped at ``max_distance`` (outside the map: ``max_distance``)."""
-        inv = 1.0 / self.resolution
-        col = np.clip(np.floor((x - self.origin_x) * inv), -1, self.size) + 1
-        row = np.clip(np.floor((y - self.origin_y) * inv), -1, self.size) + 1
-        return self._lower[row.astype(np.intp), col.astype(np.intp)]
+        inv, pad = 1.0 / self.resolution, self._pad
+        hi = self.size + 2 * pad - 1
+        col = np.clip(np.floor((x - self.origin_x) * inv).astype(np.intp) + pad, 0, hi)
+        row = np.clip(np.floor((y - self.origin_y) * inv).astype(np.intp) + pad, 0, hi)
+        return self._lower[row, col]

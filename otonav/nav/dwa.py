@@ -31,6 +31,23 @@ One step:
 
 The best admissible sample is the command. With none admissible the command is the
 braking one and the reason says so.
+
+**Fast path** (:func:`clear_arc`, ``fast_path``): where the way is open the sampling
+is not needed. The one arc through the target at the top of the window (pure
+pursuit: curvature ``2 y / L**2`` with the target at ``(x, y)``, ``L`` away in
+base_link; the yaw rate clamped to the window) is rolled out over the horizon like a
+sample; when every pose of it, the start included, has a clearance of at least
+``radius + fast_margin + v * dt / 2``, it is the command (reason ``clear arc``). That
+proves the whole arc keeps ``radius + fast_margin``, not only its poses: the
+clearance is a lower bound on a 1-Lipschitz distance and the poses are ``v * dt``
+apart, so no point of the arc is more than ``v * dt / 2`` from one. With no pose under
+the radius the stop fits (what the full step calls admissible); the safety layer
+still checks the command. Every other case (the target off by more than
+``rotate_threshold``, a pose too near a return, no speed) runs the full step. The
+arc is not the sample the full step would pick (that one also weighs clearance up to
+``clearance_cap``), but it follows the global path, which keeps off obstacles by its
+penalty. Measured on the acceptance course: 2/3 of the moving steps take it, at ~15 us
+instead of ~90 us; every built-in course passes with the same times +-0.5 s.
 """
 
 from __future__ import annotations
@@ -43,7 +60,7 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ("ClearanceFn", "DwaParams", "DwaResult", "dwa_step")
+__all__ = ("ClearanceFn", "DwaParams", "DwaResult", "clear_arc", "dwa_step")
 
 ClearanceFn = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float32]]
 """(x, y) arrays in odom -> distance to the nearest return, m (same shape)."""
@@ -70,6 +87,8 @@ class DwaParams:
         rotate_threshold: with the target farther off the heading than this, rad, the
             window's speeds shrink to its lowest (slow down and turn toward it first,
             like Nav2's rotation shim) (>= 0).
+        fast_path: try :func:`clear_arc` before sampling (module docstring).
+        fast_margin: clearance beyond ``radius`` the fast path's arc keeps, m (>= 0).
     """
 
     max_v: float = 0.4
@@ -89,12 +108,18 @@ class DwaParams:
     w_clearance: float = 0.6
     w_speed: float = 0.3
     rotate_threshold: float = 0.6
+    fast_path: bool = True
+    fast_margin: float = 0.05
 
     def __post_init__(self) -> None:
         positive: tuple[str, ...] = ("max_v", "max_omega", "max_accel", "max_alpha")
         positive += ("period", "horizon", "dt", "clearance_cap")
         for f in fields(self):
             value = getattr(self, f.name)
+            if f.name == "fast_path":
+                if not isinstance(value, bool):
+                    raise ValueError(f"DwaParams.fast_path must be a bool, got {value!r}")
+                continue
             if f.name in ("v_samples", "omega_samples"):
                 if not (isinstance(value, int) and value >= 1):
                     raise ValueError(f"DwaParams.{f.name} must be an integer >= 1, got {value!r}")
@@ -116,7 +141,8 @@ class DwaResult:
         omega: yaw-rate command, rad/s.
         admissible: how many samples could stop before breaking the clearance.
         samples: how many samples were rolled out.
-        best_score: the chosen sample's score (-inf when none was admissible).
+        best_score: the chosen sample's score (-inf when none was admissible, NaN on
+            the fast path: nothing was compared).
         clearance: the chosen rollout's smallest clearance, m.
         reason: why this command, in a few words.
     """
@@ -144,9 +170,71 @@ def _fractions(n: int) -> NDArray[np.float64]:
     return f
 
 
+@lru_cache(maxsize=8)
+def _columns(steps: int) -> NDArray[np.intp]:
+    c = np.arange(steps + 1)
+    c.flags.writeable = False
+    return c
+
+
+@lru_cache(maxsize=8)
+def _tie_break(steps: int) -> NDArray[np.float64]:
+    b = 1e-9 * np.arange(steps + 1, dtype=np.float64)
+    b.flags.writeable = False
+    return b
+
+
 def _window(lo: float, hi: float, n: int) -> NDArray[np.float64]:
     # np.linspace costs ~10 us a call; the cached fractions make this one multiply-add.
     return lo + (hi - lo) * _fractions(n) if n > 1 and hi > lo else np.array([0.5 * (lo + hi)])
+
+
+def clear_arc(
+    pose: tuple[float, float, float],
+    v0: float,
+    omega0: float,
+    target: tuple[float, float],
+    goal_distance: float,
+    clearance: ClearanceFn,
+    params: DwaParams,
+) -> DwaResult | None:
+    """The fast path (module docstring): the arc toward ``target`` at the top of the
+    window when it is provably clear, else None (run :func:`dwa_step`). Same
+    arguments as :func:`dwa_step`."""
+    p = params
+    x0, y0, th0 = pose
+    v_cap = min(p.max_v, math.sqrt(p.max_accel * max(goal_distance, 0.0)))
+    v = min(max(v0 + p.max_accel * p.period, 0.0), v_cap)
+    w_lo = max(omega0 - p.max_alpha * p.period, -p.max_omega)
+    w_hi = min(omega0 + p.max_alpha * p.period, p.max_omega)
+    if v <= 0.0 or w_lo > w_hi:
+        return None
+    c, s = math.cos(th0), math.sin(th0)
+    dx, dy = target[0] - x0, target[1] - y0
+    bx, by = c * dx + s * dy, c * dy - s * dx  # the target in base_link
+    span2 = bx * bx + by * by
+    if span2 < 1e-12 or abs(math.atan2(by, bx)) > p.rotate_threshold:
+        return None
+    omega = min(max(v * 2.0 * by / span2, w_lo), w_hi)
+    steps = max(1, round(p.horizon / p.dt))
+    t = _times(p.dt, steps)
+    w_eff = omega if abs(omega) >= 1e-6 else math.copysign(1e-6, omega)
+    th = th0 + w_eff * t
+    r = v / w_eff
+    xs = x0 + r * (np.sin(th) - s)
+    ys = y0 - r * (np.cos(th) - c)
+    least = float(clearance(xs, ys).min())
+    if least < p.radius + p.fast_margin + 0.5 * v * p.dt:
+        return None
+    return DwaResult(
+        v=v,
+        omega=omega,
+        admissible=1,
+        samples=1,
+        best_score=math.nan,
+        clearance=least,
+        reason="clear arc",
+    )
 
 
 def dwa_step(
@@ -184,11 +272,17 @@ def dwa_step(
     vs = _window(v_lo, v_lo if off > p.rotate_threshold else v_hi, p.v_samples)
     ws = _window(w_lo, w_hi, p.omega_samples)
     brake_w = min(max(0.0, w_lo), w_hi)
-    v = np.concatenate((np.repeat(vs, ws.size), [v_lo]))
-    w = np.concatenate((np.tile(ws, vs.size), [brake_w]))
-    n = v.size
+    # The grid by broadcasting into views (np.tile + np.repeat + 2 concatenations cost
+    # ~10 us; this ~3 us): v = [vs repeated per omega..., v_lo], w = [ws tiled..., brake].
+    n = vs.size * ws.size + 1
+    v = np.empty(n)
+    w = np.empty(n)
+    v[:-1].reshape(vs.size, ws.size)[...] = vs[:, None]
+    w[:-1].reshape(vs.size, ws.size)[...] = ws
+    v[-1], w[-1] = v_lo, brake_w
     steps = max(1, round(p.horizon / p.dt))
     t = _times(p.dt, steps)  # (K+1,): column 0 is the start pose
+    columns = _columns(steps)
     # Exact arcs: x = x0 + v/w (sin(th) - sin(th0)), y = y0 - v/w (cos(th) - cos(th0)).
     # A straight line is the limit w -> 0; |w| >= 1e-6 rad/s keeps v/w finite and
     # errs by < 1e-6 m over the horizon (no branch, no extra numpy calls).
@@ -223,21 +317,22 @@ def dwa_step(
     # Each rollout is judged at its closest approach to the target (up to its cut): a
     # fast arc that passes the goal within the horizon is not worse than a slow one
     # that stops short of it (judged at the end, the DWA crawls into every goal).
-    rows = np.arange(n)
     to_target = np.hypot(tx - xs, ty - ys)
-    beyond = np.arange(steps + 1)[None, :] > last[:, None]
+    beyond = columns[None, :] > last[:, None]
     # Ties (a turn on the spot stays at one point) go to the latest pose: its heading.
-    late = to_target - 1e-9 * np.arange(steps + 1)[None, :]
+    late = to_target - _tie_break(steps)[None, :]
     best_i = np.argmin(np.where(beyond, np.inf, late), axis=1)
-    ex, ey = xs[rows, best_i], ys[rows, best_i]
-    closest = to_target[rows, best_i]
-    bearing = np.arctan2(ty - ey, tx - ex) - th[rows, best_i]
+    flat = best_i + columns.size * _columns(n - 1)  # (row, best_i) in the raveled arrays
+    ex, ey = xs.ravel()[flat], ys.ravel()[flat]
+    closest = to_target.ravel()[flat]
+    bearing = np.arctan2(ty - ey, tx - ex) - th.ravel()[flat]
     bearing = np.abs(np.remainder(bearing + math.pi, math.tau) - math.pi)
     bearing = np.where(closest < 0.05, 0.0, bearing)  # at the target: no bearing to keep
     d0 = math.hypot(tx - x0, ty - y0)
     gain = (d0 - closest) / (p.max_v * p.horizon)
     min_clear = clear.min(axis=1)
-    room = np.clip(min_clear - p.radius, 0.0, p.clearance_cap) / p.clearance_cap
+    # np.minimum(np.maximum()) is np.clip's result without its ~4 us Python wrapper.
+    room = np.minimum(np.maximum(min_clear - p.radius, 0.0), p.clearance_cap) / p.clearance_cap
     score = (
         p.w_heading * (1.0 - bearing / math.pi)
         + p.w_progress * gain

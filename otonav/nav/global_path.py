@@ -6,7 +6,7 @@ runs **from the goal to the robot**: when the goal is walled in, the search exha
 small enclosed region at once instead of flooding the whole map around the robot; it
 is cut at ``max_expansions`` (then the answer is "unknown", not "unreachable").
 
-Plain Python on flat lists (no per-node numpy calls): ~1 us per neighbour examined.
+Plain Python on flat buffers (no per-node numpy calls): ~1 us per neighbour examined.
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ from __future__ import annotations
 import heapq
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -48,7 +49,7 @@ class GridPath:
 
 def astar(
     free: NDArray[np.bool_],
-    penalty: NDArray[np.float64],
+    penalty: NDArray[np.floating[Any]],
     start: tuple[int, int],
     goal: tuple[int, int],
     *,
@@ -77,10 +78,13 @@ def astar(
     g = (goal[0] + 1) * w + goal[1] + 1
     ok[s // w, s % w] = True
     ok[g // w, g % w] = True
-    okl: list[bool] = ok.ravel().tolist()
+    # bytes and a float64 memoryview index as fast as lists (~25 ns) but cost ~1 us to
+    # make where tolist() of a 200 x 200 grid cost ~0.8 ms (measured): most searches
+    # expand a few hundred cells, so the conversion was most of a replan.
+    okl = ok.tobytes()
     pen = np.zeros((rows + 2, w), dtype=np.float64)
     pen[1:-1, 1:-1] = penalty
-    penl: list[float] = pen.ravel().tolist()
+    penl = memoryview(pen.data).cast("B").cast("d")
     sr, sc = divmod(s, w)
     straight = (1, -1, w, -w)
     diagonal = ((w + 1, 1, w), (w - 1, -1, w), (-w + 1, 1, -w), (-w - 1, -1, -w))

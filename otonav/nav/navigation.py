@@ -39,7 +39,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from otonav.nav.costmap import ClearanceMap
-from otonav.nav.dwa import DwaParams, DwaResult, dwa_step
+from otonav.nav.dwa import DwaParams, DwaResult, clear_arc, dwa_step
 from otonav.nav.geometry import wrap_angle
 from otonav.nav.global_path import astar
 from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
@@ -247,7 +247,12 @@ class Navigation:
         if distance < self.params.approach_radius:
             return self._approach(distance, heading)
         target = self._target(pose)
-        result = dwa_step(pose, v0, omega0, target, distance, self.map.clearance, self.params.dwa)
+        dwa = self.params.dwa
+        result = (
+            clear_arc(pose, v0, omega0, target, distance, self.map.clearance, dwa)
+            if dwa.fast_path
+            else None
+        ) or dwa_step(pose, v0, omega0, target, distance, self.map.clearance, dwa)
         if result.admissible == 0:
             state = "blocked"
         else:
@@ -296,12 +301,15 @@ class Navigation:
         self._stage = None
         return self._out(0.0, 0.0, "unreachable", reason, distance, heading)
 
-    def _free_grid(self) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
-        coarse = self.map.coarse(self._stride).astype(np.float64)
+    def _free_grid(self) -> tuple[NDArray[np.bool_], NDArray[np.float32]]:
+        # float32 like the map, np.minimum/np.maximum for np.clip: on the 200 x 200
+        # grid the conversions were most of a replan's set-up.
+        coarse = self.map.coarse(self._stride)
         radius = self.params.dwa.radius
         free = coarse >= radius
         room = self.params.dwa.clearance_cap
-        penalty = self.params.plan_penalty * np.clip(radius + room - coarse, 0.0, room) / room
+        gap = np.minimum(np.maximum(np.float32(radius + room) - coarse, 0.0), room)
+        penalty = gap * np.float32(self.params.plan_penalty / room)
         return free, penalty
 
     def _coarse_cell(self, x: float, y: float) -> tuple[int, int]:
@@ -353,15 +361,18 @@ class Navigation:
         return self.path[int(np.argmin(d)) :]
 
     def _target(self, pose: tuple[float, float, float]) -> tuple[float, float]:
+        """The first path point at least ``lookahead`` from the robot, after the one
+        nearest it (one distance pass serves both searches)."""
         assert self.goal is not None
-        if self.path is None:
+        path = self.path
+        if path is None:
             return self.goal
-        ahead = self._ahead(pose)
-        d = np.hypot(ahead[:, 0] - pose[0], ahead[:, 1] - pose[1])
-        beyond = np.nonzero(d >= self.params.lookahead)[0]
+        d = np.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1])
+        i = int(np.argmin(d))
+        beyond = np.flatnonzero(d[i:] >= self.params.lookahead)
         if beyond.size == 0:
             return self.goal
-        p = ahead[int(beyond[0])]
+        p = path[i + int(beyond[0])]
         return float(p[0]), float(p[1])
 
     def _begin(

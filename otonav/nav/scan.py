@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ("ScanPoints", "scan_points", "to_frame")
+__all__ = ("ScanPoints", "nearest_return", "scan_points", "to_frame")
 
 Points = NDArray[np.float64]
 
@@ -68,9 +68,8 @@ def scan_points(
         raise ValueError(f"scan angles must be finite, got {angle_min!r}, {angle_increment!r}")
     c, s = _directions(ranges.shape[0], float(angle_min), float(angle_increment))
     r = np.asarray(ranges, dtype=np.float64)
-    with np.errstate(invalid="ignore"):
-        valid = (r >= range_min) & (r <= range_max)  # NaN and +-inf compare False
-        near = (r < range_min) & ~np.isnan(r)  # -inf and finite values under range_min
+    valid = (r >= range_min) & (r <= range_max)  # NaN compares False (no warning)
+    near = r < range_min  # -inf and finite values under range_min; NaN is not
     blocked = bool(near.any())
     if blocked:
         valid = valid | near
@@ -80,6 +79,42 @@ def scan_points(
     xy[:, 0] = laser_offset_x + rv * c[valid]
     xy[:, 1] = rv * s[valid]
     return ScanPoints(xy, blocked)
+
+
+@lru_cache(maxsize=8)
+def _offset_terms(n: int, angle_min: float, angle_increment: float, offset: float) -> Points:
+    c, _ = _directions(n, angle_min, angle_increment)
+    terms = 2.0 * offset * c
+    terms.flags.writeable = False
+    return terms
+
+
+def nearest_return(
+    ranges: NDArray[np.floating[Any]],
+    angle_min: float,
+    angle_increment: float,
+    range_min: float,
+    range_max: float,
+    laser_offset_x: float,
+) -> float:
+    """Distance, m, from base_link's origin to the nearest point :func:`scan_points`
+    returns for the same scan (inf with none), without making the points: with the
+    laser ``o`` ahead, a return ``r`` along ``a`` is ``sqrt(r**2 + 2 o r cos a + o**2)``
+    away. A third of the numpy calls of the points and their norms (the safety
+    layer's fast-path test runs on every scan)."""
+    if ranges.ndim != 1:
+        raise ValueError(f"ranges must be 1-D, got shape {ranges.shape}")
+    r = np.asarray(ranges, dtype=np.float64)
+    near = r < range_min  # -inf and finite values under range_min; NaN is not
+    if near.any():  # a blocked beam is a point at range_min / 2 along it
+        r = np.where(near, 0.5 * range_min, r)
+        range_min = 0.5 * range_min
+    rv = np.where((r >= range_min) & (r <= range_max), r, np.inf)
+    terms = _offset_terms(r.shape[0], float(angle_min), float(angle_increment), laser_offset_x)
+    least = float((rv * (rv + terms)).min())  # inf * (inf + finite) stays inf
+    if not math.isfinite(least):
+        return math.inf
+    return math.sqrt(max(least + laser_offset_x * laser_offset_x, 0.0))
 
 
 def to_frame(

@@ -368,6 +368,11 @@ def _check(layout: Layout) -> None:
 def layout_for(message: type[Message]) -> Layout:
     """The checked ROS layout of ``message``: from the table, else generated."""
     known = _KNOWN.get(message)
+    if known is None:
+        # A subclass that adds no field (a lazily decoded replay input) is its base.
+        base = next((c for c in message.__mro__[1:] if c in _KNOWN), None)
+        if base is not None and base.model_fields.keys() == message.model_fields.keys():
+            known = _KNOWN[base]
     layout = _generate(message) if known is None else Layout(message, *known)
     _check(layout)
     return layout

@@ -35,9 +35,11 @@ from __future__ import annotations
 import asyncio
 from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
-from otonav.record.cdr_decode import decode
+from otonav.msgs import Message
+from otonav.replay.lazy import lazy
 from otonav.replay.recording import RecordedMessage
 from otonav.runtime import Clock, Publisher, VirtualTimeLoop
 from otonav.runtime.timesource import tick_rate
@@ -54,7 +56,7 @@ class FeedSource:
             raise ValueError(f"tick must be > 0 s, got {tick!r}")
         self._tick = tick
         self.ticks = 0
-        self._wake: asyncio.Future[None] | None = None
+        self._wake: Callable[[], None] | None = None
         self._wake_tick = 0
 
     @property
@@ -71,13 +73,12 @@ class FeedSource:
         wake = self._wake
         if wake is not None and self.ticks >= self._wake_tick:
             self._wake = None
-            # Called from the loop's select, before it moves due timers to the ready
-            # queue: the feeder's task step is queued ahead of every one of them.
-            if not wake.done():
-                wake.set_result(None)
+            wake()
 
-    def wake_at(self, tick: int, future: asyncio.Future[None]) -> None:
-        self._wake, self._wake_tick = future, tick
+    def wake_at(self, tick: int, callback: Callable[[], None]) -> None:
+        """Call ``callback()`` from ``advance()`` when time reaches ``tick``: inside the
+        loop's select, before it moves the timers that fell due to the ready queue."""
+        self._wake, self._wake_tick = callback, tick
 
 
 @dataclass(frozen=True, slots=True)
@@ -96,11 +97,11 @@ class Instant:
     steps: tuple[Step, ...]
     """Inputs to publish, in recorded order, with a Settle where actors ran in between."""
     last: bool = False
-
-    @property
-    def holds(self) -> bool:
-        """Whether the actors' wake-ups must be held while the feeder works here."""
-        return self.last or any(isinstance(step, Settle) for step in self.steps)
+    holds: bool = False
+    """Whether the actors' wake-ups must be held while the feeder works here."""
+    after_idle: bool = False
+    """Every replayed actor ran before the inputs (one Settle of all, first): deliver
+    them when the loop is idle at this instant, no holding needed."""
 
 
 def plan_instants(
@@ -108,11 +109,15 @@ def plan_instants(
     inputs: Collection[str],
     publishers_of: Mapping[str, Collection[str]],
     rate: float,
+    actors: Collection[str] = (),
 ) -> list[Instant]:
     """Group the recording into the feeder's instants: those with input, plus the last
     one (so the replay runs to the recording's end). ``publishers_of`` maps each output
     topic to the replayed actors that publish it; outputs followed by input at the same
-    instant (or ending the recording) become Settle steps."""
+    instant (or ending the recording) become Settle steps. ``actors``: the names of all
+    the replayed actors (an instant where all of them ran before its inputs is marked
+    ``after_idle``)."""
+    everyone = frozenset(actors)
     groups: list[tuple[int, list[RecordedMessage]]] = []
     for message in messages:
         if message.topic not in inputs and message.topic not in publishers_of:
@@ -137,7 +142,15 @@ def plan_instants(
         if last:
             steps.append(Settle(frozenset(ran)))
         if steps:
-            instants.append(Instant(tick, tuple(steps), last))
+            settles = [step for step in steps if isinstance(step, Settle)]
+            after_idle = (
+                not last
+                and len(settles) == 1
+                and steps[0] is settles[0]
+                and bool(everyone)
+                and settles[0].actors == everyone
+            )
+            instants.append(Instant(tick, tuple(steps), last, last or bool(settles), after_idle))
     return instants
 
 
@@ -226,8 +239,17 @@ class ReplayClock(Clock):
 
 
 class Feeder:
-    """Publishes the planned instants on ``publishers`` (topic -> publisher); calls
-    ``after_instant()`` once each instant's inputs are out (to drain the outputs)."""
+    """Publishes the planned instants on ``publishers`` (topic -> publisher), each
+    recorded message as a :func:`~otonav.replay.lazy.lazy` one (decoded on first use).
+
+    An instant that needs no holding (no replayed actor ran between two of its inputs)
+    is delivered inline: from the time source's ``advance()``, in the loop's select, at
+    the point where the feeder's own wake-up would have been queued ahead of every timer
+    due then. That is the same order as a task step of the feeder at the head of the
+    ready queue, without the task switch, future and loop iteration per instant (11 ms
+    of a 113 ms navigator replay). Instants that hold, and a reliable mailbox that is
+    full (the publisher would wait), go through the feeder's task.
+    """
 
     def __init__(
         self,
@@ -235,45 +257,183 @@ class Feeder:
         source: FeedSource,
         instants: Sequence[Instant],
         publishers: Mapping[str, Publisher[Any]],
-        after_instant: Callable[[], None],
     ) -> None:
         self._gate = gate
         self._loop = gate.loop
         self._source = source
         self._instants = instants
         self._publishers = publishers
-        self._after_instant = after_instant
+        self._rate = source.rate
+        self._next = 0
+        self._resume: asyncio.Future[tuple[int, int]] | None = None
         self.published = 0
+        self._timer: asyncio.TimerHandle | None = None
+        self.inline = 0
+        """Instants delivered inline (the rest went through the task)."""
+        self.batched = 0
+        """Of those, instants delivered ahead of their tick (nothing could tell)."""
+        self.after_idle = 0
+        """Of those, instants delivered once their actors had run (``after_idle``)."""
+        self._idle_watcher = self._at_idle  # one bound method, to know it among watchers
 
     async def run(self) -> None:
-        source, publishers, gate = self._source, self._publishers, self._gate
-        for instant in self._instants:
-            if instant.tick > source.ticks:
-                await self._until(instant.tick)
-            gate.holding = instant.holds
-            idle = False  # the actors due now are parked (the loop went idle once)
-            for step in instant.steps:
-                if isinstance(step, Settle):
-                    if not idle:
-                        await self._idle()
-                        idle = True
-                    gate.release(step.actors)
-                    await self._idle()
+        instants, source = self._instants, self._source
+        index, start = 0, 0
+        while index < len(instants):
+            instant = instants[index]
+            if start == 0 and instant.tick > source.ticks:
+                if not instant.holds:
+                    index, start = await self._inline_from(index)
                     continue
-                publisher = publishers[step.topic]
-                await publisher.publish(decode(publisher.msg_type, step.data))
-                self.published += 1
-            gate.holding = False
-            if not instant.last:
-                gate.release(None)  # the rest, in the order their timers fell due
-            self._after_instant()
+                await self._until(instant.tick)
+            await self._instant(instant, start)
+            index, start = index + 1, 0
+
+    async def _instant(self, instant: Instant, start: int) -> None:
+        """Publish ``instant``'s steps from ``start`` on, holding actors as planned."""
+        gate, publishers = self._gate, self._publishers
+        gate.holding = instant.holds
+        idle = False  # the actors due now are parked (the loop went idle once)
+        for step in instant.steps[start:]:
+            if isinstance(step, Settle):
+                if not idle:
+                    await self._idle()
+                    idle = True
+                gate.release(step.actors)
+                await self._idle()
+                continue
+            publisher = publishers[step.topic]
+            await _publish(publisher, lazy(publisher.msg_type, step.data))
+            self.published += 1
+        gate.holding = False
+        if not instant.last:
+            gate.release(None)  # the rest, in the order their timers fell due
+
+    async def _inline_from(self, index: int) -> tuple[int, int]:
+        """Deliver instants inline from ``index`` on; returns where the task takes over
+        (instant, step), woken at that instant ahead of every timer due then."""
+        self._resume = self._loop.create_future()
+        self._arm(index)
+        return await self._resume
+
+    def _arm(self, index: int) -> None:
+        self._next = index
+        tick = self._instants[index].tick
+        self._source.wake_at(tick, self._on_tick)
+        # A timer at the instant, so the loop stops there even when no actor is due.
+        self._timer = self._loop.call_at(tick / self._rate, _noop)
+
+    def _on_tick(self) -> None:
+        """From the source's ``advance()``: time reached instant ``_next``. Delivers it,
+        and the instants after it that nothing can tell apart from it (see
+        :meth:`_quiet_until`); then arms the next one or hands over to the task."""
+        index = self._next
+        instant = self._instants[index]
+        if instant.after_idle:
+            # The actors due now run first (as recorded), then the inputs: at idle.
+            self._loop.add_idle_watcher(self._idle_watcher)
+            return
+        if instant.holds:
+            self._hand_over(index, 0)
+            return
+        blocked = self._deliver_now(instant)
+        if blocked is not None:
+            self._hand_over(index, blocked)
+            return
+        self.inline += 1
+        self._go_on(index + 1)
+
+    def _at_idle(self) -> bool:
+        """An idle watcher: the actors of an ``after_idle`` instant have run."""
+        index = self._next
+        blocked = self._deliver_now(self._instants[index], 1)
+        if blocked is not None:
+            self._hand_over(index, blocked)
+            return True
+        self.inline += 1
+        self.after_idle += 1
+        self._go_on(index + 1)
+        return True
+
+    def _go_on(self, index: int) -> None:
+        """Deliver the instants from ``index`` on that cannot be told apart from now,
+        then arm the next one, or hand over to the task at the end."""
+        instants = self._instants
+        while index < len(instants):
+            following = instants[index]
+            if following.holds or not self._quiet_until(following):
+                self._arm(index)
+                return
+            # Early, but unobservable: no code runs before that instant.
+            self._deliver_now(following)
+            self.inline += 1
+            self.batched += 1
+            index += 1
+        self._hand_over(index, 0)
+
+    def _quiet_until(self, instant: Instant) -> bool:
+        """Whether delivering ``instant`` now, ahead of its tick, is the same as at its
+        tick: nothing woke from what was just delivered (the ready queue is empty), no
+        idle watcher or worker thread can look, no timer but this instant's own falls
+        due before ``instant``'s tick, and its messages fit the mailboxes (no publisher
+        would wait). Between two replayed wake-ups the navigator's replay gets four /odom
+        instants: this saves their loop iterations (1342 -> 491, 9 ms of 96).
+
+        Reads the loop's private state (asyncio's ready queue and timer heap, the
+        virtual loop's watchers and holds): the replay tests break if they change."""
+        loop: Any = self._loop
+        if loop._ready or loop._holds:
+            return False
+        if any(watcher is not self._idle_watcher for watcher in loop._watchers):
+            return False
+        heap = loop._scheduled
+        # The root is this instant's own timer, or an earlier one; after it, the
+        # earliest timer is one of the root's children.
+        rest = heap[1:3] if heap and heap[0] is self._timer else heap[:1]
+        # A timer fires at tick T when its deadline < T / rate + resolution.
+        due_before = (instant.tick - 1) / self._rate + loop._clock_resolution
+        if any(timer.when() < due_before for timer in rest):
+            return False
+        publishers = self._publishers
+        n = len(instant.steps)
+        return all(
+            not s._reliable or len(s._queue) + n <= s._depth
+            for step in instant.steps
+            for s in publishers[step.topic]._topic.subscriptions  # type: ignore[union-attr]
+        )
+
+    def _hand_over(self, index: int, step: int) -> None:
+        resume, self._resume = self._resume, None
+        assert resume is not None
+        resume.set_result((index, step))
+
+    def _deliver_now(self, instant: Instant, start: int = 0) -> int | None:
+        """Offer the instant's messages from step ``start`` on to their mailboxes; the
+        index of the first one a full reliable mailbox would make wait (None: all
+        delivered)."""
+        publishers = self._publishers
+        for k in range(start, len(instant.steps)):
+            step = instant.steps[k]
+            assert not isinstance(step, Settle)
+            publisher = publishers[step.topic]
+            subscriptions = publisher._topic.subscriptions
+            if any(s._full() for s in subscriptions):
+                return k
+            message = lazy(publisher.msg_type, step.data)
+            publisher.published += 1
+            if publisher._history is not None:
+                publisher._history.append(message)
+            for subscription in subscriptions:
+                subscription._offer(message)
+            self.published += 1
+        return None
 
     async def _until(self, tick: int) -> None:
         loop = self._loop
         future: asyncio.Future[None] = loop.create_future()
-        self._source.wake_at(tick, future)
+        self._source.wake_at(tick, partial(_resolve, future))
         # A timer at the instant, so the loop stops there even when no actor is due.
-        handle = loop.call_at(tick / self._source.rate, _noop)
+        handle = loop.call_at(tick / self._rate, _noop)
         try:
             await future
         finally:
@@ -290,6 +450,24 @@ class Feeder:
 
         self._loop.add_idle_watcher(idle)
         await future
+
+
+async def _publish(publisher: Publisher[Any], message: Message) -> None:
+    """``publisher.publish(message)`` without its strict type check, which would decode
+    a lazy message on the spot (the runtime's delivery, from the feeder)."""
+    publisher.published += 1
+    if publisher._history is not None:
+        publisher._history.append(message)
+    for subscription in publisher._topic.subscriptions:
+        while not subscription._offer(message):
+            await subscription._wait_for_room()
+
+
+def _resolve(future: asyncio.Future[None]) -> None:
+    # Called from the loop's select, before it moves due timers to the ready queue:
+    # the feeder's task step is queued ahead of every one of them.
+    if not future.done():
+        future.set_result(None)
 
 
 def _noop() -> None:

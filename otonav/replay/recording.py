@@ -17,8 +17,9 @@ from pathlib import Path
 from mcap.reader import make_reader
 from pydantic import ValidationError
 
-from otonav.record.fastreader import iter_raw_messages
+from otonav.record.fastreader import ChunkDamageError, iter_raw_messages
 from otonav.record.reader import CUT_OFF_ERRORS, MAGIC
+from otonav.record.verify import _finished, _one_line, describe_damage
 from otonav.stack import StackConfig
 
 
@@ -109,9 +110,19 @@ def load_recording(path: Path, topics: Collection[str] | None) -> Recording:
                 ]
             )
             metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
+        except ChunkDamageError as exc:
+            raise ReplayInputError(
+                f"{describe_damage(path, [exc.damage])}; a replay would feed damaged data as "
+                f"recorded ('otonav info {path}' lists every damaged chunk)"
+            ) from None
         except CUT_OFF_ERRORS as exc:
             if isinstance(exc, ReplayInputError):
                 raise
+            if _finished(path):  # ends with the magic: not cut off, damaged
+                raise ReplayInputError(
+                    f"{path}: damaged: unreadable although finished ({_one_line(exc)}); "
+                    f"'otonav info {path}' says where"
+                ) from None
             raise _cut_off(path) from None
     messages.sort(key=lambda m: m.time_ns)  # stable: equal instants keep the file order
     return Recording(path, _stack_of(path, metadata), types, schemas, messages, metadata)

@@ -167,7 +167,13 @@ def replay_recording(
     _check_topics(meta, ports, actors)
     full = load_recording(path, topics=[*ports.inputs, *ports.outputs])
     source = FeedSource(config.world.timestep)
-    instants = plan_instants(full.messages, ports.inputs, ports.publishers_of, source.rate)
+    instants = plan_instants(
+        full.messages,
+        ports.inputs,
+        ports.publishers_of,
+        source.rate,
+        actors=[a.name for a in actors],
+    )
     fed: dict[str, int] = dict.fromkeys(ports.inputs, 0)
     for instant in instants:
         for step in instant.steps:
@@ -213,16 +219,18 @@ def replay_recording(
                 )
 
         gate = Gate(loop)
-        feeder = Feeder(gate, source, instants, publishers, drain)
-        async with system:
-            # Each actor sleeps on its own clock (the System handed out one shared
-            # clock; the actors have not run yet, so none has used it).
-            for actor in actors:
-                actor._otonav_clock = ReplayClock(
-                    gate, actor.name, wakes=wakes.get(actor.name), rate=source.rate
-                )
-            await feeder.run()
-        drain()
+        feeder = Feeder(gate, source, instants, publishers)
+        try:
+            async with system:
+                # Each actor sleeps on its own clock (the System handed out one shared
+                # clock; the actors have not run yet, so none has used it).
+                for actor in actors:
+                    actor._otonav_clock = ReplayClock(
+                        gate, actor.name, wakes=wakes.get(actor.name), rate=source.rate
+                    )
+                await feeder.run()
+        finally:
+            drain()  # once: the funnel is unbounded and stamps each output when published
 
     factory = lambda: VirtualTimeLoop(source, wall_ceiling=wall_ceiling)  # noqa: E731
     sim_time = 0.0

@@ -123,6 +123,7 @@ def _can_world(config: StackConfig, world: MujocoInterface) -> CanBusInterface:
             WheelAxis(can.right.node_id, can.right.sign, can.right.gear_ratio, "right wheel"),
             limits,
             peer=peer,
+            command_keepalive=can.command_keepalive,
         )
     except BaseException:
         host.close()
@@ -164,7 +165,9 @@ def build_actors(
         from otonav.hal.can.tap import CanFrameTap
 
         if isinstance(hal, CanBusInterface):
-            actors.append(CanFrameTap(hal))
+            # First: actors stop in reverse order, so the tap stops after the bridge
+            # and its on_stop records the drives' IDLE frames (ADR 0028).
+            actors.insert(0, CanFrameTap(hal))
     if navigator:
         remap = {topics.CMD_VEL: topics.CMD_VEL_NAV} if config.safety.enabled else None
         if nav.planner == "stop":
@@ -232,6 +235,8 @@ def navigation_params(config: StackConfig, geometry: RobotGeometry) -> Navigatio
             w_clearance=dwa.w_clearance,
             w_speed=dwa.w_speed,
             rotate_threshold=nav.turn_in_place_threshold,
+            fast_path=dwa.fast_path,
+            fast_margin=dwa.fast_margin,
         ),
         tolerance=nav.tolerance,
         map_half_size=grid.half_size,

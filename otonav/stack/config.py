@@ -4,9 +4,10 @@ installed wheel runs with no checkout); YAML files in ``config/`` override them.
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import (
+    AfterValidator,
     BaseModel,
     ConfigDict,
     Field,
@@ -22,6 +23,28 @@ class _Section(BaseModel):
     # strict: "yes" is not 1.0 and "3" is not 3 (a number in YAML is still a number).
     # allow_inf_nan=False: '.inf' is a YAML float, and an infinite rate is a zero period.
     model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
+
+
+def _within(lo: float, hi: float, unit: str = "", *, open_low: bool = False) -> AfterValidator:
+    """A bound whose one-line error names the whole valid range (the CAN sections)."""
+    low = "(" if open_low else "["
+
+    def check(value: float) -> float:
+        if (value <= lo if open_low else value < lo) or value > hi:
+            raise ValueError(f"must be in {low}{lo:g}, {hi:g}]{unit}")
+        return value
+
+    return AfterValidator(check)
+
+
+_CanPeriod = Annotated[float, _within(limits.MIN_CAN_PERIOD_S, limits.MAX_CAN_PERIOD_S, " s")]
+"""A cyclic frame period, s (see ``otonav.limits``)."""
+_CanTimeout = Annotated[float, _within(0.0, limits.MAX_CAN_TIMEOUT_S, " s", open_low=True)]
+"""A CAN wait that must be > 0, s."""
+_CanDelay = Annotated[float, _within(0.0, limits.MAX_CAN_TIMEOUT_S, " s")]
+"""A CAN wait where 0 means none (or off), s."""
+_NodeId = Annotated[int, _within(0, 63)]
+"""An ODrive CAN Simple node id: 6 bits."""
 
 
 class WorldConfig(_Section):
@@ -85,6 +108,11 @@ class DwaConfig(_Section):
     """score weight of clearance along the rollout, in [0, 100]."""
     w_speed: float = Field(0.3, ge=0.0, le=100.0)
     """score weight of forward speed, in [0, 100]."""
+    fast_path: bool = True
+    """try the pure-pursuit arc to the target first and skip the sampling when it
+    provably keeps ``fast_margin`` beyond the centre clearance (otonav.nav.dwa)."""
+    fast_margin: float = Field(0.05, ge=0.0, le=5.0)
+    """m, clearance beyond the centre clearance the fast path's arc keeps, in [0, 5]."""
 
 
 class MapConfig(_Section):
@@ -197,72 +225,68 @@ class GuardConfig(_Section):
 class CanAxisConfig(_Section):
     """One wheel's drive as the host sees it: CAN node id, direction sign, gearing."""
 
-    node_id: int = Field(0, ge=0, le=63)
+    node_id: _NodeId = 0
     sign: Literal[1, -1] = 1
     """+1 if positive motor turns drive the wheel forward, -1 if the motor is mirrored."""
-    gear_ratio: PositiveFloat = 1.0
+    gear_ratio: Annotated[float, _within(limits.MIN_GEAR_RATIO, limits.MAX_GEAR_RATIO)] = 1.0
     """Motor turns per wheel revolution (wheel rad = sign * 2 pi * turns / gear_ratio)."""
 
 
 class CanConfig(_Section):
     """The wheel bus (``hal.kind: can``): python-can interface and channel, the two
-    ODrive axes, and the fault-detection limits (s of sim time)."""
+    ODrive axes, and the fault-detection limits (s of sim time). Every number is
+    bounded (``otonav.limits``, ADR 0019); the error names the valid range."""
 
-    interface: str = "virtual"
+    interface: str = Field("virtual", min_length=1, max_length=limits.MAX_CAN_NAME_CHARS)
     """python-can interface: ``virtual`` (in-process, with the drive emulator) or
     ``socketcan`` (a Linux CAN link such as ``can0`` or ``vcan0``)."""
-    channel: str = "can0"
+    channel: str = Field("can0", min_length=1, max_length=limits.MAX_CAN_NAME_CHARS)
     emulate: bool = True
     """Run the drive emulator at the far end of the bus (false: real drives)."""
     left: CanAxisConfig = CanAxisConfig(node_id=0, sign=-1)
     right: CanAxisConfig = CanAxisConfig(node_id=1, sign=1)
-    encoder_period: PositiveFloat = 0.01
+    encoder_period: _CanPeriod = 0.01
     """The drives' Get_Encoder_Estimates period (ODrive ``encoder_msg_rate_ms``)."""
-    startup_timeout: PositiveFloat = 1.0
-    heartbeat_timeout: PositiveFloat = 0.25
-    encoder_timeout: PositiveFloat = 0.05
-    max_frame_loss: float = Field(0.2, ge=0.0, le=1.0)
+    startup_timeout: _CanTimeout = 1.0
+    heartbeat_timeout: _CanTimeout = 0.25
+    encoder_timeout: _CanTimeout = 0.05
+    """Must be longer than ``encoder_period``."""
+    max_frame_loss: Annotated[float, _within(0.0, 1.0)] = 0.2
     """Fraction of encoder frames that may be lost over ``loss_window`` s."""
-    loss_window: PositiveFloat = 0.5
-    recovery_delay: float = Field(0.3, ge=0.0)
+    loss_window: _CanTimeout = 0.5
+    """At least ``encoder_period``."""
+    recovery_delay: _CanDelay = 0.3
     """s a fault's cause must stay clear before recovery starts."""
-    max_recovery_attempts: int = Field(3, ge=0)
+    max_recovery_attempts: Annotated[int, _within(0, limits.MAX_RECOVERY_ATTEMPTS)] = 3
+    command_keepalive: _CanDelay = 0.1
+    """s: an unchanged wheel setpoint is sent again only this often (0: at every base
+    tick). Keep it well under the drives' watchdog timeout."""
     record_frames: bool = True
     """Publish every frame on /can/frames (and so into the recording)."""
-
-    @model_validator(mode="after")
-    def _distinct(self) -> CanConfig:
-        if self.left.node_id == self.right.node_id:
-            raise ValueError(
-                f"hal.can.left.node_id and hal.can.right.node_id must differ "
-                f"(both {self.left.node_id})"
-            )
-        return self
 
 
 class DriveSimConfig(_Section):
     """The emulated drives (``otonav.hal.sim``): how they are configured, which can
-    differ from what the host expects (a wrong node id is a fault to detect)."""
+    differ from what the host expects (a wrong node id, a slower heartbeat: faults to
+    detect, not configs to refuse)."""
 
-    left_node_id: int = Field(0, ge=0, le=63)
-    right_node_id: int = Field(1, ge=0, le=63)
-    heartbeat_period: PositiveFloat = 0.1
-    encoder_period: PositiveFloat = 0.01
-    vel_limit: PositiveFloat = 20.0
+    left_node_id: _NodeId = 0
+    right_node_id: _NodeId = 1
+    heartbeat_period: _CanPeriod = 0.1
+    encoder_period: _CanPeriod = 0.01
+    vel_limit: Annotated[
+        float, _within(0.0, limits.MAX_DRIVE_VEL_TURNS_S, " turns/s", open_low=True)
+    ] = 20.0
     """turns/s."""
-    vel_ramp_rate: PositiveFloat = 200.0
+    vel_ramp_rate: Annotated[
+        float, _within(0.0, limits.MAX_DRIVE_RAMP_TURNS_S2, " turns/s^2", open_low=True)
+    ] = 200.0
     """turns/s^2."""
-    watchdog_timeout: float = Field(0.2, ge=0.0)
+    watchdog_timeout: _CanDelay = 0.2
     """s without Set_Input_Vel before the axis stops (0: off)."""
-    arm_time: float = Field(0.01, ge=0.0)
-    seed: int = Field(0, ge=0)
+    arm_time: _CanDelay = 0.01
+    seed: int = Field(0, ge=0, le=limits.MAX_SEED)
     """Seeds the injected faults' random numbers."""
-
-    @model_validator(mode="after")
-    def _distinct(self) -> DriveSimConfig:
-        if self.left_node_id == self.right_node_id:
-            raise ValueError("hal.sim.left_node_id and hal.sim.right_node_id must differ")
-        return self
 
 
 class HalConfig(_Section):
@@ -308,6 +332,7 @@ class StackConfig(_Section):
                 f"({self.safety.clearance} m): a planner keeping less would drive into "
                 "the safety layer"
             )
+        self._consistent_can()
         tick_hz = 1.0 / self.world.timestep
         for key, hz in self.rates_hz().items():
             if hz > tick_hz * (1 + 1e-9):
@@ -317,6 +342,44 @@ class StackConfig(_Section):
                     "(lower the rate, or the timestep)"
                 )
         return self
+
+    def _consistent_can(self) -> None:
+        """Cross-field checks of ``hal.can`` and ``hal.sim`` (here, at the top, so the
+        one-line error quotes just the keys involved)."""
+        can, sim = self.hal.can, self.hal.sim
+        if can.left.node_id == can.right.node_id:
+            raise ValueError(
+                f"hal.can.left.node_id and hal.can.right.node_id must differ "
+                f"(both {can.left.node_id})"
+            )
+        if sim.left_node_id == sim.right_node_id:
+            raise ValueError(
+                f"hal.sim.left_node_id and hal.sim.right_node_id must differ "
+                f"(both {sim.left_node_id})"
+            )
+        timestep = self.world.timestep
+        periods = {
+            "hal.can.encoder_period": can.encoder_period,
+            "hal.sim.encoder_period": sim.encoder_period,
+            "hal.sim.heartbeat_period": sim.heartbeat_period,
+        }
+        for key, period in periods.items():
+            if period < timestep * (1 - 1e-9):
+                raise ValueError(
+                    f"{key} = {period:g} s is shorter than a physics tick: at least "
+                    f"world.timestep = {timestep:g} s (frames go out on ticks)"
+                )
+        if can.encoder_timeout <= can.encoder_period:
+            raise ValueError(
+                f"hal.can.encoder_timeout ({can.encoder_timeout:g} s) must be longer than "
+                f"hal.can.encoder_period ({can.encoder_period:g} s): every estimate "
+                "would be late"
+            )
+        if can.loss_window < can.encoder_period:
+            raise ValueError(
+                f"hal.can.loss_window ({can.loss_window:g} s) must be at least "
+                f"hal.can.encoder_period ({can.encoder_period:g} s)"
+            )
 
     def rates_hz(self) -> dict[str, float]:
         """Every periodic actor rate of the stack, by key path (Hz)."""

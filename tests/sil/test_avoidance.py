@@ -64,8 +64,12 @@ def test_walled_in_goal_is_reported_unreachable_before_the_budget(otonav_artifac
 
 def test_gate_has_teeth_a_planner_that_ignores_the_goal_fails(otonav_artifacts: Path) -> None:
     """The dwa planner's sabotage: no heading and no progress weight (it then only likes
-    speed and clearance) must fail the acceptance scenario and leave its recording."""
-    broken = StackConfig(nav=NavConfig(dwa=DwaConfig(w_heading=0.0, w_progress=0.0)))
+    speed and clearance) must fail the acceptance scenario and leave its recording.
+    The fast path (a pure-pursuit arc to the target, no weights) is off: it would
+    otherwise drive to the goal on its own wherever the way is open."""
+    broken = StackConfig(
+        nav=NavConfig(dwa=DwaConfig(w_heading=0.0, w_progress=0.0, fast_path=False))
+    )
     verdict = run_scenario(ScenarioConfig(), broken, out_dir=otonav_artifacts, plot=False)
     assert not verdict.passed
     assert not verdict.reached

@@ -9,6 +9,8 @@ and the recovery explicit and logged.
 
 from __future__ import annotations
 
+import bisect
+import itertools
 import math
 from collections.abc import Callable
 from pathlib import Path
@@ -72,21 +74,30 @@ def test_acceptance_over_can_passes_and_every_wheel_command_is_a_frame(tmp_path:
     # Encoder estimates every 10 ms and heartbeats every 100 ms, from both drives.
     assert len(by_cmd[p.CMD_GET_ENCODER_ESTIMATES]) == pytest.approx(2 * sim / 0.01, abs=4)
     assert len(by_cmd[p.CMD_HEARTBEAT]) == pytest.approx(2 * sim / 0.1, abs=4)
-    # Every /wheel_cmd left as a pair of Set_Input_Vel frames with the same values
-    # (turns/s, float32, left motor mirrored).
+    # Every /wheel_cmd reached the drives as Set_Input_Vel (turns/s, float32, left motor
+    # mirrored): at its instant, the last setpoint sent to each drive is its value. A
+    # repeated setpoint is resent only after the keepalive, so fewer frames than
+    # commands cross the bus, and no drive waits longer than keepalive + a base period.
     wheel_cmds = [m for _t, _s, m in read_messages(recording, [topics.WHEEL_CMD])]
-    setpoints = [
-        (frame.id >> 5, struct_f32(bytes(frame.data))) for frame in by_cmd[p.CMD_SET_INPUT_VEL]
-    ]
-    assert len(setpoints) == 2 * len(wheel_cmds)
-    for cmd, (left, right) in zip(
-        wheel_cmds, zip(setpoints[::2], setpoints[1::2], strict=True), strict=True
-    ):
-        if cmd.header.stamp.sec + cmd.header.stamp.nanosec * 1e-9 < 0.15:
+    sent: dict[int, list[tuple[float, float]]] = {0: [], 1: []}
+    for frame in by_cmd[p.CMD_SET_INPUT_VEL]:
+        sent[frame.id >> 5].append((_secs(frame.header.stamp), struct_f32(frame.data)))
+    checked = 0
+    for cmd in wheel_cmds:
+        t = _secs(cmd.header.stamp)
+        if t < 0.15:
             continue  # zero while the drives start
-        assert (left[0], right[0]) == (0, 1)
-        assert left[1] == pytest.approx(-cmd.left / (2 * math.pi), rel=1e-6, abs=1e-6)
-        assert right[1] == pytest.approx(cmd.right / (2 * math.pi), rel=1e-6, abs=1e-6)
+        for node, value in ((0, -cmd.left / (2 * math.pi)), (1, cmd.right / (2 * math.pi))):
+            times = [s for s, _v in sent[node]]
+            last = sent[node][bisect.bisect_right(times, t + 1e-9) - 1]
+            assert last[1] == pytest.approx(value, rel=1e-6, abs=1e-6), (t, node)
+            checked += 1
+    assert checked > 2 * 500
+    keepalive = CAN.hal.can.command_keepalive
+    for node in (0, 1):
+        assert len(sent[node]) < 0.8 * len(wheel_cmds)
+        gaps = [b - a for (a, _), (b, _) in itertools.pairwise(sent[node])]
+        assert max(gaps) <= keepalive + BASE_PERIOD + 1e-9
     # Startup (Clear_Errors, controller mode, closed loop) and shutdown (IDLE) frames.
     states = [p.decode_set_axis_state(bytes(f.data)) for f in by_cmd[p.CMD_SET_AXIS_STATE]]
     assert states[:2] == [p.AxisState.CLOSED_LOOP_CONTROL] * 2
@@ -94,8 +105,12 @@ def test_acceptance_over_can_passes_and_every_wheel_command_is_a_frame(tmp_path:
     assert any("running: node 0 (left wheel), node 1 (right wheel)" in m for m in logs)
 
 
-def struct_f32(data: bytes) -> float:
-    return float(p.unpack_two_f32(data)[0])
+def _secs(stamp: Any) -> float:
+    return float(stamp.sec + stamp.nanosec * 1e-9)
+
+
+def struct_f32(data: bytes | tuple[int, ...]) -> float:
+    return float(p.unpack_two_f32(bytes(data))[0])
 
 
 def test_two_can_runs_give_byte_identical_recordings(tmp_path: Path) -> None:
@@ -107,6 +122,24 @@ def test_two_can_runs_give_byte_identical_recordings(tmp_path: Path) -> None:
     assert summarize(tmp_path / "a" / "recording.mcap").topics
     assert len(a) > 50_000
     assert a == b
+
+
+def test_a_failed_run_ends_its_recording_with_the_idle_frames(tmp_path: Path) -> None:
+    # A 1 s budget: the scenario fails. Its recording must still show the shutdown:
+    # both drives set IDLE, after every other command the host sent them.
+    verdict = run_scenario(ScenarioConfig(sim_budget=1.0), CAN, out_dir=tmp_path, plot=False)
+    assert not verdict.passed
+    frames = [m for _t, _s, m in read_messages(tmp_path / "recording.mcap", [FRAMES_TOPIC])]
+    commands = [f for f in frames if f.id & 0x1F not in _FROM_DRIVES]
+    assert [(f.id >> 5, f.id & 0x1F) for f in commands[-2:]] == [
+        (0, p.CMD_SET_AXIS_STATE),
+        (1, p.CMD_SET_AXIS_STATE),
+    ]
+    assert {p.decode_set_axis_state(bytes(f.data)) for f in commands[-2:]} == {p.AxisState.IDLE}
+    assert _secs(commands[-1].header.stamp) == pytest.approx(verdict.sim_time_s, abs=0.011)
+
+
+_FROM_DRIVES = {p.CMD_HEARTBEAT, p.CMD_GET_ENCODER_ESTIMATES}
 
 
 # -- the interface alone: startup, shutdown, encoders only from frames -------------------
@@ -149,7 +182,12 @@ class _SensorsOnly(RobotHardwareInterface):
 
 
 def _bench(
-    channel: str, *, left_sign: int = -1, mount_sign: int = -1, host_left_id: int = 0
+    channel: str,
+    *,
+    left_sign: int = -1,
+    mount_sign: int = -1,
+    host_left_id: int = 0,
+    keepalive: float = 0.1,
 ) -> tuple[CanBusInterface, DriveEmulator, MujocoInterface]:
     world = MujocoInterface("empty")
     emulator = DriveEmulator(
@@ -166,6 +204,7 @@ def _bench(
         WheelAxis(1, 1, label="right wheel"),
         MonitorLimits(),
         peer=emulator,
+        command_keepalive=keepalive,
     )
     return hal, emulator, world
 
@@ -194,6 +233,31 @@ def test_startup_waits_for_closed_loop_in_sim_time_and_shutdown_sets_idle() -> N
     frames = hal.take_frames()
     idle = p.set_axis_state(0, p.AxisState.IDLE)
     assert (frames[-2][1].arbitration_id, frames[-2][1].data) == idle
+
+
+@pytest.mark.parametrize(("keepalive", "expected"), [(0.1, 5), (0.0, 50)])
+def test_an_unchanged_setpoint_is_resent_only_after_the_keepalive(
+    keepalive: float, expected: int
+) -> None:
+    hal, emulator, _world = _bench(f"test-keepalive-{keepalive}", keepalive=keepalive)
+    with hal:
+        hal.advance(50)
+        assert hal.health().drivable
+        hal.take_frames()
+        for _ in range(50):  # 0.5 s of the same setpoint, written every 10 ms
+            hal.write(WheelCommand(6.0, 6.0))
+            hal.advance(5)
+        frames = [f for _t, f in hal.take_frames()]
+        hal.write(WheelCommand(5.0, 6.0))  # a change goes out at once
+        changed = [f for _t, f in hal.take_frames()]
+        # The drives were fed all along: the 0.2 s watchdog never expired.
+        assert emulator.drive(0).state == p.AxisState.CLOSED_LOOP_CONTROL
+        assert hal.health().drivable
+    setpoints = [f for f in frames if f.arbitration_id & 0x1F == p.CMD_SET_INPUT_VEL]
+    for node in (0, 1):
+        assert len([f for f in setpoints if f.arbitration_id >> 5 == node]) == expected
+    left = [f for f in changed if f.arbitration_id == p.arbitration_id(0, p.CMD_SET_INPUT_VEL)]
+    assert struct_f32(left[0].data) == pytest.approx(-5.0 / (2 * math.pi), rel=1e-6)
 
 
 def test_a_wrong_direction_sign_drives_the_wheel_backwards() -> None:

@@ -11,12 +11,12 @@ import pytest
 from otonav.hal import RobotGeometry
 from otonav.hal.mujoco import MujocoInterface
 from otonav.nav.costmap import ClearanceMap
-from otonav.nav.dwa import DwaParams, dwa_step
+from otonav.nav.dwa import DwaParams, clear_arc, dwa_step
 from otonav.nav.footprint import centre_clearance
 from otonav.nav.global_path import astar
 from otonav.nav.navigation import Navigation, NavigationParams
 from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
-from otonav.nav.scan import scan_points, to_frame
+from otonav.nav.scan import nearest_return, scan_points, to_frame
 
 pytestmark = pytest.mark.unit
 
@@ -70,6 +70,23 @@ def test_scan_points_in_base_link_and_blocked_beams() -> None:
     assert clean.xy.shape == (1, 2)
 
 
+def test_nearest_return_is_the_nearest_of_the_scan_points() -> None:
+    rng = np.random.default_rng(3)
+    inc = 2 * math.pi / 360
+    for trial in range(20):
+        ranges = rng.uniform(0.05, 9.0, 360)
+        ranges[rng.random(360) < 0.2] = np.inf
+        ranges[rng.random(360) < 0.05] = np.nan
+        if trial % 2:
+            ranges[rng.integers(360)] = -np.inf
+        offset = float(rng.uniform(-0.2, 0.2))
+        xy = scan_points(ranges, -math.pi, inc, 0.12, 8.0, offset).xy
+        expected = float(np.hypot(xy[:, 0], xy[:, 1]).min())
+        got = nearest_return(ranges, -math.pi, inc, 0.12, 8.0, offset)
+        assert got == pytest.approx(expected, abs=1e-9)
+    assert nearest_return(np.full(8, np.inf), 0.0, 0.1, 0.12, 8.0, 0.1) == math.inf
+
+
 def test_to_frame_round_trip() -> None:
     pts = np.array([[1.0, 0.0], [0.0, 2.0]])
     odom = to_frame(pts, (1.0, 1.0, math.pi / 2))
@@ -93,6 +110,22 @@ def test_clearance_is_a_lower_bound_capped_and_unknown_is_free() -> None:
     assert (c[:3] >= np.minimum(true[:3], 0.6) - 0.08).all()  # and not much less
     assert c[3] == pytest.approx(0.6)  # farther than the cap
     assert c[4] == pytest.approx(0.6)  # outside the map
+
+
+def test_a_scan_adding_no_new_cell_leaves_the_map_as_it_was() -> None:
+    m = ClearanceMap(0.0, 0.0, half_size=2.0, resolution=0.05, max_distance=0.6)
+    wall = _wall(1.0, -0.5, 0.5)
+    assert m.mark(wall) > 0
+    before, marked = m.clearance(*np.mgrid[-2:2:0.01, -2:2:0.01]).copy(), m.marked
+    # the same cells again, and points outside the map (ignored): nothing changes
+    again = np.concatenate((wall + 0.001, [[5.0, 0.0], [-9.0, -9.0]]))
+    assert m.mark(again) == 0
+    assert m.marked == marked
+    assert (m.clearance(*np.mgrid[-2:2:0.01, -2:2:0.01]) == before).all()
+    # a return on the map's edge stamps the ring just outside it (a true bound there)
+    assert m.mark(np.array([[1.99, 0.0]])) == 1
+    assert m.clearance(np.array([2.04]), np.array([0.0]))[0] < 0.6
+    assert m.clearance(np.array([3.0]), np.array([0.0]))[0] == pytest.approx(0.6)
 
 
 # -- A* --------------------------------------------------------------------------------
@@ -155,6 +188,59 @@ def test_dwa_does_not_crawl_into_a_goal_inside_its_horizon() -> None:
     # Goal 0.3 m ahead, 0.4 m/s now: an arc through the goal beats one stopping short.
     r = dwa_step((0.0, 0.0, 0.0), 0.4, 0.0, (0.3, 0.0), 0.3, m.clearance, DwaParams())
     assert r.v >= 0.35
+
+
+def test_fast_path_in_the_open_is_the_pure_pursuit_arc_at_the_top_of_the_window() -> None:
+    m = _map_with(np.empty((0, 2)))
+    p = DwaParams()
+    r = clear_arc((0.0, 0.0, 0.0), 0.2, 0.0, (2.0, 0.4), 3.0, m.clearance, p)
+    assert r is not None
+    assert r.reason == "clear arc"
+    assert r.v == pytest.approx(0.2 + p.max_accel * p.period)
+    # curvature 2 y / L^2 toward the target, within the yaw-rate window
+    assert r.omega == pytest.approx(r.v * 2 * 0.4 / (2.0**2 + 0.4**2))
+    # a target far off the heading, or no speed in reach: the full step decides
+    assert clear_arc((0.0, 0.0, 0.0), 0.2, 0.0, (-1.0, 1.0), 3.0, m.clearance, p) is None
+    assert clear_arc((0.0, 0.0, 0.0), 0.0, 0.0, (2.0, 0.0), 0.0, m.clearance, p) is None
+
+
+def test_fast_path_gives_way_to_the_sampling_near_an_obstacle() -> None:
+    p = DwaParams()
+    m = _map_with(_wall(0.9, -0.3, 0.3))
+    assert clear_arc((0.0, 0.0, 0.0), 0.4, 0.0, (2.0, 0.0), 3.0, m.clearance, p) is None
+    nav = Navigation(NavigationParams(), (0.0, 0.0))
+    nav.set_goal((2.0, 0.0))
+    nav.observe(_wall(0.9, -0.3, 0.3))
+    out = nav.step(0.0, (0.0, 0.0, 0.0), 0.4, 0.0, np.empty((0, 2)))
+    assert out.dwa is not None
+    assert out.dwa.samples > 1  # sampled, not the fast path
+
+
+def test_fast_path_arcs_keep_their_margin_everywhere_not_only_at_their_poses() -> None:
+    """The proof in the module docstring, checked: wherever clear_arc answers, the arc
+    sampled every millimetre stays radius + fast_margin from every return."""
+    rng = np.random.default_rng(7)
+    p = DwaParams()
+    taken = 0
+    for _ in range(300):
+        pts = rng.uniform(-2.0, 2.0, (6, 2))
+        m = _map_with(pts)
+        pose = (float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), float(rng.uniform(-3, 3)))
+        v0, w0 = float(rng.uniform(0, 0.4)), float(rng.uniform(-1, 1))
+        ang = pose[2] + float(rng.uniform(-0.6, 0.6))
+        target = (pose[0] + 0.8 * math.cos(ang), pose[1] + 0.8 * math.sin(ang))
+        r = clear_arc(pose, v0, w0, target, 3.0, m.clearance, p)
+        if r is None:
+            continue
+        taken += 1
+        t = np.linspace(0.0, p.horizon, 1601)
+        w = r.omega if abs(r.omega) > 1e-9 else 1e-9
+        th = pose[2] + w * t
+        xs = pose[0] + r.v / w * (np.sin(th) - math.sin(pose[2]))
+        ys = pose[1] - r.v / w * (np.cos(th) - math.cos(pose[2]))
+        gap = np.hypot(xs[:, None] - pts[None, :, 0], ys[:, None] - pts[None, :, 1]).min()
+        assert gap >= p.radius + p.fast_margin - 1e-9
+    assert taken > 30  # the property was exercised, not skipped
 
 
 def test_dwa_turns_first_toward_a_target_behind() -> None:

@@ -87,6 +87,11 @@ class CanBusInterface(RobotHardwareInterface):
 
     ``frame_log`` bounds the frames kept for :meth:`take_frames` (the recording tap);
     older ones are dropped and counted in :attr:`frames_dropped_from_log`.
+
+    ``command_keepalive`` (s): a wheel setpoint equal to the one last sent to that drive
+    is sent again only once this much sim time has passed since (0: every write is
+    sent). The drive holds its last setpoint; the resend feeds its watchdog, so keep
+    it well under the drives' ``watchdog_timeout``. A changed setpoint always goes out.
     """
 
     def __init__(
@@ -99,7 +104,10 @@ class CanBusInterface(RobotHardwareInterface):
         *,
         peer: BusPeer | None = None,
         frame_log: int = 50_000,
+        command_keepalive: float = 0.1,
     ) -> None:
+        if not 0.0 <= command_keepalive < math.inf:
+            raise ValueError(f"command_keepalive must be >= 0 s, got {command_keepalive}")
         if left.node_id == right.node_id:
             raise ValueError(f"left and right wheel share node id {left.node_id}")
         self._endpoint = endpoint
@@ -108,6 +116,10 @@ class CanBusInterface(RobotHardwareInterface):
         self._axes = (left, right)
         self._index = {left.node_id: 0, right.node_id: 1}
         self._scale = (left.turns_per_rad(), right.turns_per_rad())
+        self._vel_ids = (
+            p.arbitration_id(left.node_id, p.CMD_SET_INPUT_VEL),
+            p.arbitration_id(right.node_id, p.CMD_SET_INPUT_VEL),
+        )
         self.monitor = DriveMonitor(
             (NodeLabel(left.node_id, left.label), NodeLabel(right.node_id, right.label)),
             limits,
@@ -119,6 +131,11 @@ class CanBusInterface(RobotHardwareInterface):
         self._logged = 0
         self.frames_dropped_from_log = 0
         self._closed = False
+        self._stopped = False  # the drives were set IDLE (stop_drives)
+        self._keepalive_ticks = round(command_keepalive / sensors.tick)
+        # Per axis: the Set_Input_Vel payload last sent and its tick (None: send).
+        self._last_vel: list[bytes | None] = [None, None]
+        self._last_vel_tick = [0, 0]
         self._serviced_at = -1  # the tick of the last bus instant
         self._sent = False  # frames sent since then (the peer must hear them)
         self._tick = sensors.tick
@@ -180,17 +197,29 @@ class CanBusInterface(RobotHardwareInterface):
         except BusError as exc:
             monitor.bus_off(t, str(exc))
             frames = []
+        if frames:
+            self._receive(frames, t)
+        self._apply(monitor.check(t), t)
+
+    def _receive(self, frames: list[RawFrame], t: float) -> None:
+        """Log and decode the frames of one bus instant (the hot path: two encoder
+        frames every 10 ms; the id split and dispatch are inlined)."""
+        monitor, log = self.monitor, self._log
+        maxlen = log.maxlen
         for frame in frames:
-            self._record(t, frame)
+            if len(log) == maxlen:
+                self.frames_dropped_from_log += 1
+            log.append((t, frame))
+            ident = frame.arbitration_id
             if frame.is_error:
-                if frame.arbitration_id & CAN_ERR_BUSOFF:
+                if ident & CAN_ERR_BUSOFF:
                     monitor.bus_off(t, "error frame from the controller (CAN_ERR_BUSOFF)")
-                if frame.arbitration_id & CAN_ERR_RESTARTED:
+                if ident & CAN_ERR_RESTARTED:
                     monitor.bus_restarted(t)
                 continue
             if frame.is_remote:
                 continue
-            node, cmd = p.split_id(frame.arbitration_id)
+            node, cmd = ident >> 5 & p.MAX_NODE_ID, ident & 0x1F
             try:
                 if cmd == p.CMD_GET_ENCODER_ESTIMATES:
                     self._on_encoder(node, frame.data, t)
@@ -199,7 +228,6 @@ class CanBusInterface(RobotHardwareInterface):
                     monitor.heartbeat(node, beat.axis_error, beat.axis_state, t)
             except ValueError:  # a short payload: ignored, like a bad frame on the wire
                 continue
-        self._apply(monitor.check(t), t)
 
     def _on_encoder(self, node: int, data: bytes, t: float) -> None:
         self.monitor.encoder(node, t)
@@ -220,6 +248,7 @@ class CanBusInterface(RobotHardwareInterface):
             elif action is Action.ZERO_ALL:
                 for axis in self._axes:
                     self._send(*p.set_input_vel(axis.node_id, 0.0), t)
+                self._last_vel = [None, None]
             elif action is Action.START_ALL:
                 self._start(t)
 
@@ -234,6 +263,7 @@ class CanBusInterface(RobotHardwareInterface):
             )
             self._send(*p.set_axis_state(axis.node_id, p.AxisState.CLOSED_LOOP_CONTROL), t)
         self.monitor.requested(t)
+        self._last_vel = [None, None]  # the next setpoint goes out whatever it is
 
     def _send(self, ident: int, data: bytes, t: float) -> None:
         frame = RawFrame(ident, data)
@@ -243,9 +273,6 @@ class CanBusInterface(RobotHardwareInterface):
             self.monitor.bus_off(t, str(exc))
             return
         self._sent = True
-        self._record(t, frame)
-
-    def _record(self, t: float, frame: RawFrame) -> None:
         log = self._log
         if len(log) == log.maxlen:
             self.frames_dropped_from_log += 1
@@ -266,11 +293,22 @@ class CanBusInterface(RobotHardwareInterface):
         if not (math.isfinite(cmd.left) and math.isfinite(cmd.right)):
             raise ValueError(f"wheel command must be finite, got {cmd}")
         drivable = self.monitor.health.drivable
-        t = self._sensors.ticks * self._tick
-        left, right = self._axes
+        now = self._sensors.ticks
+        t = now * self._tick
         sl, sr = self._scale
-        self._send(*p.set_input_vel(left.node_id, cmd.left * sl if drivable else 0.0), t)
-        self._send(*p.set_input_vel(right.node_id, cmd.right * sr if drivable else 0.0), t)
+        pack = p.pack_two_f32
+        self._set_vel(0, pack(cmd.left * sl if drivable else 0.0, 0.0), now, t)
+        self._set_vel(1, pack(cmd.right * sr if drivable else 0.0, 0.0), now, t)
+
+    def _set_vel(self, i: int, data: bytes, now: int, t: float) -> None:
+        """Set_Input_Vel to axis ``i``, unless it repeats the last one within the
+        keepalive (the acceptance run repeats 57 % of its setpoints: at rest, at the
+        speed limit)."""
+        if data == self._last_vel[i] and now - self._last_vel_tick[i] < self._keepalive_ticks:
+            return
+        self._last_vel[i] = data
+        self._last_vel_tick[i] = now
+        self._send(self._vel_ids[i], data, t)
 
     def read_wheels(self) -> WheelState:
         wheels = self._wheels
@@ -306,18 +344,30 @@ class CanBusInterface(RobotHardwareInterface):
         """The sensor source (in simulation: the world, for viewers and ground truth)."""
         return self._sensors
 
+    def stop_drives(self) -> None:
+        """Set both drives IDLE now and let a simulated peer take it in. Idempotent;
+        :meth:`close` does it if nobody did before. The frame tap calls it as the last
+        robot actor stops, so a recording ends with these frames (when the HAL closes,
+        the recording is already finished)."""
+        if self._closed or self._stopped:
+            return
+        self._stopped = True
+        now = self._sensors.ticks
+        t = now * self._tick
+        for axis in self._axes:
+            self._send(*p.set_axis_state(axis.node_id, p.AxisState.IDLE), t)
+        if self._peer is not None:
+            self._peer.exchange(now)
+
     def close(self) -> None:
-        """Set both drives IDLE, let a simulated peer hear it, close the bus. Idempotent."""
+        """Set both drives IDLE (unless :meth:`stop_drives` did), let a simulated peer
+        hear it, close the bus. Idempotent."""
         if self._closed:
             return
-        self._closed = True
         try:
-            t = self._sensors.ticks * self._tick
-            for axis in self._axes:
-                self._send(*p.set_axis_state(axis.node_id, p.AxisState.IDLE), t)
-            if self._peer is not None:
-                self._peer.exchange(self._sensors.ticks)
+            self.stop_drives()
         finally:
+            self._closed = True
             try:
                 self._endpoint.close()
             finally:

@@ -47,6 +47,7 @@ __all__ = [
     "encode_heartbeat",
     "error_names",
     "estop",
+    "pack_two_f32",
     "set_axis_state",
     "set_controller_mode",
     "set_input_vel",
@@ -230,6 +231,9 @@ def decode_encoder_estimates(data: bytes) -> EncoderEstimates:
     pos, vel = _TWO_F32.unpack_from(data)
     return EncoderEstimates(float(pos), float(vel))
 
+
+pack_two_f32 = _TWO_F32.pack
+"""Two little-endian float32 (the hot-path encoder of encoder estimates)."""
 
 unpack_two_f32 = _TWO_F32.unpack_from
 """``(a, b)`` from two little-endian float32: the hot-path decoder of encoder estimates

@@ -69,13 +69,17 @@ class BusFaults:
 
 
 class _Drive:
-    __slots__ = ("axis", "heartbeat_silent", "mount", "node_id")
+    __slots__ = ("axis", "encoder_id", "heartbeat_id", "heartbeat_silent", "k", "mount", "node_id")
 
     def __init__(self, params: AxisParams, mount: DriveMount) -> None:
         self.axis = AxisModel(params)
         self.mount = mount
         self.node_id = params.node_id
         self.heartbeat_silent = False
+        # Precomputed for the 10 ms encoder frames: the id, and wheel rad -> motor turns.
+        self.encoder_id = p.arbitration_id(params.node_id, p.CMD_GET_ENCODER_ESTIMATES)
+        self.heartbeat_id = p.arbitration_id(params.node_id, p.CMD_HEARTBEAT)
+        self.k = mount.sign * mount.gear_ratio / _TWO_PI
 
 
 class DriveEmulator:
@@ -111,6 +115,7 @@ class DriveEmulator:
         self._rng = np.random.default_rng(seed)
         self._bus_off = False
         self._sent_at = -1  # last tick whose cyclic frames went out
+        self._updated_at = -1  # last tick the axes were updated and the wheels driven
         self._seq = 0
         # Delayed frames: (due tick, seq, outbound?, frame).
         self._held: list[tuple[int, int, bool, RawFrame]] = []
@@ -160,25 +165,37 @@ class DriveEmulator:
         return nxt
 
     def exchange(self, now: int) -> None:
-        """Receive, update the drives and the wheels, send what is due at tick ``now``."""
+        """Receive, update the drives and the wheels, send what is due at tick ``now``.
+
+        Called again at an instant already exchanged (the host sent commands since),
+        the axes are updated again only if a command changed their state: a
+        Set_Input_Vel alone moves nothing before time passes (the setpoint ramp is
+        ``vel_ramp_rate * dt`` and dt is 0), so that update would be a no-op. Skipping
+        it saved ~10 % of the emulator's cost (one such instant per 20 ms base tick)."""
         t = now * self._tick
+        changed = False
         incoming = self._endpoint.poll()
-        if self._bus_off:
-            incoming = []  # nothing crosses a bus-off bus
-        for frame in incoming:
-            self.frames_received += 1
-            if self._lose_or_hold(frame, now, outbound=False):
-                continue
-            self._handle(frame, t)
-        while self._held and self._held[0][0] <= now:
-            _, _, outbound, frame = heapq.heappop(self._held)
+        if incoming and not self._bus_off:  # nothing crosses a bus-off bus
+            faults = self.faults
+            lossy = faults.drop_rate > 0.0 or faults.delay > 0.0 or faults.jitter > 0.0
+            for frame in incoming:
+                self.frames_received += 1
+                if lossy and self._lose_or_hold(frame, now, outbound=False):
+                    continue
+                changed |= self._handle(frame, t)
+        held = self._held
+        while held and held[0][0] <= now:
+            _, _, outbound, frame = heapq.heappop(held)
             if self._bus_off:
                 continue
             if outbound:
                 self._endpoint.send(frame, t)
                 self.frames_sent += 1
             else:
-                self._handle(frame, t)
+                changed |= self._handle(frame, t)
+        if now == self._updated_at and not changed:
+            return
+        self._updated_at = now
         wheels = self._world.read_wheels()
         self._drive_wheels(t, wheels)
         if now != self._sent_at and not self._bus_off:
@@ -206,23 +223,30 @@ class DriveEmulator:
         return False
 
     def _transmit(self, frame: RawFrame, now: int, t: float) -> None:
-        if self._lose_or_hold(frame, now, outbound=True):
+        faults = self.faults
+        if (
+            faults.drop_rate > 0.0 or faults.delay > 0.0 or faults.jitter > 0.0
+        ) and self._lose_or_hold(frame, now, outbound=True):
             return
         self._endpoint.send(frame, t)
         self.frames_sent += 1
 
-    def _handle(self, frame: RawFrame, t: float) -> None:
+    def _handle(self, frame: RawFrame, t: float) -> bool:
+        """Apply one command frame; True if it may have changed an axis' state (any
+        command but Set_Input_Vel)."""
         if frame.is_error or frame.is_remote:
-            return
-        node, cmd = p.split_id(frame.arbitration_id)
-        drive = self._by_node.get(node)
+            return False
+        ident = frame.arbitration_id
+        drive = self._by_node.get(ident >> 5 & p.MAX_NODE_ID)
         if drive is None:
-            return
+            return False
+        cmd = ident & 0x1F
         axis, data = drive.axis, frame.data
         try:
             if cmd == p.CMD_SET_INPUT_VEL:
                 axis.set_input_vel(p.unpack_two_f32(data)[0], t)
-            elif cmd == p.CMD_SET_AXIS_STATE:
+                return False
+            if cmd == p.CMD_SET_AXIS_STATE:
                 axis.request_state(p.decode_set_axis_state(data), t)
             elif cmd == p.CMD_ESTOP:
                 axis.estop()
@@ -230,33 +254,42 @@ class DriveEmulator:
                 axis.clear_errors()
             elif cmd == p.CMD_SET_CONTROLLER_MODE:
                 axis.set_controller_mode(*p.decode_set_controller_mode(data))
+            else:
+                return False
         except ValueError:  # a short payload (struct.error is a ValueError): ignored
-            return
+            return False
+        return True
 
     def _drive_wheels(self, t: float, wheels: WheelState) -> None:
         left, right = self.drives
-        out = []
-        for drive, wheel_vel in ((left, wheels.left_velocity), (right, wheels.right_velocity)):
-            mount = drive.mount
-            measured = mount.sign * wheel_vel * mount.gear_ratio / _TWO_PI
-            turns = drive.axis.update(t, measured)
-            out.append(mount.sign * turns * _TWO_PI / mount.gear_ratio)
-        cmd = (out[0], out[1])
+        ml, mr = left.mount, right.mount
+        # wheel rad/s -> motor turns/s and back (the arithmetic is the recording's bytes)
+        turns_l = left.axis.update(t, ml.sign * wheels.left_velocity * ml.gear_ratio / _TWO_PI)
+        turns_r = right.axis.update(t, mr.sign * wheels.right_velocity * mr.gear_ratio / _TWO_PI)
+        cmd = (
+            ml.sign * turns_l * _TWO_PI / ml.gear_ratio,
+            mr.sign * turns_r * _TWO_PI / mr.gear_ratio,
+        )
         if cmd != self._last_cmd:
             self._last_cmd = cmd
             self._world.write(WheelCommand(cmd[0], cmd[1]))
 
     def _send_encoders(self, now: int, t: float, wheels: WheelState) -> None:
         left, right = self.drives
-        for drive, pos, vel in (
-            (left, wheels.left_position, wheels.left_velocity),
-            (right, wheels.right_position, wheels.right_velocity),
-        ):
-            k = drive.mount.sign * drive.mount.gear_ratio / _TWO_PI
-            ident, data = p.encode_encoder_estimates(
-                drive.node_id, p.EncoderEstimates(pos * k, vel * k)
-            )
-            self._transmit(RawFrame(ident, data), now, t)
+        pack = p.pack_two_f32
+        kl, kr = left.k, right.k
+        self._transmit(
+            RawFrame(left.encoder_id, pack(wheels.left_position * kl, wheels.left_velocity * kl)),
+            now,
+            t,
+        )
+        self._transmit(
+            RawFrame(
+                right.encoder_id, pack(wheels.right_position * kr, wheels.right_velocity * kr)
+            ),
+            now,
+            t,
+        )
 
     def _send_heartbeats(self, now: int, t: float) -> None:
         for drive in self.drives:

@@ -4,27 +4,14 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
-from otonav.cli import main
 from otonav.record.reader import MAGIC
 
 pytestmark = pytest.mark.unit
-
-
-def _fails(capsys: pytest.CaptureFixture[str], argv: list[str], *fragments: str) -> str:
-    code = main(argv)
-    err = capsys.readouterr().err
-    assert code == 2, err
-    assert "Traceback" not in err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert len(lines[0]) < 400, lines[0][:400]
-    for fragment in fragments:
-        assert fragment in lines[0], lines[0]
-    return lines[0]
 
 
 @pytest.mark.parametrize(
@@ -36,12 +23,11 @@ def _fails(capsys: pytest.CaptureFixture[str], argv: list[str], *fragments: str)
     ],
 )
 def test_start_or_goal_too_close_to_a_wall(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path, text: str, key: str
+    cli_fails: Callable[..., str], tmp_path: Path, text: str, key: str
 ) -> None:
     f = tmp_path / "s.yaml"
     f.write_text(text)
-    _fails(
-        capsys,
+    cli_fails(
         ["run", "--scenario", str(f), "--out", str(tmp_path)],
         str(f),
         f"{key}:",
@@ -52,11 +38,11 @@ def test_start_or_goal_too_close_to_a_wall(
 
 
 def test_info_on_the_magic_and_garbage_is_exit_2(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path
+    cli_fails: Callable[..., str], tmp_path: Path
 ) -> None:
     f = tmp_path / "junk.mcap"
     f.write_bytes(MAGIC + b"\x00garbage that is no record" * 40)
-    _fails(capsys, ["info", str(f)], str(f), "no readable MCAP header")
+    cli_fails(["info", str(f)], str(f), "no readable MCAP header")
 
 
 def _bomb(levels: int) -> str:
@@ -84,29 +70,29 @@ def _bomb(levels: int) -> str:
     ids=["anchor-bomb", "recursive-alias", "deep", "latin-1", "utf-16", "big", "10MB-name"],
 )
 def test_config_files_over_a_limit(
-    capsys: pytest.CaptureFixture[str],
+    cli_fails: Callable[..., str],
     tmp_path: Path,
     content: bytes,
     fragments: tuple[str, ...],
 ) -> None:
     f = tmp_path / "stack.yaml"
     f.write_bytes(content)
-    _fails(capsys, ["run", "--config", str(f), "--out", str(tmp_path)], str(f), *fragments)
-    _fails(capsys, ["run", "--scenario", str(f), "--out", str(tmp_path)], str(f), *fragments)
+    cli_fails(["run", "--config", str(f), "--out", str(tmp_path)], str(f), *fragments)
+    cli_fails(["run", "--scenario", str(f), "--out", str(tmp_path)], str(f), *fragments)
 
 
 def test_set_values_are_parsed_within_the_same_limits(
-    capsys: pytest.CaptureFixture[str],
+    cli_fails: Callable[..., str],
 ) -> None:
     bomb = _bomb(7).replace("\n", ", ").replace("a0: ", "{a0: ", 1).rstrip(", ") + "}"
-    _fails(capsys, ["run", "--set", f"world.scene={bomb}"], "--set world.scene", "expands")
+    cli_fails(["run", "--set", f"world.scene={bomb}"], "--set world.scene", "expands")
 
 
 def test_long_names_through_set_are_refused_in_a_short_line(
-    capsys: pytest.CaptureFixture[str],
+    cli_fails: Callable[..., str],
 ) -> None:
-    _fails(capsys, ["run", "--set", "world.scene=" + "s" * 5000], "world.scene", "4096")
-    _fails(capsys, ["run", "--set", "world.scene=" + "s" * 10_000_000], "world.scene", "KiB")
+    cli_fails(["run", "--set", "world.scene=" + "s" * 5000], "world.scene", "4096")
+    cli_fails(["run", "--set", "world.scene=" + "s" * 10_000_000], "world.scene", "KiB")
 
 
 def test_anchors_for_ordinary_reuse_still_work(tmp_path: Path) -> None:
@@ -126,9 +112,9 @@ def test_anchors_for_ordinary_reuse_still_work(tmp_path: Path) -> None:
 
 
 def test_sweep_set_values_are_parsed_within_the_same_limits(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path
+    cli_fails: Callable[..., str], tmp_path: Path
 ) -> None:
     # A grid value is parsed as YAML too: 3000 levels were a RecursionError traceback.
     deep = "[" * 3000 + "]" * 3000
     argv = ["sweep", "--scenario", "acceptance", "--set", f"nav.kp_lin={deep}"]
-    _fails(capsys, [*argv, "--out", str(tmp_path)], "nav.kp_lin", "nested deeper than 32")
+    cli_fails([*argv, "--out", str(tmp_path)], "nav.kp_lin", "nested deeper than 32")

@@ -5,6 +5,7 @@ load time with one line naming the key, exit 2 (issue 17, item 2)."""
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -13,18 +14,6 @@ from otonav.cli import main
 from otonav.stack import StackConfig
 
 pytestmark = pytest.mark.unit
-
-
-def _fails(capsys: pytest.CaptureFixture[str], argv: list[str], *fragments: str) -> str:
-    code = main(argv)
-    err = capsys.readouterr().err
-    assert code == 2, err
-    assert "Traceback" not in err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    for fragment in fragments:
-        assert fragment in lines[0], lines[0]
-    return lines[0]
 
 
 @pytest.mark.parametrize(
@@ -41,7 +30,7 @@ def _fails(capsys: pytest.CaptureFixture[str], argv: list[str], *fragments: str)
     ],
 )
 def test_stack_numbers_beyond_what_the_stack_honours(
-    capsys: pytest.CaptureFixture[str],
+    cli_fails: Callable[..., str],
     tmp_path: Path,
     section: str,
     key: str,
@@ -50,7 +39,7 @@ def test_stack_numbers_beyond_what_the_stack_honours(
 ) -> None:
     f = tmp_path / "stack.yaml"
     f.write_text(f"{section}:\n  {key}: {value}\n")
-    _fails(capsys, ["run", "--config", str(f)], str(f), f"{section}.{key}", valid)
+    cli_fails(["run", "--config", str(f)], str(f), f"{section}.{key}", valid)
 
 
 @pytest.mark.parametrize(
@@ -58,11 +47,11 @@ def test_stack_numbers_beyond_what_the_stack_honours(
     ["rates.scan_hz=1.0e+9", "rates.clock_hz=501", "base.rate_hz=1000", "nav.rate_hz=600"],
 )
 def test_a_rate_faster_than_the_physics_ticks_is_refused(
-    capsys: pytest.CaptureFixture[str], override: str
+    cli_fails: Callable[..., str], override: str
 ) -> None:
     # scan_hz=1e9 re-armed its timer inside one tick and livelocked the loop.
     key = override.partition("=")[0]
-    _fails(capsys, ["run", "--set", override], key, "500 Hz", "world.timestep")
+    cli_fails(["run", "--set", override], key, "500 Hz", "world.timestep")
 
 
 def test_a_rate_may_equal_the_tick_rate() -> None:
@@ -71,9 +60,9 @@ def test_a_rate_may_equal_the_tick_rate() -> None:
     )
 
 
-def test_set_accepts_exponent_floats_as_numbers(capsys: pytest.CaptureFixture[str]) -> None:
+def test_set_accepts_exponent_floats_as_numbers(cli_fails: Callable[..., str]) -> None:
     # YAML 1.1 reads 1e-9 as a string: the error must be about the bound, not the type.
-    _fails(capsys, ["run", "--set", "world.timestep=1e-9"], "world.timestep", "0.0001")
+    cli_fails(["run", "--set", "world.timestep=1e-9"], "world.timestep", "0.0001")
 
 
 @pytest.mark.parametrize(
@@ -102,21 +91,20 @@ def test_set_accepts_exponent_floats_as_numbers(capsys: pytest.CaptureFixture[st
     ],
 )
 def test_scenario_values_beyond_what_the_stack_honours(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path, text: str, key: str, valid: str
+    cli_fails: Callable[..., str], tmp_path: Path, text: str, key: str, valid: str
 ) -> None:
     f = tmp_path / "s.yaml"
     f.write_text(text)
-    _fails(capsys, ["run", "--scenario", str(f), "--out", str(tmp_path)], str(f), key, valid)
+    cli_fails(["run", "--scenario", str(f), "--out", str(tmp_path)], str(f), key, valid)
 
 
 def test_a_scenario_too_costly_to_finish_under_the_wall_ceiling_is_refused(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path
+    cli_fails: Callable[..., str], tmp_path: Path
 ) -> None:
     # Each value is within its own bound, together they are ~18 million physics steps.
     f = tmp_path / "s.yaml"
     f.write_text("sim_budget: 1800.0\n")
-    line = _fails(
-        capsys,
+    line = cli_fails(
         ["run", "--scenario", str(f), "--set", "world.timestep=0.0001", "--out", str(tmp_path)],
         str(f),
         "sim_budget",
@@ -128,10 +116,9 @@ def test_a_scenario_too_costly_to_finish_under_the_wall_ceiling_is_refused(
 
 @pytest.mark.parametrize("scale", ["1e308", "1e-9", "nan", "inf", "0"])
 def test_realtime_scale_is_bounded(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path, scale: str
+    cli_fails: Callable[..., str], tmp_path: Path, scale: str
 ) -> None:
-    _fails(
-        capsys,
+    cli_fails(
         ["run", "--realtime", "--scale", scale, "--out", str(tmp_path)],
         "--scale",
         "[0.01, 100]",

@@ -3,24 +3,12 @@ value is one line naming the key and what is valid, exit 2."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
-from otonav.cli import main
-
 pytestmark = pytest.mark.unit
-
-
-def _fails(capsys: pytest.CaptureFixture[str], argv: list[str], *fragments: str) -> None:
-    code = main(argv)
-    err = capsys.readouterr().err
-    assert code == 2, err
-    assert "Traceback" not in err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    for fragment in fragments:
-        assert fragment in lines[0], lines[0]
 
 
 @pytest.mark.parametrize(
@@ -41,12 +29,12 @@ def _fails(capsys: pytest.CaptureFixture[str], argv: list[str], *fragments: str)
     ],
 )
 def test_bad_nav_and_safety_values(
-    capsys: pytest.CaptureFixture[str], assignment: str, fragments: tuple[str, ...]
+    cli_fails: Callable[..., str], assignment: str, fragments: tuple[str, ...]
 ) -> None:
-    _fails(capsys, ["run", "--set", assignment], "--set", *fragments)
+    cli_fails(["run", "--set", assignment], "--set", *fragments)
 
 
-def test_bad_value_in_a_stack_file(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+def test_bad_value_in_a_stack_file(cli_fails: Callable[..., str], tmp_path: Path) -> None:
     f = tmp_path / "stack.yaml"
     f.write_text("safety:\n  drive_lag: -1\n")
-    _fails(capsys, ["run", "--config", str(f)], str(f), "safety.drive_lag", "-1")
+    cli_fails(["run", "--config", str(f)], str(f), "safety.drive_lag", "-1")

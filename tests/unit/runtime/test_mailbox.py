@@ -146,6 +146,58 @@ def test_best_effort_drops_oldest_and_counts_exactly() -> None:
     _run(main)
 
 
+def test_drain_empties_the_mailbox_oldest_first_and_counts_each() -> None:
+    bus = Bus()
+    pub = bus.publisher("/odom", Ping, BEST_EFFORT, endpoint=Endpoint("a", "o"))
+    sub = bus.subscribe(
+        "/odom", Ping, QoS(Reliability.BEST_EFFORT, depth=3), endpoint=Endpoint("b", "i")
+    )
+
+    async def main() -> None:
+        assert sub.drain() == ()
+        for n in range(5):
+            await pub.publish(Ping(n))
+        assert sub.drain() == (Ping(2), Ping(3), Ping(4))
+        assert sub.drain() == ()
+        stats = sub.statistics()
+        assert (stats.received, stats.taken, stats.dropped, stats.queued) == (5, 3, 2, 0)
+
+    _run(main)
+
+
+def test_drain_lets_a_blocked_reliable_publisher_go_on() -> None:
+    sent: list[int] = []
+
+    class Burst(Actor):
+        out = Output("/data", Ping)
+
+        async def run(self) -> None:
+            for n in range(6):
+                await self.out.publish(Ping(n))
+                sent.append(n)
+
+    class Batch(Actor):
+        inp = Input("/data", Ping, QoS(depth=2))
+
+        def __init__(self) -> None:
+            super().__init__("batch")
+            self.got: list[tuple[Ping, ...]] = []
+
+        async def run(self) -> None:
+            while sum(len(b) for b in self.got) < 6:
+                await self.clock.sleep(1.0)
+                self.got.append(self.inp.drain())
+
+    batch = Batch()
+
+    async def main() -> None:
+        await System([Burst(), batch]).run()
+
+    _run(main)
+    assert [p.n for b in batch.got for p in b] == list(range(6))
+    assert sent == list(range(6))
+
+
 def test_one_message_object_is_shared_by_all_subscribers() -> None:
     bus = Bus()
     pub = bus.publisher("/t", Ping, endpoint=Endpoint("a", "o"))

@@ -4,11 +4,11 @@ naming the file, the key path and what is valid."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
-from otonav.cli import main
 from otonav.sweep.plan import plan_runs, run_id
 from otonav.sweep.spec import load_sweep
 
@@ -21,18 +21,6 @@ def _write(path: Path, text: str) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(text)
     return path
-
-
-def _fails(capsys: pytest.CaptureFixture[str], argv: list[str], *fragments: str) -> str:
-    code = main(argv)
-    err = capsys.readouterr().err
-    assert code == 2, err
-    assert "Traceback" not in err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    for fragment in fragments:
-        assert fragment in lines[0], lines[0]
-    return lines[0]
 
 
 def test_grid_times_seeds_expands_in_order_with_stable_ids(tmp_path: Path) -> None:
@@ -98,20 +86,20 @@ def test_a_list_of_overrides_and_duplicates_run_once(tmp_path: Path) -> None:
     ],
 )
 def test_a_bad_sweep_file_is_one_line_and_exit_2(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path, text: str, fragments: tuple[str, ...]
+    cli_fails: Callable[..., str], tmp_path: Path, text: str, fragments: tuple[str, ...]
 ) -> None:
     sweep = _write(tmp_path / "bad.yaml", text)
-    line = _fails(capsys, ["sweep", str(sweep), "--out", str(tmp_path / "o")], *fragments)
+    line = cli_fails(["sweep", str(sweep), "--out", str(tmp_path / "o")], *fragments)
     assert "bad.yaml" in line
     assert not (tmp_path / "o").exists()  # nothing started
 
 
 def test_a_broken_scenario_file_names_that_file(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path
+    cli_fails: Callable[..., str], tmp_path: Path
 ) -> None:
     _write(tmp_path / "w" / "x.yaml", "goal: {x: fast}\n")
     sweep = _write(tmp_path / "s.yaml", "scenarios: ['w/*.yaml']\n")
-    _fails(capsys, ["sweep", str(sweep), "--out", str(tmp_path / "o")], "x.yaml", "goal.x")
+    cli_fails(["sweep", str(sweep), "--out", str(tmp_path / "o")], "x.yaml", "goal.x")
 
 
 @pytest.mark.parametrize(
@@ -126,21 +114,20 @@ def test_a_broken_scenario_file_names_that_file(
     ],
 )
 def test_bad_quick_form_flags(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path, argv: list[str], fragments: tuple[str, ...]
+    cli_fails: Callable[..., str], tmp_path: Path, argv: list[str], fragments: tuple[str, ...]
 ) -> None:
-    _fails(capsys, [*argv, "--out", str(tmp_path / "o")], *fragments)
+    cli_fails([*argv, "--out", str(tmp_path / "o")], *fragments)
 
 
 def test_an_out_dir_holding_another_sweep_is_refused(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path
+    cli_fails: Callable[..., str], tmp_path: Path
 ) -> None:
     out = tmp_path / "o"
     out.mkdir()
     (out / "results.jsonl").write_text('{"run_id": "x"}\n')
-    _fails(capsys, ["sweep", "--scenario", "empty", "--out", str(out)], "already holds", "--resume")
+    cli_fails(["sweep", "--scenario", "empty", "--out", str(out)], "already holds", "--resume")
     (out / "sweep.json").write_text('{"fingerprint": "other"}\n')
-    _fails(
-        capsys,
+    cli_fails(
         ["sweep", "--scenario", "empty", "--out", str(out), "--resume"],
         "different sweep",
     )
@@ -186,12 +173,12 @@ def test_generated_worlds_are_named_by_params_and_seed_and_drawn_by_workers(
     ],
 )
 def test_bad_generator_parameters(
-    capsys: pytest.CaptureFixture[str], tmp_path: Path, params: str, fragments: tuple[str, ...]
+    cli_fails: Callable[..., str], tmp_path: Path, params: str, fragments: tuple[str, ...]
 ) -> None:
     sweep = _write(
         tmp_path / "g.yaml", f"scenarios: [{{generate: {{count: 2, params: {params}}}}}]\n"
     )
-    _fails(capsys, ["sweep", str(sweep), "--out", str(tmp_path / "o")], "g.yaml", *fragments)
+    cli_fails(["sweep", str(sweep), "--out", str(tmp_path / "o")], "g.yaml", *fragments)
 
 
 def test_the_quick_form_generates_worlds(tmp_path: Path) -> None:

@@ -1,0 +1,92 @@
+"""Lazily decoded replay inputs are, from their first use on, the decoded message."""
+
+from __future__ import annotations
+
+import copy
+import pickle
+from collections.abc import Callable
+from typing import Any
+
+import pytest
+
+from otonav.msgs import Header, LaserScan, Odometry, Pose, PoseWithCovariance, Time, Twist, Vector3
+from otonav.record.cdr import encode
+from otonav.record.cdr_decode import decode
+from otonav.replay.lazy import is_lazy, lazy, materialize
+from otonav.runtime import QoS, Reliability, TopicTypeError
+from otonav.runtime.mailbox import Bus, Endpoint
+
+pytestmark = pytest.mark.unit
+
+ODOM = Odometry(
+    header=Header(stamp=Time(sec=3, nanosec=250_000_000), frame_id="odom"),
+    child_frame_id="base_link",
+    pose=PoseWithCovariance(pose=Pose.model_validate({"position": {"x": 1.5, "y": -2.0}})),
+)
+SCAN = LaserScan(ranges=(1.0, float("inf"), 0.25), range_max=8.0)
+
+
+@pytest.mark.parametrize("message", [ODOM, SCAN, Twist(angular=Vector3(z=0.5))])
+def test_every_operation_sees_the_decoded_message(message: Odometry | LaserScan | Twist) -> None:
+    data = encode(message)
+    decoded = decode(type(message), data)
+    operations: dict[str, Callable[[Any], object]] = {
+        "field": lambda m: getattr(m, next(iter(type(message).model_fields))),
+        "eq": lambda m: m == decoded,
+        "reflected eq": lambda m: decoded == m,
+        "hash": hash,
+        "repr": repr,
+        "str": str,
+        "model_dump": lambda m: m.model_dump(),
+        "copy": lambda m: copy.copy(m) == decoded,
+        "deepcopy": lambda m: copy.deepcopy(m) == decoded,
+        "pickle": lambda m: pickle.loads(pickle.dumps(m)) == decoded,
+        "encode": encode,
+        "__class__": lambda m: m.__class__,
+    }
+    for name, operation in operations.items():
+        m = lazy(type(message), data)
+        assert is_lazy(m), name
+        assert isinstance(m, type(message))
+        assert operation(m) == operation(decoded), name
+        assert not is_lazy(m), name
+        assert type(m) is type(message), name
+        assert m == decoded, name
+        assert m.__dict__ == decoded.__dict__, name
+
+
+def test_a_copy_made_before_use_is_the_message_too() -> None:
+    original = lazy(Odometry, encode(ODOM))
+    twin = copy.copy(original)  # pydantic copies with type(self), read before decoding
+    assert twin == ODOM
+    assert type(twin) is Odometry
+
+
+def test_bad_bytes_fail_at_first_use_with_the_type_named() -> None:
+    m = lazy(Odometry, b"\x00\x01\x00\x00\x01")
+    with pytest.raises(ValueError, match="cannot decode nav_msgs/msg/Odometry"):
+        _ = m.header
+
+
+def test_materialize_is_idempotent_and_leaves_decoded_messages_alone() -> None:
+    m = lazy(Twist, encode(Twist(linear=Vector3(x=2.0))))
+    assert materialize(m) is m
+    assert materialize(m).linear.x == 2.0
+    assert materialize(ODOM) is ODOM
+
+
+@pytest.mark.asyncio
+async def test_a_relayed_unread_input_passes_the_publishers_type_check() -> None:
+    bus = Bus()
+    publisher = bus.publisher("/cmd", Twist, endpoint=Endpoint("relay", "out"))
+    inbox = bus.subscribe(
+        "/cmd", Twist, QoS(Reliability.RELIABLE, depth=4), endpoint=Endpoint("b", "in")
+    )
+    unread = lazy(Twist, encode(Twist(linear=Vector3(x=0.3))))
+    await publisher.publish(unread)
+    received = inbox.try_recv()
+    assert type(received) is Twist
+    assert received == Twist(linear=Vector3(x=0.3))
+    # A wrong type is still refused.
+    with pytest.raises(TopicTypeError):
+        await publisher.publish(lazy(Vector3, encode(Vector3(x=1.0))))  # type: ignore[arg-type]
