@@ -9,7 +9,7 @@ import numpy as np
 
 from otonav.actors import topics
 from otonav.actors.odom_history import OdomHistory
-from otonav.actors.scan_cache import points_of
+from otonav.actors.scan_cache import points_of, rays_of
 from otonav.msgs import (
     HardwareStatus,
     Header,
@@ -109,7 +109,10 @@ class AvoidingNavigator(Actor):
         # A static world seen from the same pose marks the same cells: skip the update
         # (and the points: at rest a scan costs nothing here).
         if moved:
-            self.nav.observe(to_frame(points_of(scan, self.laser_offset_x).xy, pose))
+            offset = self.laser_offset_x
+            self.nav.observe(
+                to_frame(points_of(scan, offset).xy, pose), lambda: rays_of(scan, offset, pose)
+            )
 
     async def _step(self) -> None:
         now = self.clock.now()
