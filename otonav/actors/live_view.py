@@ -2,13 +2,14 @@
 runs, with the recordings' ROS 2 schemas and CDR payloads (so Foxglove's 3D panel draws
 the robot, its scan and /tf live), stamped with sim time.
 
-Two parts (docs/adr/0031-live-view-over-foxglove-sdk.md):
+Two parts (docs/adr/0031-live-view-over-foxglove-sdk.md, amended by 0032):
 
-- :class:`FoxgloveServer` wraps ``foxglove-sdk``'s WebSocket server (the optional extra
-  ``otonav[foxglove]``). The server runs on the SDK's own threads; handing it a message
-  copies the bytes and returns, and each client has a bounded backlog that drops its
-  oldest data message when the client does not keep up. Neither the loop nor the robot
-  ever waits for a client.
+- :class:`FoxgloveServer` serves the protocol (:mod:`otonav.actors.foxglove_protocol`,
+  on ``websockets``: the optional extra ``otonav[foxglove]``), under both its names,
+  ``foxglove.sdk.v1`` and ``foxglove.websocket.v1``. The server runs on its own thread;
+  handing it a message queues a frame and returns, and each client has a bounded
+  backlog that drops (and counts) its oldest data message when the client does not keep
+  up. Neither the loop nor the robot ever waits for a client.
 - :class:`LiveView` is an actor that taps every topic (like the recorder, but lossy):
   each tap is a best-effort mailbox that keeps the newest ``depth`` messages with their
   publish instants and counts what it drops; every ``period`` s of sim time the actor
@@ -20,6 +21,7 @@ Two parts (docs/adr/0031-live-view-over-foxglove-sdk.md):
 from __future__ import annotations
 
 import math
+import os
 import threading
 from collections import deque
 from dataclasses import dataclass
@@ -78,69 +80,56 @@ class FoxgloveServer:
 
     def __init__(self, options: LiveViewOptions = LiveViewOptions()) -> None:
         try:
-            import foxglove
-            from foxglove.websocket import Capability, ChannelView, Client, ServerListener
+            from otonav.actors.foxglove_protocol import ProtocolServer
         except ImportError:
             raise LiveViewError(
                 "--foxglove needs the foxglove extra: pip install 'otonav[foxglove]'"
             ) from None
         self.options = options
-        self._foxglove = foxglove
-        self._context = foxglove.Context()
         self._lock = threading.Lock()
         self._channels: dict[str, Any] = {}
         self._latched: dict[int, tuple[bytes, int]] = {}
         self.subscriptions: dict[int, set[int]] = {}
-        """client id -> channel ids it subscribes to (kept by the SDK's callbacks)."""
+        """client id -> channel ids it subscribes to."""
         self.clients_seen: set[int] = set()
         self._changed = threading.Condition(self._lock)
         self._subscribed_total = 0
-        server = self
-
-        class Listener(ServerListener):
-            """Callbacks from the SDK's threads: count subscriptions, re-send latched data."""
-
-            def on_subscribe(self, client: Client, channel: ChannelView) -> None:
-                server._subscribed(client.id, channel.id)
-
-            def on_unsubscribe(self, client: Client, channel: ChannelView) -> None:
-                server._unsubscribed(client.id, channel.id)
-
         try:
-            self._server = foxglove.start_server(
+            self._server = ProtocolServer(
+                options.host,
+                options.port,
                 name="otonav",
-                host=options.host,
-                port=options.port,
-                capabilities=[Capability.Time],
-                server_listener=Listener(),
-                context=self._context,
-                message_backlog_size=options.backlog,
+                backlog=options.backlog,
+                on_subscribe=self._subscribed,
+                on_unsubscribe=self._unsubscribed,
             )
-        except Exception as exc:  # the SDK raises its own error types; all mean "cannot bind"
+        except OSError as exc:
             raise LiveViewError(
-                f"foxglove server on {options.host}:{options.port}: cannot start ({exc}); "
-                "pick another --foxglove-port (0: any free one)"
+                f"foxglove server on {options.host}:{options.port}: cannot start "
+                f"({os.strerror(exc.errno) if exc.errno else exc}); pick another "
+                "--foxglove-port (0: any free one)"
             ) from None
         self.closed = False
 
     @property
     def port(self) -> int:
         """The bound port (the one picked when ``options.port`` was 0)."""
-        return int(self._server.port)
+        return self._server.port
 
     @property
     def url(self) -> str:
         return f"ws://{self.options.host}:{self.port}"
 
+    @property
+    def dropped(self) -> int:
+        """Messages dropped for clients that did not keep up (their backlog was full)."""
+        return self._server.dropped
+
     def channel(self, topic: str, msg_type: type[Message]) -> Any:
         """The channel of ``topic`` (advertised to clients when first made)."""
         channel = self._channels.get(topic)
         if channel is None:
-            name, definition = schema_for(msg_type)
-            schema = self._foxglove.Schema(name=name, encoding="ros2msg", data=definition.encode())
-            channel = self._foxglove.Channel(
-                topic, schema=schema, message_encoding="cdr", context=self._context
-            )
+            channel = self._server.channel(topic, schema_for(msg_type))
             self._channels[topic] = channel
         return channel
 
@@ -159,10 +148,8 @@ class FoxgloveServer:
             self._subscribed_total += 1
             self._changed.notify_all()
         latched = self._latched.get(channel_id)
-        if latched is not None:
-            for channel in tuple(self._channels.values()):
-                if int(channel.id()) == channel_id:
-                    channel.log(latched[0], log_time=latched[1])
+        if latched is not None:  # the protocol has no latching: send it to this client
+            self._server.send_to(client, channel_id, *latched)
 
     def wait_for_subscriptions(self, count: int = 1, timeout: float | None = None) -> bool:
         """Block (a thread, never the loop) until clients made ``count`` channel
@@ -183,9 +170,7 @@ class FoxgloveServer:
         if self.closed:
             return
         self.closed = True
-        for channel in self._channels.values():
-            channel.close()
-        self._server.stop()
+        self._server.close()
 
 
 # Matches every publisher (ROS 2 rules): tapping a topic never makes wiring fail.
@@ -235,6 +220,8 @@ class LiveViewStatistics(NamedTuple):
     clients: int
     """Clients subscribed to at least one channel now."""
     clients_seen: int
+    client_dropped: int = 0
+    """Messages the server dropped for clients that did not keep up (backlog full)."""
 
 
 @dataclass(slots=True)
@@ -341,6 +328,7 @@ class LiveView(Actor):
             dropped=sum(s.tap.dropped for s in self._topics.values()),
             clients=len(server.subscriptions),
             clients_seen=len(server.clients_seen),
+            client_dropped=server.dropped,
         )
 
     def topic_statistics(self) -> dict[str, tuple[int, int]]:

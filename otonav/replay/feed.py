@@ -97,11 +97,11 @@ class Instant:
     steps: tuple[Step, ...]
     """Inputs to publish, in recorded order, with a Settle where actors ran in between."""
     last: bool = False
-
-    @property
-    def holds(self) -> bool:
-        """Whether the actors' wake-ups must be held while the feeder works here."""
-        return self.last or any(isinstance(step, Settle) for step in self.steps)
+    holds: bool = False
+    """Whether the actors' wake-ups must be held while the feeder works here."""
+    after_idle: bool = False
+    """Every replayed actor ran before the inputs (one Settle of all, first): deliver
+    them when the loop is idle at this instant, no holding needed."""
 
 
 def plan_instants(
@@ -109,11 +109,15 @@ def plan_instants(
     inputs: Collection[str],
     publishers_of: Mapping[str, Collection[str]],
     rate: float,
+    actors: Collection[str] = (),
 ) -> list[Instant]:
     """Group the recording into the feeder's instants: those with input, plus the last
     one (so the replay runs to the recording's end). ``publishers_of`` maps each output
     topic to the replayed actors that publish it; outputs followed by input at the same
-    instant (or ending the recording) become Settle steps."""
+    instant (or ending the recording) become Settle steps. ``actors``: the names of all
+    the replayed actors (an instant where all of them ran before its inputs is marked
+    ``after_idle``)."""
+    everyone = frozenset(actors)
     groups: list[tuple[int, list[RecordedMessage]]] = []
     for message in messages:
         if message.topic not in inputs and message.topic not in publishers_of:
@@ -138,7 +142,15 @@ def plan_instants(
         if last:
             steps.append(Settle(frozenset(ran)))
         if steps:
-            instants.append(Instant(tick, tuple(steps), last))
+            settles = [step for step in steps if isinstance(step, Settle)]
+            after_idle = (
+                not last
+                and len(settles) == 1
+                and steps[0] is settles[0]
+                and bool(everyone)
+                and settles[0].actors == everyone
+            )
+            instants.append(Instant(tick, tuple(steps), last, last or bool(settles), after_idle))
     return instants
 
 
@@ -260,6 +272,9 @@ class Feeder:
         """Instants delivered inline (the rest went through the task)."""
         self.batched = 0
         """Of those, instants delivered ahead of their tick (nothing could tell)."""
+        self.after_idle = 0
+        """Of those, instants delivered once their actors had run (``after_idle``)."""
+        self._idle_watcher = self._at_idle  # one bound method, to know it among watchers
 
     async def run(self) -> None:
         instants, source = self._instants, self._source
@@ -312,8 +327,12 @@ class Feeder:
         """From the source's ``advance()``: time reached instant ``_next``. Delivers it,
         and the instants after it that nothing can tell apart from it (see
         :meth:`_quiet_until`); then arms the next one or hands over to the task."""
-        index, instants = self._next, self._instants
-        instant = instants[index]
+        index = self._next
+        instant = self._instants[index]
+        if instant.after_idle:
+            # The actors due now run first (as recorded), then the inputs: at idle.
+            self._loop.add_idle_watcher(self._idle_watcher)
+            return
         if instant.holds:
             self._hand_over(index, 0)
             return
@@ -322,7 +341,24 @@ class Feeder:
             self._hand_over(index, blocked)
             return
         self.inline += 1
-        index += 1
+        self._go_on(index + 1)
+
+    def _at_idle(self) -> bool:
+        """An idle watcher: the actors of an ``after_idle`` instant have run."""
+        index = self._next
+        blocked = self._deliver_now(self._instants[index], 1)
+        if blocked is not None:
+            self._hand_over(index, blocked)
+            return True
+        self.inline += 1
+        self.after_idle += 1
+        self._go_on(index + 1)
+        return True
+
+    def _go_on(self, index: int) -> None:
+        """Deliver the instants from ``index`` on that cannot be told apart from now,
+        then arm the next one, or hand over to the task at the end."""
+        instants = self._instants
         while index < len(instants):
             following = instants[index]
             if following.holds or not self._quiet_until(following):
@@ -346,7 +382,9 @@ class Feeder:
         Reads the loop's private state (asyncio's ready queue and timer heap, the
         virtual loop's watchers and holds): the replay tests break if they change."""
         loop: Any = self._loop
-        if loop._ready or loop._watchers or loop._holds:
+        if loop._ready or loop._holds:
+            return False
+        if any(watcher is not self._idle_watcher for watcher in loop._watchers):
             return False
         heap = loop._scheduled
         # The root is this instant's own timer, or an earlier one; after it, the
@@ -369,11 +407,13 @@ class Feeder:
         assert resume is not None
         resume.set_result((index, step))
 
-    def _deliver_now(self, instant: Instant) -> int | None:
-        """Offer the instant's messages to their mailboxes; the index of the first one
-        a full reliable mailbox would make wait (None: all delivered)."""
+    def _deliver_now(self, instant: Instant, start: int = 0) -> int | None:
+        """Offer the instant's messages from step ``start`` on to their mailboxes; the
+        index of the first one a full reliable mailbox would make wait (None: all
+        delivered)."""
         publishers = self._publishers
-        for k, step in enumerate(instant.steps):
+        for k in range(start, len(instant.steps)):
+            step = instant.steps[k]
             assert not isinstance(step, Settle)
             publisher = publishers[step.topic]
             subscriptions = publisher._topic.subscriptions

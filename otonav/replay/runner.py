@@ -167,7 +167,13 @@ def replay_recording(
     _check_topics(meta, ports, actors)
     full = load_recording(path, topics=[*ports.inputs, *ports.outputs])
     source = FeedSource(config.world.timestep)
-    instants = plan_instants(full.messages, ports.inputs, ports.publishers_of, source.rate)
+    instants = plan_instants(
+        full.messages,
+        ports.inputs,
+        ports.publishers_of,
+        source.rate,
+        actors=[a.name for a in actors],
+    )
     fed: dict[str, int] = dict.fromkeys(ports.inputs, 0)
     for instant in instants:
         for step in instant.steps:

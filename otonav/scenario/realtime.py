@@ -97,6 +97,7 @@ def run_scenario_realtime(
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
     extra_actors: tuple[Actor, ...] = (),
     hold: Callable[[Verdict], None] | None = None,
+    loop_factory: Callable[[], asyncio.AbstractEventLoop] | None = None,
 ) -> Verdict:
     """Run ``scenario`` with sim time following the wall clock times ``scale`` and judge
     it, like :func:`~otonav.scenario.run.run_scenario` (same artifacts in ``out_dir``,
@@ -111,6 +112,8 @@ def run_scenario_realtime(
     ``hold`` (with ``gui``): once the run is over and its recording finished, call
     ``hold(verdict)`` (its artifact paths are not set yet) and keep the window open on
     the final state until the user closes it; Ctrl-C ends the hold too.
+    ``loop_factory``: the loop to run on (default: a stock one, the wall clock); a test
+    passes a loop whose clock it controls, so a paced run is exact.
     """
     problem = check_scale(scale, "scale")
     if problem is not None:
@@ -148,7 +151,7 @@ def run_scenario_realtime(
     wall_start = time.perf_counter()
     ended = "completed"
     try:
-        with asyncio.Runner() as runner:
+        with asyncio.Runner(loop_factory=loop_factory) as runner:
             runner.run(_main(scenario, session, judge, viewer, closed_at, on_start))
     except BaseException as exc:
         sim = hal.ticks / tick_rate(hal.tick)

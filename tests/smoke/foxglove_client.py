@@ -17,9 +17,10 @@ from websockets.asyncio.client import ClientConnection, connect
 from websockets.exceptions import ConnectionClosed
 from websockets.typing import Subprotocol
 
-#: What the Foxglove app offers: the protocol's original name and its current one. The
-#: wire protocol is the same; foxglove-sdk negotiates only the current name (ADR 16).
-SUBPROTOCOLS = [Subprotocol("foxglove.websocket.v1"), Subprotocol("foxglove.sdk.v1")]
+#: The protocol's name in its specification, which clients of the @foxglove/ws-protocol
+#: library, roslibjs-foxglove and older Lichtblick offer alone (issue 15: the suite
+#: connects with it). Our server also accepts the current name, foxglove.sdk.v1 (ADR 32).
+SUBPROTOCOLS = [Subprotocol("foxglove.websocket.v1")]
 CEILING = 30.0
 """Wall seconds after which a wait is a hang (never a timing assertion)."""
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import json
 import socket
 import threading
 from collections.abc import Iterator
@@ -14,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from foxglove_client import SUBPROTOCOLS, FoxgloveClient
+from foxglove_client import FoxgloveClient
 from websockets.asyncio.client import connect
 from websockets.exceptions import InvalidStatus
 from websockets.typing import Subprotocol
@@ -64,7 +65,8 @@ def test_every_topic_is_advertised_and_odom_arrives_as_recorded(tmp_path: Path) 
         client.wait_for("/scan", 30)
         client.stop()
     assert verdict.sim_time_s == pytest.approx(3.0, abs=0.05)
-    assert client.subprotocol == "foxglove.sdk.v1"
+    assert client.subprotocol == "foxglove.websocket.v1"
+    assert client.server_info["capabilities"] == ["time"]
     types = {t.topic: t.type for t in summarize(recording).topics}
     types.pop("/scenario/verdict")  # written by the runner after the run, not a topic
     assert set(types) >= STACK_TOPICS
@@ -164,6 +166,8 @@ def test_slow_and_churning_clients_neither_stall_the_robot_nor_grow_memory() -> 
     assert sent > 60e6  # the stuck client was offered > 60 MB it never read
     # Memory did not follow the traffic: the server keeps a bounded backlog per client.
     assert rss_after - rss_before < 0.3 * sent, (rss_after - rss_before, sent)
+    # What the stuck client's backlog could not hold was dropped, and counted.
+    assert live.statistics().client_dropped > 0
     # The reader kept getting /clock throughout (the stuck client did not block it).
     stamps = [t for t, _ in reader.received["/clock"]]
     assert stamps[-1] >= 1.9e9
@@ -238,11 +242,17 @@ async def test_open_live_stack_serves_foxglove_on_the_host_loop() -> None:
 
 
 @pytest.mark.asyncio
-async def test_a_client_offering_only_the_old_protocol_name_is_refused() -> None:
-    # What README and ADR 16 say: foxglove-sdk negotiates foxglove.sdk.v1 only.
+async def test_both_names_of_the_protocol_are_accepted_and_nothing_else() -> None:
+    # The specification's name (foxglove.websocket.v1) and foxglove-sdk's (foxglove.sdk.v1):
+    # the same protocol; current Foxglove apps offer both, older clients only the first.
+    old, new = Subprotocol("foxglove.websocket.v1"), Subprotocol("foxglove.sdk.v1")
     with serving() as server:
-        with pytest.raises(InvalidStatus, match="400"):
-            async with connect(server.url, subprotocols=[Subprotocol("foxglove.websocket.v1")]):
-                pass
-        async with connect(server.url, subprotocols=SUBPROTOCOLS) as ws:
-            assert ws.subprotocol == "foxglove.sdk.v1"
+        for offered, expected in [([old], old), ([new], new), ([new, old], new), ([old, new], new)]:
+            async with connect(server.url, subprotocols=offered) as ws:
+                assert ws.subprotocol == expected
+                info = json.loads(await ws.recv())
+                assert (info["op"], info["capabilities"]) == ("serverInfo", ["time"])
+        for offered in ([Subprotocol("foxglove.websocket.v2")], []):
+            with pytest.raises(InvalidStatus, match="400"):
+                async with connect(server.url, subprotocols=offered or None):
+                    pass

@@ -169,3 +169,16 @@ def test_plan_settles_only_where_input_follows_an_output() -> None:
         (100, (i3,), False),
         (150, (i4, Settle(frozenset({"A"}))), True),  # the end: A runs, then it stops
     ]
+
+
+def test_plan_marks_instants_where_every_actor_ran_before_the_inputs() -> None:
+    a1, i1, b1 = _msg("/a", 0.1), _msg("/in", 0.1), _msg("/b", 0.1)
+    a2, b2, i2 = _msg("/a", 0.2), _msg("/b", 0.2), _msg("/in", 0.2)
+    i3, a3 = _msg("/in", 0.3), _msg("/a", 0.3)
+    messages = [a1, i1, b1, a2, b2, i2, i3, a3]
+    publishers = {"/a": {"A"}, "/b": {"B"}}
+    both = plan_instants(messages, {"/in"}, publishers, rate=500.0, actors=["A", "B"])
+    # 0.1: B ran after the input (hold B back); 0.2: both ran first (deliver at idle).
+    assert [(i.holds, i.after_idle) for i in both] == [(True, False), (True, True), (True, False)]
+    only_a = plan_instants([a1, i1, i3, a3], {"/in"}, {"/a": {"A"}}, rate=500.0, actors=["A"])
+    assert [(i.holds, i.after_idle) for i in only_a] == [(True, True), (True, False)]

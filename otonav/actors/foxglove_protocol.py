@@ -1,0 +1,346 @@
+"""A Foxglove WebSocket server (protocol v1) on ``websockets``, in its own thread.
+
+The only module that imports ``websockets`` (an import-linter contract); the live view
+(:mod:`otonav.actors.live_view`) is its one user.
+
+It speaks the part of the protocol a live view needs (docs/adr/0032): ``serverInfo``
+with the ``time`` capability, ``advertise`` of channels (topic, ``cdr``
+encoding, ``ros2msg`` schema), ``subscribe``/``unsubscribe`` from clients, binary
+message data and time frames. The handshake accepts the protocol under both its names:
+``foxglove.sdk.v1`` (what foxglove-sdk's servers accept, and current Foxglove apps offer)
+and ``foxglove.websocket.v1`` (the specification's name, which the @foxglove/ws-protocol
+client library, roslibjs-foxglove and Lichtblick before its December 2025 change offer
+alone); the wire format is the same. foxglove-sdk 0.30.3, which served the live view
+before, accepts only the first: clients that offer only the second got a 400.
+
+Threads: the stack calls :meth:`Channel.log` and :meth:`ProtocolServer.broadcast_time`
+from its own thread. Each appends a ready frame to every subscribed client's queue
+under one lock and returns: nothing waits for a socket. The server's thread
+runs an asyncio loop with one writer task per client that sends what is queued. A
+client that does not read stops its writer (the socket's buffer is full); its queue
+then keeps the newest ``backlog`` data frames, dropping (and counting) the oldest.
+Control messages (serverInfo, advertisements, status) are never dropped.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import struct
+import threading
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from websockets.asyncio.server import Server, ServerConnection, serve
+from websockets.exceptions import ConnectionClosed
+from websockets.typing import Subprotocol
+
+SUBPROTOCOLS = (Subprotocol("foxglove.sdk.v1"), Subprotocol("foxglove.websocket.v1"))
+"""What the handshake accepts: the protocol's current name, then its original one."""
+
+_MESSAGE_DATA = struct.Struct("<BIQ")  # opcode 0x01, subscription id, log time ns
+_TIME = struct.Struct("<BQ")  # opcode 0x02, time ns
+
+
+@dataclass(eq=False)
+class _Client:
+    id: int
+    connection: ServerConnection
+    wake: asyncio.Event
+    control: deque[str] = field(default_factory=deque)
+    data: deque[bytes] = field(default_factory=deque)
+    subscriptions: dict[int, int] = field(default_factory=dict)
+    """subscription id -> channel id."""
+    by_channel: dict[int, list[int]] = field(default_factory=dict)
+    """channel id -> subscription ids."""
+    dropped: int = 0
+    waking: bool = False
+
+
+class Channel:
+    """One advertised topic. :meth:`log` hands a message to every client subscribed."""
+
+    __slots__ = ("_id", "_server", "definition", "schema_name", "topic")
+
+    def __init__(
+        self, server: ProtocolServer, channel_id: int, topic: str, schema: tuple[str, str]
+    ) -> None:
+        self._server = server
+        self._id = channel_id
+        self.topic = topic
+        self.schema_name, self.definition = schema
+
+    def id(self) -> int:
+        return self._id
+
+    def has_sinks(self) -> bool:
+        """Whether some client subscribed to this channel now."""
+        return self._id in self._server._subscribed_channels
+
+    def log(self, data: bytes, *, log_time: int) -> None:
+        """Queue ``data`` (CDR) stamped ``log_time`` (ns) for every subscribed client."""
+        self._server._log(self._id, data, log_time)
+
+    def advertisement(self) -> dict[str, Any]:
+        return {
+            "id": self._id,
+            "topic": self.topic,
+            "encoding": "cdr",
+            "schemaName": self.schema_name,
+            "schema": self.definition,
+            "schemaEncoding": "ros2msg",
+        }
+
+
+class ProtocolServer:
+    """Serves on ``host:port`` (0: any free port) from its own thread once made; raises
+    ``OSError`` when the address cannot be bound. ``on_subscribe(client, channel)`` and
+    ``on_unsubscribe(client, channel)`` are called from the server's thread."""
+
+    def __init__(
+        self,
+        host: str,
+        port: int,
+        *,
+        name: str,
+        backlog: int,
+        on_subscribe: Callable[[int, int], None] = lambda client, channel: None,
+        on_unsubscribe: Callable[[int, int], None] = lambda client, channel: None,
+    ) -> None:
+        self.name = name
+        self.backlog = backlog
+        self._on_subscribe = on_subscribe
+        self._on_unsubscribe = on_unsubscribe
+        self._lock = threading.Lock()
+        self._clients: dict[int, _Client] = {}
+        self._channels: dict[int, Channel] = {}
+        self._subscribed_channels: dict[int, int] = {}
+        """channel id -> how many subscriptions it has now."""
+        self._next_client = 1
+        self._next_channel = 1
+        self.dropped = 0
+        """Data frames dropped for clients that did not keep up (all clients so far)."""
+        self._loop = asyncio.new_event_loop()
+        self._server: Server | None = None
+        self._ready = threading.Event()
+        self._error: BaseException | None = None
+        self._thread = threading.Thread(
+            target=self._run, args=(host, port), name="foxglove-server", daemon=True
+        )
+        self._thread.start()
+        self._ready.wait()
+        if self._error is not None:
+            self._thread.join()
+            raise self._error
+        assert self._server is not None
+        self.port: int = self._server.sockets[0].getsockname()[1]
+
+    # -- the stack's side (any thread) ---------------------------------------------------
+
+    def channel(self, topic: str, schema: tuple[str, str]) -> Channel:
+        """A new channel, advertised to every client now and to each that connects."""
+        with self._lock:
+            channel = Channel(self, self._next_channel, topic, schema)
+            self._next_channel += 1
+            self._channels[channel.id()] = channel
+            message = json.dumps({"op": "advertise", "channels": [channel.advertisement()]})
+            for client in self._clients.values():
+                self._queue_control(client, message)
+        return channel
+
+    def broadcast_time(self, time_ns: int) -> None:
+        frame = _TIME.pack(0x02, time_ns)
+        with self._lock:
+            for client in self._clients.values():
+                self._queue_data(client, frame)
+
+    def _log(self, channel_id: int, data: bytes, log_time: int) -> None:
+        with self._lock:
+            if channel_id not in self._subscribed_channels:
+                return
+            for client in self._clients.values():
+                for subscription in client.by_channel.get(channel_id, ()):
+                    self._queue_data(
+                        client, _MESSAGE_DATA.pack(0x01, subscription, log_time) + data
+                    )
+
+    def send_to(self, client_id: int, channel_id: int, data: bytes, log_time: int) -> None:
+        """Queue one message for one client only (a latched topic's last message)."""
+        with self._lock:
+            client = self._clients.get(client_id)
+            if client is None:
+                return
+            for subscription in client.by_channel.get(channel_id, ()):
+                self._queue_data(client, _MESSAGE_DATA.pack(0x01, subscription, log_time) + data)
+
+    def _queue_data(self, client: _Client, frame: bytes) -> None:  # under the lock
+        if len(client.data) >= self.backlog:
+            client.data.popleft()
+            client.dropped += 1
+            self.dropped += 1
+        client.data.append(frame)
+        self._wake(client)
+
+    def _queue_control(self, client: _Client, message: str) -> None:  # under the lock
+        client.control.append(message)
+        self._wake(client)
+
+    def _wake(self, client: _Client) -> None:  # under the lock
+        if not client.waking:
+            client.waking = True
+            self._loop.call_soon_threadsafe(client.wake.set)
+
+    def close(self) -> None:
+        """Disconnect every client and stop the thread. Idempotent."""
+        if self._thread.is_alive():
+            self._loop.call_soon_threadsafe(self._stop)
+            self._thread.join()
+
+    # -- the server's thread --------------------------------------------------------------
+
+    def _run(self, host: str, port: int) -> None:
+        asyncio.set_event_loop(self._loop)
+
+        async def start() -> Server:
+            return await serve(
+                self._connection,
+                host,
+                port,
+                subprotocols=list(SUBPROTOCOLS),
+                compression=None,
+                max_size=1 << 20,
+            )
+
+        try:
+            self._server = self._loop.run_until_complete(start())
+        except BaseException as exc:  # e.g. the address is in use
+            self._error = exc
+            self._ready.set()
+            self._loop.close()
+            return
+        self._ready.set()
+        try:
+            self._loop.run_forever()
+        finally:
+            self._loop.run_until_complete(self._loop.shutdown_asyncgens())
+            self._loop.close()
+
+    def _stop(self) -> None:
+        assert self._server is not None
+        self._server.close()
+
+        async def stop() -> None:
+            assert self._server is not None
+            await self._server.wait_closed()
+            self._loop.stop()
+
+        self._loop.create_task(stop())
+
+    async def _connection(self, connection: ServerConnection) -> None:
+        with self._lock:
+            client = _Client(self._next_client, connection, asyncio.Event())
+            self._next_client += 1
+            self._clients[client.id] = client
+            info = {
+                "op": "serverInfo",
+                "name": self.name,
+                "capabilities": ["time"],
+                "supportedEncodings": [],
+                "metadata": {},
+            }
+            self._queue_control(client, json.dumps(info))
+            channels = [c.advertisement() for c in self._channels.values()]
+            self._queue_control(client, json.dumps({"op": "advertise", "channels": channels}))
+        writer = asyncio.create_task(self._write(client))
+        try:
+            async for message in connection:
+                self._handle(client, message)
+        except ConnectionClosed:
+            pass
+        finally:
+            writer.cancel()
+            with self._lock:
+                del self._clients[client.id]
+                gone = list(client.subscriptions.values())
+                for channel_id in gone:
+                    self._unsubscribed(channel_id)
+            for channel_id in gone:
+                self._on_unsubscribe(client.id, channel_id)
+
+    async def _write(self, client: _Client) -> None:
+        lock, connection = self._lock, client.connection
+        try:
+            while True:
+                await client.wake.wait()
+                with lock:
+                    client.wake.clear()
+                    client.waking = False
+                while True:
+                    with lock:
+                        frame: str | bytes | None = (
+                            client.control.popleft()
+                            if client.control
+                            else client.data.popleft()
+                            if client.data
+                            else None
+                        )
+                    if frame is None:
+                        break
+                    await connection.send(frame)
+        except ConnectionClosed:
+            pass
+
+    def _handle(self, client: _Client, raw: str | bytes) -> None:
+        try:
+            message = json.loads(raw)
+            op = message["op"]
+            if op == "subscribe":
+                for sub in message["subscriptions"]:
+                    self._subscribe(client, int(sub["id"]), int(sub["channelId"]))
+            elif op == "unsubscribe":
+                for sub_id in message["subscriptionIds"]:
+                    self._unsubscribe(client, int(sub_id))
+            else:
+                self._status(client, 1, f"unsupported operation {op!r}: this server only serves")
+        except (ValueError, KeyError, TypeError) as exc:
+            self._status(client, 2, f"bad message ({exc!r})")
+
+    def _subscribe(self, client: _Client, sub_id: int, channel_id: int) -> None:
+        with self._lock:
+            if sub_id in client.subscriptions or channel_id not in self._channels:
+                problem = "already used" if sub_id in client.subscriptions else "unknown channel"
+                self._queue_control(client, _status(2, f"subscription {sub_id}: {problem}"))
+                return
+            client.subscriptions[sub_id] = channel_id
+            client.by_channel.setdefault(channel_id, []).append(sub_id)
+            self._subscribed_channels[channel_id] = self._subscribed_channels.get(channel_id, 0) + 1
+        self._on_subscribe(client.id, channel_id)
+
+    def _unsubscribe(self, client: _Client, sub_id: int) -> None:
+        with self._lock:
+            channel_id = client.subscriptions.pop(sub_id, None)
+            if channel_id is None:
+                return
+            subs = client.by_channel[channel_id]
+            subs.remove(sub_id)
+            if not subs:
+                del client.by_channel[channel_id]
+            self._unsubscribed(channel_id)
+        self._on_unsubscribe(client.id, channel_id)
+
+    def _unsubscribed(self, channel_id: int) -> None:  # under the lock
+        left = self._subscribed_channels[channel_id] - 1
+        if left:
+            self._subscribed_channels[channel_id] = left
+        else:
+            del self._subscribed_channels[channel_id]
+
+    def _status(self, client: _Client, level: int, text: str) -> None:
+        with self._lock:
+            self._queue_control(client, _status(level, text))
+
+
+def _status(level: int, text: str) -> str:
+    return json.dumps({"op": "status", "level": level, "message": text})
