@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
@@ -52,6 +53,8 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--reps", type=int, default=5)
     args = parser.parse_args()
+    # The machine is shared: say how busy it was, so a figure can be judged.
+    print("load average before: {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
     with tempfile.TemporaryDirectory():
         for record in (False, True):
             walls: dict[str, list[float]] = {"mujoco": [], "can": []}
@@ -76,6 +79,7 @@ def main() -> int:
                 f"{label:14s} CAN / MuJoCo: wall time {med['can'] / med['mujoco']:.2f}, "
                 f"CPU time {cpu['can'] / cpu['mujoco']:.2f}"
             )
+    print("load average after:  {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
     return 0
 
 

@@ -7,6 +7,7 @@ import contextlib
 import logging
 
 import anyio
+import numpy as np
 
 from otonav.actors import topics
 from otonav.control import Pose2D, integrate_odometry
@@ -51,6 +52,12 @@ _LOG_LEVELS = {
 def _diag6(*variances: float) -> tuple[float, ...]:
     """A row-major 6x6 covariance with ``variances`` on the diagonal."""
     return tuple(variances[i // 6] if i % 7 == 0 else 0.0 for i in range(36))
+
+
+def _f32(*values: float) -> list[float]:
+    """``values`` rounded to float32 (as Python floats)."""
+    rounded: list[float] = np.array(values, dtype=np.float32).tolist()
+    return rounded
 
 
 # (x, y, z, roll, pitch, yaw): planar robot; z, roll and pitch are not estimated.
@@ -272,16 +279,27 @@ class Bridge(Actor):
 
     async def _publish_scan(self, stamp: Time, _now: float) -> None:
         scan = self.hal.read_scan()
+        # float32 like the ROS 2 message and the recording, so every subscriber (the
+        # live view, a replay from the file) sees the values the file holds; the ranges
+        # are float32 already (their float64 copies are exact).
+        a_min, a_max, a_inc, period, r_min, r_max = _f32(
+            scan.angle_min,
+            scan.angle_max,
+            scan.angle_increment,
+            self._periods["scan"],
+            scan.range_min,
+            scan.range_max,
+        )
         await self.scan.publish(
             LaserScan.fast(
                 header=Header.fast(stamp=stamp, frame_id="laser"),
-                angle_min=scan.angle_min,
-                angle_max=scan.angle_max,
-                angle_increment=scan.angle_increment,
+                angle_min=a_min,
+                angle_max=a_max,
+                angle_increment=a_inc,
                 time_increment=0.0,
-                scan_time=self._periods["scan"],
-                range_min=scan.range_min,
-                range_max=scan.range_max,
+                scan_time=period,
+                range_min=r_min,
+                range_max=r_max,
                 ranges=tuple(scan.ranges.tolist()),
                 intensities=(),
             )

@@ -12,7 +12,7 @@ from pathlib import Path
 from tempfile import TemporaryDirectory
 
 from otonav.actors import topics
-from otonav.bench.bare import run_bare
+from otonav.bench.bare import run_bare, run_bare_stack
 from otonav.msgs import LaserScan, Point, Pose, PoseStamped
 from otonav.runtime import LATCHED_QOS, Actor, Input, virtual_loop_factory
 from otonav.scenario import ScenarioConfig
@@ -22,7 +22,8 @@ from otonav.stack.session import StackSession
 
 @dataclass(frozen=True, slots=True)
 class Case:
-    """What to run: ``kind`` is bare | stack | recorded (``duration`` s of sim), fixed
+    """What to run: ``kind`` is bare (the stack's functions inline) | bare0 (the old
+    control law inline) | stack | recorded (``duration`` s of sim), fixed
     (a run of no sim time: the fixed costs) or scenario (the acceptance scenario, as
     ``otonav run`` runs it; ``duration`` unused)."""
 
@@ -159,11 +160,12 @@ def run_case(case: Case) -> Sample:
 
         stack = apply_overrides(stack, case.overrides, source="bench case")
     goal = (scenario.goal.x, scenario.goal.y)
-    if case.kind == "bare":
+    if case.kind in ("bare", "bare0"):
         hal = build_world(stack)
+        bare = run_bare_stack if case.kind == "bare" else run_bare
         cpu = time.process_time()
         wall = time.perf_counter()
-        run_bare(hal, stack, goal, case.duration)
+        bare(hal, stack, goal, case.duration)
         wall = time.perf_counter() - wall
         cpu = time.process_time() - cpu
         hal.close()

@@ -1,5 +1,6 @@
-"""``otonav bench``: (a) bare loop, (b) stack, (c) stack + recorder; medians, ratios,
-peak RSS, where the time goes, and how cost scales with beams and /scan subscribers."""
+"""``otonav bench``: (a) bare loop (the stack's own functions inline), (a0) the old bare
+loop (ADR 0025's control law), (b) stack, (c) stack + recorder; medians, ratios, peak
+RSS, where the time goes, and how cost scales with beams and /scan subscribers."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ from pathlib import Path
 from otonav.bench.harness import Case, Sample, run_in_children
 
 LABELS = {
+    "bare0": "(a0) bare loop, old law",
     "bare": "(a) bare loop",
     "stack": "(b) stack, no recorder",
     "recorded": "(c) stack + recorder",
@@ -75,7 +77,7 @@ def _scenario(samples: list[Sample]) -> dict[str, object]:
 
 
 def run_bench(duration: float, reps: int, *, scaling: bool, profile: bool) -> dict[str, object]:
-    kinds = ("bare", "stack", "recorded")
+    kinds = ("bare0", "bare", "stack", "recorded")
     extra = ("fixed", "scenario")
     # Interleave a, b, c, ... a, b, c, ... so slow phases of this shared machine hit all.
     cases = [Case(kind, duration) for _ in range(reps) for kind in (*kinds, *extra)]
@@ -93,6 +95,9 @@ def run_bench(duration: float, reps: int, *, scaling: bool, profile: bool) -> di
         "ratio_c_over_a": rows["recorded"].wall_median_s / base,
         "cpu_ratio_b_over_a": rows["stack"].cpu_median_s / cpu_base,
         "cpu_ratio_c_over_a": rows["recorded"].cpu_median_s / cpu_base,
+        # Against ADR 0025's baseline (the old control law inline), for comparison only.
+        "cpu_ratio_b_over_a0": rows["stack"].cpu_median_s / (rows["bare0"].cpu_median_s or 1.0),
+        "cpu_ratio_c_over_a0": rows["recorded"].cpu_median_s / (rows["bare0"].cpu_median_s or 1.0),
         "fixed_cost": _fixed(by_kind["fixed"]),
         "acceptance_scenario": _scenario(by_kind["scenario"]),
     }
@@ -161,6 +166,11 @@ def format_report(result: dict[str, object]) -> str:
         lines.append(
             f"ratios (CPU):  (b)/(a) = {result['cpu_ratio_b_over_a']:.2f}   "
             f"(c)/(a) = {result['cpu_ratio_c_over_a']:.2f}"
+        )
+    if "cpu_ratio_c_over_a0" in result:
+        lines.append(
+            f"  against (a0), the old baseline: (b)/(a0) = {result['cpu_ratio_b_over_a0']:.2f}"
+            f"   (c)/(a0) = {result['cpu_ratio_c_over_a0']:.2f}"
         )
     fixed = result.get("fixed_cost")
     if isinstance(fixed, dict):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -14,12 +15,33 @@ def add_parser(commands: Any) -> None:
     p.add_argument("--json", type=Path, default=Path("out/bench.json"), help="write figures here")
     p.add_argument("--no-scaling", action="store_true", help="skip the beams / subscribers tables")
     p.add_argument("--quick", action="store_true", help="2 s, 1 run, no scaling: checks it runs")
+    p.add_argument(
+        "--long",
+        type=float,
+        metavar="SECONDS",
+        help="instead: memory over one long run of the stack + recorder (e.g. 600): RSS, "
+        "Python heap and file size every 60 s of sim",
+    )
     p.set_defaults(handler=main)
 
 
 def main(args: argparse.Namespace) -> int:
     from otonav.bench.report import format_report, run_bench, write_json
 
+    if args.long is not None:
+        from otonav.bench.memory import format_long, run_long
+
+        if not 0 < args.long <= 86_400:
+            print(
+                f"otonav bench: --long must be in (0, 86400] s of sim time, got {args.long:g}",
+                file=sys.stderr,
+            )
+            return 2
+        memory = run_long(args.long, every=min(60.0, args.long))
+        print(format_long(memory))
+        write_json(memory, args.json)
+        print(f"figures: {args.json}")
+        return 0
     duration, reps, scaling = args.duration, args.reps, not args.no_scaling
     if args.quick:
         duration, reps, scaling = 2.0, 1, False

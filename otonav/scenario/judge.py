@@ -69,6 +69,13 @@ class Judge(Actor):
         self.tolerance = tolerance
         self.rate_hz = rate_hz
         self.boxes: tuple[BoxObstacle, ...] = hal.obstacles() + hal.walls()
+        # Per box: centre, half sizes and its yaw's cos and sin, computed once (the
+        # arithmetic of BoxObstacle.distance_to, so the same floats), and the distance
+        # at its last check with the path length then (see _clearance).
+        self._box_math = [
+            (b.x, b.y, b.half_x, b.half_y, math.cos(b.yaw), math.sin(b.yaw)) for b in self.boxes
+        ]
+        self._box_seen = [(-math.inf, 0.0)] * len(self.boxes)  # never checked yet
         self.min_clearance = math.inf
         self.min_clearance_at: tuple[float, float] = (math.nan, math.nan)
         self.path_length = 0.0
@@ -144,8 +151,24 @@ class Judge(Actor):
             and now >= self.time_to_goal + self.settle_s - 1e-9
         ):
             self._check_arrival(now)
-        for box in self.boxes:
-            d = box.distance_to(x, y)
+        self._clearance(x, y)
+
+    def _clearance(self, x: float, y: float) -> None:
+        """Update the minimum clearance with every box that could lower it: a box's
+        distance changes by at most the path driven since it was last computed (it is
+        1-Lipschitz in the position), so a box that was farther than the minimum by more
+        than that path is skipped. Exactly the result of checking every box (in the
+        acceptance run the judge cost ~10 % of the summary's wall time, mostly here)."""
+        path, seen = self.path_length, self._box_seen
+        for i, (bx, by, hx, hy, c, s) in enumerate(self._box_math):
+            d_then, path_then = seen[i]
+            if d_then - (path - path_then) > self.min_clearance + 1e-9:
+                continue
+            dx, dy = x - bx, y - by
+            lx = c * dx + s * dy
+            ly = -s * dx + c * dy
+            d = math.hypot(max(abs(lx) - hx, 0.0), max(abs(ly) - hy, 0.0))
+            seen[i] = (d, path)
             if d < self.min_clearance:
                 self.min_clearance = d
                 self.min_clearance_at = (x, y)

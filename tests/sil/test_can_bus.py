@@ -20,7 +20,7 @@ import pytest
 
 from otonav.actors import topics
 from otonav.hal import HealthLevel, RobotHardwareInterface, WheelCommand
-from otonav.hal.can import CanBusInterface, MonitorLimits, WheelAxis, open_endpoint
+from otonav.hal.can import CanBusInterface, MonitorLimits, RawFrame, WheelAxis, open_endpoint
 from otonav.hal.can import protocol as p
 from otonav.hal.can.tap import FRAMES_TOPIC
 from otonav.hal.mujoco import MujocoInterface
@@ -28,9 +28,10 @@ from otonav.hal.sim import AxisParams, DriveEmulator, DriveMount
 from otonav.msgs import DiagnosticArray, Frame, Log, NavState, Point, Pose, PoseStamped
 from otonav.msgs import WheelCommand as WheelCommandMsg
 from otonav.record.reader import read_messages, summarize
-from otonav.runtime import LATCHED_QOS, QoS, Reliability, Subscription, until
+from otonav.runtime import LATCHED_QOS, QoS, Reliability, RestartPolicy, Subscription, until
 from otonav.scenario import ScenarioConfig, run_scenario
-from otonav.stack import StackConfig
+from otonav.stack import StackConfig, StackSession
+from otonav.stack.build import build_actors, build_world
 from otonav.stack.overrides import apply_overrides
 from otonav.testing import running_stack
 
@@ -140,6 +141,32 @@ def test_a_failed_run_ends_its_recording_with_the_idle_frames(tmp_path: Path) ->
 
 
 _FROM_DRIVES = {p.CMD_HEARTBEAT, p.CMD_GET_ENCODER_ESTIMATES}
+
+
+@pytest.mark.sim(wall_ceiling=60)
+async def test_a_tap_that_crashes_and_restarts_leaves_the_drives_running() -> None:
+    # The tap sets the drives IDLE in on_stop; a restart also runs on_stop: only the
+    # system's stop may release the drives.
+    hal = build_world(CAN)
+    assert isinstance(hal, CanBusInterface)
+    take, calls = hal.take_frames, [0]
+
+    def crash_once() -> list[tuple[float, RawFrame]]:
+        calls[0] += 1
+        if calls[0] == 10:
+            raise RuntimeError("tap crash (test)")
+        return take()
+
+    hal.take_frames = crash_once  # type: ignore[method-assign]
+    session = StackSession(hal, build_actors(CAN, hal), restart={"can_tap": RestartPolicy()})
+    async with session.running() as system:
+        await system.clock.sleep(1.0)
+        assert [e.kind for e in system.events if e.actor == "can_tap"].count("restarted") == 1
+        emulator = emulator_of(hal)
+        assert emulator.drive(0).state == p.AxisState.CLOSED_LOOP_CONTROL
+        assert hal.health().drivable
+        assert [m for _t, m in hal.monitor.events if "running" not in m] == []  # no fault
+    assert emulator.drive(0).state == p.AxisState.IDLE
 
 
 # -- the interface alone: startup, shutdown, encoders only from frames -------------------

@@ -20,6 +20,7 @@ def test_bench_quick_mode_runs_and_writes_its_figures(
     assert main(["bench", "--quick", "--json", str(figures)]) == 0
     out = capsys.readouterr().out
     for label in (
+        "(a0) bare loop, old law",
         "(a) bare loop",
         "(b) stack, no recorder",
         "(c) stack + recorder",
@@ -30,12 +31,14 @@ def test_bench_quick_mode_runs_and_writes_its_figures(
         assert label in out
     data = json.loads(figures.read_text())
     assert [row["label"] for row in data["rows"]] == [
+        "(a0) bare loop, old law",
         "(a) bare loop",
         "(b) stack, no recorder",
         "(c) stack + recorder",
     ]
     assert all(row["duration_s"] == 2.0 and row["wall_median_s"] > 0 for row in data["rows"])
     assert data["ratio_c_over_a"] > 0
+    assert data["cpu_ratio_c_over_a0"] > 0
     assert all(row["cpu_median_s"] > 0 for row in data["rows"])
     fixed = data["fixed_cost"]
     assert set(fixed["phases_ms"]) >= {"world build", "actor stop", "finish file + close world"}
@@ -44,3 +47,23 @@ def test_bench_quick_mode_runs_and_writes_its_figures(
     assert abs(sum(walls) - fixed["total_ms"]) < 0.05 * fixed["total_ms"] + 0.5
     # The scenario ran to its verdict (the acceptance goal is reached before 30 s).
     assert 0 < data["acceptance_scenario"]["sim_s"] < 30
+
+
+def test_memory_probe_reads_rss_heap_and_file_at_each_checkpoint() -> None:
+    from otonav.bench.memory import long_run
+
+    points = long_run(3.0, 1.0, trace=True)
+    assert [round(p.sim_s, 6) for p in points] == [1.0, 2.0, 3.0]
+    assert all(p.rss_mb > 10 and p.heap_mb > 0 for p in points)
+    # The recording is written as it goes (chunks flushed), so the file grows.
+    assert points[-1].recorded_mb > points[0].recorded_mb
+
+
+@pytest.mark.parametrize("value", ["0", "-5", "nan", "1e9"])
+def test_bench_long_rejects_a_bad_duration_in_one_line(
+    value: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(["bench", "--long", value]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1
+    assert "--long must be in (0, 86400]" in err[0]

@@ -45,21 +45,28 @@ class CanFrameTap(Actor):
         self.hal = hal
         self.rate_hz = rate_hz
         self._topic: Topic[Frame] | None = None
+        self._stopping = False
 
     def on_wired(self, bus: Bus) -> None:
         self._topic = bus.topics[self.topic_of(CanFrameTap.frames)]
 
     async def run(self) -> None:
         rate = self.clock.rate(self.rate_hz)
-        while True:
-            await rate.sleep()
-            await self.flush()
+        try:
+            while True:
+                await rate.sleep()
+                await self.flush()
+        except anyio.get_cancelled_exc_class():
+            self._stopping = True  # the system stops us (a crash restarts without this)
+            raise
 
     async def on_stop(self) -> None:
         # The stack builder lists the tap before the bridge, so it stops after every
         # actor that commands the wheels: the drives go IDLE here, and the recording
-        # (still open: the recorder stops last) ends with those frames.
-        self.hal.stop_drives()
+        # (still open: the recorder stops last) ends with those frames. Not when the
+        # tap itself crashed (on_stop then precedes a restart, or the HAL's close).
+        if self._stopping:
+            self.hal.stop_drives()
         if self._topic is not None and not self._topic.subscriptions:
             self.hal.take_frames()
             return

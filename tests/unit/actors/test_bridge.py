@@ -12,6 +12,7 @@ from contextlib import asynccontextmanager
 from typing import Any
 
 import anyio
+import numpy as np
 import pytest
 
 from otonav.actors import Bridge, topics
@@ -153,6 +154,28 @@ def test_scan_and_imu_carry_the_hardware_readings() -> None:
         _, imu = log[topics.IMU][-1]
         assert imu.header.frame_id == "imu_link"
         assert imu.linear_acceleration.z == pytest.approx(9.81)
+
+    _run(hal, main)
+
+
+def test_scan_fields_are_float32_like_the_wire_and_the_recording() -> None:
+    # ROS 2's LaserScan and the recording hold float32: a subscriber in the run (the live
+    # view, the navigator) must see the values a replay of the file will see. 2*pi/360
+    # and 0.1 are not float32 values, so an unrounded float64 fails here.
+    hal = FakeHardware(lidar_beams=360, lidar_range_max=5.0)
+
+    async def main() -> None:
+        async with System([Bridge(hal)]) as system, _observing(system, SENSORS) as log:
+            await anyio.sleep(0.25)
+        _, scan = log[topics.SCAN][-1]
+        raw = hal.read_scan()
+        assert raw.angle_increment != float(np.float32(raw.angle_increment))  # the premise
+        for field in ("angle_min", "angle_max", "angle_increment", "scan_time", "range_min"):
+            value = getattr(scan, field)
+            assert value == float(np.float32(value)), field
+        assert scan.angle_increment == float(np.float32(raw.angle_increment))
+        assert scan.scan_time == float(np.float32(0.1))
+        assert all(r == float(np.float32(r)) for r in scan.ranges)
 
     _run(hal, main)
 
