@@ -1,7 +1,7 @@
 """Sweep throughput, per-run overhead, Ray against the process pool, and peak RSS.
 
     python benchmarks/sweep_bench.py [--runs 200] [--shell-runs 8] [--rss 100 1000]
-                                     [--no-ray] [--json PATH]
+                                     [--no-ray] [--json PATH] [--rss-only]
 
 Every figure is measured in this invocation, so ratios compare like with like on a
 shared, noisy machine (quote ratios and medians, not absolute seconds):
@@ -17,8 +17,10 @@ shared, noisy machine (quote ratios and medians, not absolute seconds):
   finishing and hashing the recording; p50 of wall_time_s - sim_wall_s), and in total
   with 1 worker ((sweep wall - sum of simulation walls) / runs: adds pool start-up,
   dispatch, the results line, artifacts of failures);
-- peak RSS of the driver and of the largest worker for sweeps of ``--rss`` runs of a
-  short scenario (~3 s of sim), each in a fresh interpreter.
+- memory: one sweep of ``max(--rss)`` runs of a short scenario (~3 s of sim) on 2
+  workers, in a fresh interpreter; as the Nth record is written, for each N in
+  ``--rss``, the RSS and peak RSS of the driver and of the workers (``--rss-only``: just
+  this part, a few minutes at 1,000 runs).
 """
 
 from __future__ import annotations
@@ -92,17 +94,70 @@ def shell_loop(runs: int, out: Path) -> dict[str, Any]:
     return {"runs": runs, "wall_s": sum(walls), "wall_p50_s": statistics.median(walls)}
 
 
-def rss_child(runs: int, workers: int) -> None:
-    """In a fresh interpreter: a sweep of ``runs`` short runs; print peak RSS (MB)."""
+def _status_mb(pid: int | str) -> dict[str, float]:
+    """VmRSS and VmHWM (the peak since the process's last exec) of a process, in MB."""
+    out = {}
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        key, _, value = line.partition(":")
+        if key in ("VmRSS", "VmHWM"):
+            out[key] = int(value.split()[0]) / 1024
+    return out
+
+
+def _children() -> list[int]:
+    """Live child processes of this one (the pool's workers)."""
+    me, kids = str(Path("/proc/self").resolve().name), []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if fields[1] == me:
+            kids.append(int(stat.parent.name))
+    return kids
+
+
+def rss_child(checkpoints: list[int], workers: int) -> None:
+    """In a fresh interpreter: one sweep of ``max(checkpoints)`` short runs on the
+    process pool; as the record of run N (a checkpoint) is written, print the driver's and
+    every live worker's RSS and peak RSS (VmHWM, /proc: not ``ru_maxrss``, which a
+    process inherits from its parent across fork and exec)."""
+    samples: list[dict[str, Any]] = []
+    seen: dict[int, dict[str, float]] = {}
+    done = 0
+
+    def on_record(record: dict[str, Any]) -> None:
+        nonlocal done
+        done += 1
+        if done not in checkpoints:
+            return
+        workers_now = {}
+        for pid in _children():
+            try:
+                workers_now[pid] = _status_mb(pid)
+            except OSError:  # exited between the listing and the read
+                continue
+        seen.update(workers_now)
+        driver = _status_mb("self")
+        samples.append(
+            {
+                "runs": done,
+                "driver_mb": driver["VmRSS"],
+                "driver_peak_mb": driver["VmHWM"],
+                "worker_mb": max(w["VmRSS"] for w in workers_now.values()),
+                "worker_peak_mb": max(w["VmHWM"] for w in seen.values()),
+                "workers": len(workers_now),
+                "distinct_workers": len(seen),
+            }
+        )
+
     with tempfile.TemporaryDirectory() as tmp:
         scenario = Path(tmp) / "short.yaml"
         scenario.write_text(SHORT)
-        spec = SweepSpec(scenarios=(str(scenario),), seeds=SeedRange(count=runs))
+        spec = SweepSpec(scenarios=(str(scenario),), seeds=SeedRange(count=max(checkpoints)))
         prepared = prepare(Path(tmp) / "out", plan_runs(spec))
-        execute(prepared, make_backend("process", workers=workers))
-    me = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    kids = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
-    print(json.dumps({"runs": runs, "driver_mb": me, "worker_mb": kids}))
+        execute(prepared, make_backend("process", workers=workers), on_record=on_record)
+    print(json.dumps(samples))
 
 
 def main() -> None:
@@ -112,10 +167,14 @@ def main() -> None:
     parser.add_argument("--rss", type=int, nargs="*", default=[100, 1000])
     parser.add_argument("--no-ray", action="store_true")
     parser.add_argument("--json", type=Path)
-    parser.add_argument("--rss-child", type=int, help=argparse.SUPPRESS)
+    parser.add_argument("--rss-only", action="store_true", help="only the RSS figures")
+    parser.add_argument("--rss-child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.rss_child:
-        rss_child(args.rss_child, 2)
+        rss_child(args.rss, 2)
+        return
+    if args.rss_only:
+        report_rss(args.rss)
         return
 
     figures: dict[str, Any] = {"runs": args.runs}
@@ -129,8 +188,10 @@ def main() -> None:
         if not args.no_ray:
             import ray
 
+            from otonav.sweep.backends.ray import init_local
+
             start = time.perf_counter()
-            ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+            init_local(2)  # as `--backend ray` starts one: nothing written to ~/.ray
             figures["ray_start_s"] = time.perf_counter() - start
             try:
                 results.append(timed_sweep(args.runs, "ray", 2, root / "ray"))
@@ -194,22 +255,26 @@ def main() -> None:
     figures["shell"] = {**shell, "throughput": shell_throughput, "scaled_wall_s": scaled}
     figures["identical_recordings"] = same
 
-    rss = []
-    for n in args.rss:
-        child = subprocess.run(
-            [sys.executable, __file__, "--rss-child", str(n)],
-            check=True, capture_output=True, text=True,
-        )  # fmt: skip
-        rss.append(json.loads(child.stdout.strip().splitlines()[-1]))
-    for r in rss:
-        print(
-            f"peak RSS, {r['runs']:>5} short runs: driver {r['driver_mb']:.0f} MB, "
-            f"largest worker {r['worker_mb']:.0f} MB"
-        )
-    figures["rss"] = rss
+    figures["rss"] = report_rss(args.rss)
     print(f"load average after: {' '.join(Path('/proc/loadavg').read_text().split()[:3])}")
     if args.json:
         args.json.write_text(json.dumps(figures, indent=2) + "\n")
+
+
+def report_rss(checkpoints: list[int]) -> list[dict[str, Any]]:
+    child = subprocess.run(
+        [sys.executable, __file__, "--rss-child", "--rss", *map(str, checkpoints)],
+        check=True, capture_output=True, text=True,
+    )  # fmt: skip
+    samples: list[dict[str, Any]] = json.loads(child.stdout.strip().splitlines()[-1])
+    print(f"RSS during one {max(checkpoints)}-run sweep of a short scenario (2 workers), MB:")
+    for r in samples:
+        print(
+            f"  after {r['runs']:>5} runs: driver {r['driver_mb']:.0f} (peak "
+            f"{r['driver_peak_mb']:.0f}), largest worker {r['worker_mb']:.0f} (peak of any "
+            f"worker so far {r['worker_peak_mb']:.0f}; {r['distinct_workers']} workers so far)"
+        )
+    return samples
 
 
 if __name__ == "__main__":

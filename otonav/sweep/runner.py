@@ -95,15 +95,20 @@ def _write_artifacts(
     out: Path, task: RunTask, outcome: RunOutcome
 ) -> tuple[str | None, str | None]:
     """Write a kept run's files under ``runs/<run_id>/``; return (that dir, the scenario
-    file), relative to ``out``."""
-    if not outcome.artifacts:
+    file), relative to ``out``.
+
+    A generated world that did not pass keeps its ``scenario.yaml`` (~1 kB) even with
+    ``keep: none``: its repro line runs that file, since ``otonav run`` cannot draw
+    worlds (docs/adr/0029-sweep-memory-and-ray-state.md)."""
+    scenario_json = outcome.scenario_json or task.scenario_json
+    repro_needs_it = task.world is not None and outcome.status != "passed"
+    if not scenario_json or not (outcome.artifacts or repro_needs_it):
         return None, None
     rel = Path(RUNS) / task.run_id
     folder = out / rel
     folder.mkdir(parents=True, exist_ok=True)
     for name, data in outcome.artifacts.items():
         (folder / name).write_bytes(data)
-    scenario_json = outcome.scenario_json or task.scenario_json
     scenario = yaml.safe_dump(json.loads(scenario_json), sort_keys=False)
     (folder / "scenario.yaml").write_text(scenario)
     return str(rel), str(out / rel / "scenario.yaml")

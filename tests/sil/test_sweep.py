@@ -8,6 +8,7 @@ tests only."""
 from __future__ import annotations
 
 import asyncio
+import gc
 import hashlib
 import json
 import os
@@ -131,15 +132,56 @@ def test_a_generated_world_is_kept_with_a_repro_that_reproduces_it(tmp_path: Pat
     assert hashlib.sha256(recording).hexdigest() == record["recording_sha256"]
 
 
-def test_a_worker_is_recycled_after_its_quota_of_runs(tmp_path: Path) -> None:
-    from otonav.sweep.backends.process import ProcessBackend
+def test_a_failed_generated_world_keeps_its_scenario_for_the_repro_even_with_keep_none(
+    tmp_path: Path,
+) -> None:
+    sweep = tmp_path / "gen.yaml"
+    sweep.write_text(  # the same small world, a robot too slow to make it in time
+        "scenarios:\n  - generate: {count: 1, seed: 7, params: {arena: 5, "
+        "obstacle_count: [1, 1], start_goal_distance: [1.0, 1.2]}}\n"
+        "overrides: {nav.max_v: [0.02]}\nkeep: none\n"
+    )
+    [record] = run_inline(sweep, tmp_path / "out")
+    assert record["status"] == "failed", record["reason"]
+    folder = tmp_path / "out" / record["artifacts"]
+    assert sorted(p.name for p in folder.iterdir()) == ["scenario.yaml"]  # no recording
+    argv = shlex.split(record["repro"])
+    assert argv[3] == str(folder / "scenario.yaml")
+    assert main([*argv[1:], "--out", str(tmp_path / "repro")]) == 1
+    recording = (tmp_path / "repro" / "recording.mcap").read_bytes()
+    assert hashlib.sha256(recording).hexdigest() == record["recording_sha256"]
+
+
+def test_a_warm_worker_frees_each_run_before_the_next(tmp_path: Path) -> None:
+    """A run's objects form reference cycles; a warm worker that left them to the cyclic
+    collector's own pace had ~10 runs' worlds alive (a 13.6 MB MjData each) and its RSS
+    crept (docs/adr/0029). Here the real worker code runs real runs in this process, and
+    after each one no object of a per-run type may be alive, without this test
+    collecting anything."""
+    from otonav.record.writer import RecordingWriter
+    from otonav.runtime.loop import VirtualTimeLoop
+    from otonav.runtime.system import System
+    from otonav.stack.session import StackSession
+    from otonav.sweep.worker import WarmWorker
+
+    per_run = (StackSession, System, VirtualTimeLoop, RecordingWriter)
+
+    def alive() -> list[str]:
+        return [type(o).__name__ for o in gc.get_objects() if isinstance(o, per_run)]
 
     sweep = write_sweep(tmp_path)
-    tasks = [t for t in tasks_of(sweep) if t.scenario == "stuck"][:3]  # 0.5 s of sim each
-    records = execute(prepare(tmp_path / "out", tasks), ProcessBackend(1, runs_per_worker=2))
-    workers = [r["worker"] for r in records]
-    assert workers[0] == workers[1] != workers[2]
-    assert [r["status"] for r in records] == ["failed"] * 3
+    tasks = [t for t in tasks_of(sweep) if t.scenario == "short"][:3]  # 3-4 s of sim each
+    (tmp_path / "scratch").mkdir()
+    gc.collect()
+    before = len(alive())  # other tests' live ones, if any (none expected)
+    worker = WarmWorker(tmp_path / "scratch")  # freezes what exists: hidden from alive()
+    try:
+        for task in tasks:
+            assert worker.run(task).status == "passed"
+            assert alive() == []
+    finally:
+        gc.unfreeze()  # this process is pytest's, not a worker's
+    assert len(alive()) == before  # none hidden by a freeze either
 
 
 def test_crashed_and_hung_workers_are_errors_then_resume_retries_only_them(
@@ -274,28 +316,41 @@ def test_cancelling_the_iterating_task_stops_the_pool(tmp_path: Path) -> None:
 # -- Ray ---------------------------------------------------------------------------------
 
 
+_RAY_AUTH = ("RAY_AUTH_MODE", "RAY_AUTH_TOKEN", "RAY_AUTH_TOKEN_PATH")
+
+
 @pytest.fixture(scope="module")
-def local_ray() -> Iterator[None]:
+def local_ray(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
+    """The cluster the Ray backend starts on demand (``init_local``), with an empty
+    home: yields that home, where Ray must leave nothing (no ``.ray/auth_token``)."""
     import ray  # the dev extra includes otonav[ray]: a missing Ray fails, never skips
 
-    # Workers inherit the environment the cluster starts with: the crash hook is set for
-    # them only (this process runs inline references and must not have it).
-    os.environ[FAULT_ENV] = "crash:crashy"
+    from otonav.sweep.backends.ray import init_local
+
+    home = tmp_path_factory.mktemp("home")
+    saved = {k: os.environ.pop(k, None) for k in ("HOME", *_RAY_AUTH)}
+    os.environ["HOME"] = str(home)
     try:
-        ray.init(
-            num_cpus=2,
-            include_dashboard=False,
-            log_to_driver=False,
-            object_store_memory=128 * 1024 * 1024,  # results are small (default: 30 % of RAM)
-        )
+        # Workers inherit the environment the cluster starts with: the crash hook is set
+        # for them only (this process runs inline references and must not have it).
+        os.environ[FAULT_ENV] = "crash:crashy"
+        try:
+            # results are small: 128 MB of object store (default: 30 % of RAM)
+            init_local(2, object_store_memory=128 * 1024 * 1024)
+        finally:
+            del os.environ[FAULT_ENV]
+        yield home
+        ray.shutdown()
     finally:
-        del os.environ[FAULT_ENV]
-    yield
-    ray.shutdown()
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
 
 
 def test_ray_gives_the_serial_results_and_survives_a_dead_worker(
-    local_ray: None, tmp_path: Path
+    local_ray: Path, tmp_path: Path
 ) -> None:
     sweep = write_sweep(tmp_path, names=("crashy",))
     sweep.write_text(sweep.read_text().replace("seeds: [0, 1]", "seeds: [1]"))
@@ -314,3 +369,4 @@ def test_ray_gives_the_serial_results_and_survives_a_dead_worker(
     assert all(r["worker"].split(":")[1] != str(os.getpid()) for r in healthy)  # on Ray
     kept = [r for r in records if r["status"] == "failed"]
     assert all((tmp_path / "ray" / r["artifacts"] / "recording.mcap").exists() for r in kept)
+    assert not (local_ray / ".ray").exists()  # Ray's token stayed out of the home

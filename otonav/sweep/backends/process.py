@@ -52,8 +52,9 @@ _PACKAGE_ROOT = str(Path(__file__).resolve().parents[3])
 
 def _worker_main(fd: int, scratch: Path) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    from otonav.sweep.worker import execute  # the imports a worker pays once
+    from otonav.sweep.worker import WarmWorker  # the imports a worker pays once
 
+    worker = WarmWorker(scratch)
     conn = Connection(fd)
     conn.send(_READY)
     while True:
@@ -64,7 +65,7 @@ def _worker_main(fd: int, scratch: Path) -> None:
         if task is None:
             return
         try:
-            outcome = execute(task, scratch)
+            outcome = worker.run(task)
         except (KeyboardInterrupt, asyncio.CancelledError):  # SIGTERM to the process group:
             return  # the run was cancelled (recording finished); the parent decides the rest
         conn.send(outcome)
@@ -78,7 +79,6 @@ class _Worker:
     ready: bool = False
     task: RunTask | None = None
     started: float = 0.0
-    runs: int = 0
 
     @property
     def name(self) -> str:
@@ -97,9 +97,8 @@ def _exit_description(code: int | None) -> str:
 class ProcessBackend:
     name = "process"
 
-    def __init__(self, workers: int | None = None, *, runs_per_worker: int = 500) -> None:
+    def __init__(self, workers: int | None = None) -> None:
         self.workers = workers or len(os.sched_getaffinity(0))
-        self.runs_per_worker = runs_per_worker
         self._root = Path(tempfile.gettempdir())
         self._spawned = 0
 
@@ -154,10 +153,7 @@ class ProcessBackend:
                         w.ready = True
                     elif w.task is not None:
                         task, w.task = w.task, None
-                        w.runs += 1
                         emit(task, message)
-                        if w.runs >= self.runs_per_worker and not stop.is_set():
-                            pool[i] = self._retire(w)
             if dead:
                 code = w.proc.wait()
                 if stop.is_set():  # a stop's signal may reach the workers too: their runs
@@ -186,19 +182,6 @@ class ProcessBackend:
     def _lost(w: _Worker, reason: str) -> RunOutcome:
         assert w.task is not None
         return error_outcome(w.task, reason, time.perf_counter() - w.started, w.name)
-
-    def _retire(self, w: _Worker) -> _Worker:
-        """A fresh worker for one that has run ``runs_per_worker`` tasks: a worker's peak
-        RSS crept from 91 MB after 100 short runs to 105 MB after 1,000 (cause not found);
-        recycling bounds it for ~1.5 s of start-up per 500 runs (~3 ms a run)."""
-        with contextlib.suppress(OSError):
-            w.conn.send(None)
-        try:
-            w.proc.wait(timeout=5.0)
-        except subprocess.TimeoutExpired:
-            w.proc.kill()
-            w.proc.wait()
-        return self._replace(w)
 
     def _replace(self, dead: _Worker) -> _Worker:
         dead.conn.close()

@@ -9,12 +9,19 @@ and a fresh actor takes the slot. Outcomes come back through Ray's object store,
 artifacts included as bytes, and the driver writes them into ``--out``: remote workers
 need no shared filesystem (docs/adr/0018-sweep-backends-and-artifacts.md). Every node
 needs otonav installed (the same version) in the Python that runs Ray.
+
+A cluster started on demand keeps Ray's token authentication on but leaves nothing in
+the user's home: unless the caller set ``RAY_AUTH_MODE``, ``RAY_AUTH_TOKEN`` or
+``RAY_AUTH_TOKEN_PATH``, it gets a random token in the environment (``RAY_AUTH_TOKEN``,
+inherited by the cluster's processes) instead of Ray writing ``~/.ray/auth_token``
+(docs/adr/0029-sweep-memory-and-ray-state.md).
 """
 
 from __future__ import annotations
 
 import logging
 import os
+import secrets
 import shutil
 import tempfile
 import threading
@@ -29,6 +36,26 @@ from otonav.sweep.plan import RunTask
 from otonav.sweep.worker import RunOutcome
 
 _POLL_S = 0.2
+_AUTH_VARS = ("RAY_AUTH_MODE", "RAY_AUTH_TOKEN", "RAY_AUTH_TOKEN_PATH")
+
+
+def init_local(num_cpus: int, **kwargs: Any) -> None:
+    """Start a local Ray cluster of ``num_cpus`` CPUs for this process, with token
+    authentication and no file in the user's home (see the module's docstring)."""
+    import ray
+
+    if not any(os.environ.get(name) for name in _AUTH_VARS):
+        # With the mode unset, ray.init turns token authentication on (in this process
+        # too: setting the mode here would come after `import ray` read its config) and
+        # finds this token instead of writing one. Process-wide on purpose: the
+        # cluster's processes inherit it, and Ray's token loader caches what it read.
+        os.environ["RAY_AUTH_TOKEN"] = secrets.token_hex(32)
+    options: dict[str, Any] = {
+        "include_dashboard": False,
+        "logging_level": logging.WARNING,
+        "log_to_driver": False,
+    }
+    ray.init(num_cpus=num_cpus, **{**options, **kwargs})
 
 
 class SweepActor:
@@ -37,14 +64,15 @@ class SweepActor:
     def __init__(self) -> None:
         from otonav.sweep import worker
 
-        self._worker = worker
         self._scratch = Path(tempfile.mkdtemp(prefix="otonav-sweep-ray-"))
+        self._worker = worker.WarmWorker(self._scratch)
+        self._name = worker.worker_name()
 
     def ready(self) -> str:
-        return self._worker.worker_name()
+        return self._name
 
     def run(self, task: RunTask) -> RunOutcome:
-        return self._worker.execute(task, self._scratch)
+        return self._worker.run(task)
 
     def close(self) -> None:
         shutil.rmtree(self._scratch, ignore_errors=True)
@@ -83,12 +111,7 @@ class RayBackend:
             if self.address:
                 ray.init(address=self.address, logging_level=logging.WARNING)
             else:
-                ray.init(
-                    num_cpus=self.workers or len(os.sched_getaffinity(0)),
-                    include_dashboard=False,
-                    logging_level=logging.WARNING,
-                    log_to_driver=False,
-                )
+                init_local(self.workers or len(os.sched_getaffinity(0)))
                 started_here = True
         remote = ray.remote(num_cpus=1, max_restarts=0)(SweepActor)
         cpus = int(ray.cluster_resources().get("CPU", 1))  # type: ignore[no-untyped-call]
