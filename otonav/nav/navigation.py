@@ -5,7 +5,8 @@ Units: m, s of sim time, rad; poses in odom.
 
 Each :meth:`Navigation.step` (at the navigator's rate):
 
-1. no goal: ``idle``; within ``tolerance``: ``reached``; after giving up:
+1. no goal: ``idle``; within ``tolerance``: ``reached`` (latched until the robot is
+   twice as far: settling must not restart the approach); after giving up:
    ``unreachable`` (until a new goal);
 2. **global path** (:mod:`otonav.nav.global_path`) on the map's coarse grid, cells free
    when their clearance is at least the centre clearance; replanned when there is none,
@@ -167,6 +168,7 @@ class Navigation:
     _gave_up: str | None = None
     _stride: int = field(init=False)
     _rays: ScanRays | Callable[[], ScanRays] | None = None
+    _reached: bool = False
 
     def __post_init__(self) -> None:
         p = self.params
@@ -189,6 +191,7 @@ class Navigation:
             self.goal = goal
             self.path = None
             self._gave_up = None
+            self._reached = False
             self._stage = None
             self._ladder = 0
             self._ladder_best = math.inf
@@ -228,9 +231,14 @@ class Navigation:
         heading = wrap_angle(math.atan2(gy - y, gx - x) - yaw)
         if self._gave_up is not None:
             return self._out(0.0, 0.0, "unreachable", self._gave_up, distance, heading)
-        if distance <= self.params.tolerance:
+        # Reached latches (Nav2's stateful goal checker): a robot settling or drifting a
+        # few mm back out of the tolerance stays arrived, until pushed twice as far.
+        tolerance = self.params.tolerance
+        if distance <= tolerance or (self._reached and distance <= 2.0 * tolerance):
             self._stage = None
+            self._reached = True
             return self._out(0.0, 0.0, "reached", "within tolerance", distance, heading)
+        self._reached = False
         if self._stage is not None:
             out = self._recover(now, pose, distance, heading, points)
             if out is not None:

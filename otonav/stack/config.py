@@ -111,7 +111,7 @@ class DwaConfig(_Section):
     fast_path: bool = True
     """try the pure-pursuit arc to the target first and skip the sampling when it
     provably keeps ``fast_margin`` beyond the centre clearance (otonav.nav.dwa)."""
-    fast_margin: float = Field(0.05, ge=0.0, le=5.0)
+    fast_margin: float = Field(0.2, ge=0.0, le=5.0)
     """m, clearance beyond the centre clearance the fast path's arc keeps, in [0, 5]."""
 
 
