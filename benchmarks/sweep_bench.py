@@ -255,7 +255,7 @@ def main() -> None:
     figures["shell"] = {**shell, "throughput": shell_throughput, "scaled_wall_s": scaled}
     figures["identical_recordings"] = same
 
-    figures["rss"] = report_rss(args.rss)
+    figures["rss"] = report_rss(args.rss) if args.rss else []
     print(f"load average after: {' '.join(Path('/proc/loadavg').read_text().split()[:3])}")
     if args.json:
         args.json.write_text(json.dumps(figures, indent=2) + "\n")

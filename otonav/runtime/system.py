@@ -132,6 +132,10 @@ class System:
             else:
                 bound = self.bus.subscribe(topic, port.msg_type, port.qos, endpoint=endpoint)
             actor._otonav_ports[port.name] = bound
+            # The ports are non-data descriptors: the instance's own attribute wins, so
+            # from now on ``self.odom`` is one dict lookup instead of two Python calls
+            # (15 per 10 ms instant in the stack).
+            vars(actor)[port.name] = bound
 
     # -- for code outside the actors (tests, hosts) -------------------------------------
 

@@ -174,3 +174,57 @@ class TestAnyioPlugin:
             await anyio.sleep(1000)
         trace.append(anyio.current_time())
         assert trace == [pytest.approx(30.0)]
+
+
+def _ordering_program(log: list[str]) -> list[asyncio.Task[None]]:
+    """Callbacks, tasks and futures at one instant (no time passes): what asyncio runs in
+    which iteration decides the order. The virtual loop runs its passes itself (ADR 0027)
+    and must give exactly asyncio's order."""
+    loop = asyncio.get_running_loop()
+
+    def note(name: str, then: tuple[str, ...] = ()) -> None:
+        log.append(name)
+        for child in then:
+            loop.call_soon(note, child)
+
+    async def waiter(name: str, future: asyncio.Future[str]) -> None:
+        log.append(f"{name} waits")
+        log.append(f"{name} got {await future}")
+        await asyncio.sleep(0)
+        log.append(f"{name} after sleep(0)")
+
+    future: asyncio.Future[str] = loop.create_future()
+    tasks = [loop.create_task(waiter("t1", future))]
+    loop.call_soon(note, "a", ("a1", "a2"))
+    loop.call_at(loop.time(), note, "due now", ("due child",))
+    loop.call_soon(future.set_result, "x")
+    tasks.append(loop.create_task(waiter("t2", loop.create_future())))
+    cancelled = loop.call_soon(note, "never")
+    cancelled.cancel()
+    loop.call_soon(note, "b", ("b1",))
+    return tasks
+
+
+@pytest.mark.parametrize("debug", [False, True], ids=["fast", "asyncio-debug"])
+def test_one_instant_runs_callbacks_in_stock_asyncio_order(debug: bool) -> None:
+    def trace(loop: asyncio.AbstractEventLoop) -> list[str]:
+        log: list[str] = []
+
+        async def main() -> None:
+            tasks = _ordering_program(log)
+            for _ in range(10):  # let every chain settle
+                await asyncio.sleep(0)
+            for task in tasks:
+                task.cancel()
+
+        loop.set_debug(debug)
+        try:
+            loop.run_until_complete(main())
+        finally:
+            loop.close()
+        return log
+
+    stock = trace(asyncio.new_event_loop())
+    virtual = trace(VirtualTimeLoop())
+    assert "never" not in stock
+    assert virtual == stock
