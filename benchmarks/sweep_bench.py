@@ -7,7 +7,7 @@ Every figure is measured in this invocation, so ratios compare like with like on
 shared, noisy machine (quote ratios and medians, not absolute seconds):
 
 - throughput, in sim-seconds per wall-second, of a ``--runs`` sweep of the acceptance
-  scenario (seeds 0..runs-1: the same 11.3 s of sim each, a different recording each)
+  scenario (seeds 0..runs-1: the same ~13.4 s of sim each, a different recording each)
   on the process pool with 1 worker and with 2, and on a local 2-CPU Ray cluster (its
   start-up timed apart, as for an existing cluster); wall time from the first task
   handed out to the last record written, pool start-up included;

@@ -265,18 +265,20 @@ class CanBusInterface(RobotHardwareInterface):
         self.monitor.requested(t)
         self._last_vel = [None, None]  # the next setpoint goes out whatever it is
 
-    def _send(self, ident: int, data: bytes, t: float) -> None:
+    def _send(self, ident: int, data: bytes, t: float) -> bool:
+        """Send and log one frame; False if the bus refused it (a bus-off fault)."""
         frame = RawFrame(ident, data)
         try:
             self._endpoint.send(frame, t)
         except BusError as exc:
             self.monitor.bus_off(t, str(exc))
-            return
+            return False
         self._sent = True
         log = self._log
         if len(log) == log.maxlen:
             self.frames_dropped_from_log += 1
         log.append((t, frame))
+        return True
 
     def take_frames(self) -> list[tuple[float, RawFrame]]:
         """Frames sent and received since the last call, with their sim times (s)."""
@@ -306,9 +308,9 @@ class CanBusInterface(RobotHardwareInterface):
         speed limit)."""
         if data == self._last_vel[i] and now - self._last_vel_tick[i] < self._keepalive_ticks:
             return
-        self._last_vel[i] = data
-        self._last_vel_tick[i] = now
-        self._send(self._vel_ids[i], data, t)
+        if self._send(self._vel_ids[i], data, t):
+            self._last_vel[i] = data
+            self._last_vel_tick[i] = now
 
     def read_wheels(self) -> WheelState:
         wheels = self._wheels
