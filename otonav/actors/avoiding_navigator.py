@@ -8,32 +8,18 @@ import math
 import numpy as np
 
 from otonav.actors import topics
+from otonav.actors.navigator import GoalNavigator
 from otonav.actors.odom_history import OdomHistory
-from otonav.actors.scan_cache import points_of
-from otonav.msgs import (
-    HardwareStatus,
-    Header,
-    LaserScan,
-    NavDiagnostics,
-    NavState,
-    Odometry,
-    PoseStamped,
-    Time,
-    Twist,
-    Vector3,
-)
+from otonav.actors.scan_cache import points_of, rays_of
+from otonav.msgs import Header, LaserScan, NavDiagnostics, Time
 from otonav.nav.navigation import Navigation, NavigationParams, NavOutput
 from otonav.nav.scan import to_frame
-from otonav.runtime import Actor, Input, Output
+from otonav.runtime import Output
 
-_STOP = Twist.fast(
-    linear=Vector3.fast(x=0.0, y=0.0, z=0.0), angular=Vector3.fast(x=0.0, y=0.0, z=0.0)
-)
-"""(0, 0): messages are immutable and shared, so one object serves every stop."""
 _AT_REST = frozenset({"idle", "waiting", "reached", "unreachable", "fault"})
 
 
-class AvoidingNavigator(Actor):
+class AvoidingNavigator(GoalNavigator):
     """At ``rate_hz``: record each new scan in the map (at the odometry pose of its
     stamp), then step :class:`~otonav.nav.navigation.Navigation`. Only /odom and /scan
     are used, never ground truth. With no scan yet, or none for ``scan_timeout`` s of
@@ -44,12 +30,6 @@ class AvoidingNavigator(Actor):
     rest: when the state or reason change). While /hardware/status reports a fault it
     commands zero and its state is ``fault``."""
 
-    odom = Input(topics.ODOM, Odometry, topics.SENSOR_QOS)
-    scan = Input(topics.SCAN, LaserScan, topics.SENSOR_QOS)
-    goal_in = Input(topics.GOAL, PoseStamped, topics.LATCHED)
-    hardware = Input(topics.HARDWARE_STATUS, HardwareStatus, topics.HARDWARE_QOS)
-    cmd_vel = Output(topics.CMD_VEL, Twist, topics.COMMAND_QOS)
-    state = Output(topics.NAV_STATE, NavState, topics.COMMAND_QOS)
     diagnostics = Output(topics.NAV_DIAGNOSTICS, NavDiagnostics, topics.COMMAND_QOS)
 
     def __init__(
@@ -64,11 +44,7 @@ class AvoidingNavigator(Actor):
         name: str = "nav",
         remap: dict[str, str] | None = None,
     ) -> None:
-        super().__init__(name, remap=remap)
-        if not rate_hz > 0:
-            raise ValueError(f"nav.rate_hz must be > 0 Hz, got {rate_hz}")
-        self.rate_hz = rate_hz
-        self.scan_timeout = scan_timeout
+        super().__init__(rate_hz=rate_hz, scan_timeout=scan_timeout, name=name, remap=remap)
         self.laser_offset_x = laser_offset_x
         self.nav = Navigation(params, start)
         if goal is not None:
@@ -78,23 +54,12 @@ class AvoidingNavigator(Actor):
         self._points_pose: tuple[float, float, float] | None = None
         self._scan_time = -math.inf
         self._last_diag: tuple[str, str] | None = None
-        self._hardware_fault = False
 
-    async def run(self) -> None:
-        rate = self.clock.rate(self.rate_hz)
-        while True:
-            await rate.sleep()
-            self._history.extend(self.odom.drain())
-            goal_msg = self.goal_in.take_latest()
-            if goal_msg is not None:
-                self.nav.set_goal((goal_msg.pose.position.x, goal_msg.pose.position.y))
-            status = self.hardware.take_latest()
-            if status is not None:
-                self._hardware_fault = status.faulted
-            scan = self.scan.take_latest()
-            if scan is not None:
-                self._take_scan(scan)
-            await self._step()
+    def _take_odometry(self) -> None:
+        self._history.extend(self.odom.drain())
+
+    def _take_goal(self, goal: tuple[float, float]) -> None:
+        self.nav.set_goal(goal)
 
     def _take_scan(self, scan: LaserScan) -> None:
         pose = self._history.pose_at(scan.header.stamp.to_seconds())
@@ -109,7 +74,10 @@ class AvoidingNavigator(Actor):
         # A static world seen from the same pose marks the same cells: skip the update
         # (and the points: at rest a scan costs nothing here).
         if moved:
-            self.nav.observe(to_frame(points_of(scan, self.laser_offset_x).xy, pose))
+            offset = self.laser_offset_x
+            self.nav.observe(
+                to_frame(points_of(scan, offset).xy, pose), lambda: rays_of(scan, offset, pose)
+            )
 
     async def _step(self) -> None:
         now = self.clock.now()
@@ -142,24 +110,10 @@ class AvoidingNavigator(Actor):
     async def _publish(self, out: NavOutput) -> None:
         stamp = Time.from_seconds(self.clock.now())
         header = Header.fast(stamp=stamp, frame_id="odom")
-        await self.cmd_vel.publish(
-            _STOP
-            if out.v == 0.0 and out.omega == 0.0
-            else Twist.fast(
-                linear=Vector3.fast(x=out.v, y=0.0, z=0.0),
-                angular=Vector3.fast(x=0.0, y=0.0, z=out.omega),
-            )
-        )
         dwa = out.dwa
         closest = dwa.clearance if dwa is not None else math.inf
-        await self.state.publish(
-            NavState.fast(
-                header=header,
-                state=out.state,
-                distance_to_goal=out.distance,
-                heading_error=out.heading_error,
-                closest_ahead=closest,
-            )
+        await self._publish_command(
+            header, out.v, out.omega, out.state, out.distance, out.heading_error, closest
         )
         # Diagnostics every step while it moves (driving, avoiding, recovering, blocked);
         # at rest (idle, waiting, reached, unreachable) when the state or reason change.

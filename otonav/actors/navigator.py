@@ -1,4 +1,5 @@
-"""The navigator: go-to-goal with an obstacle guard. /odom + /scan + /goal -> /cmd_vel."""
+"""The navigators' shared skeleton, and the stop-only one: go-to-goal with an obstacle
+guard. /odom + /scan + /goal -> /cmd_vel (+ /nav/state)."""
 
 from __future__ import annotations
 
@@ -23,8 +24,93 @@ from otonav.msgs import (
 from otonav.nav import GoToGoalParams, GuardParams, go_to_goal, guard_blocked
 from otonav.runtime import Actor, Input, Output
 
+STOP = Twist.fast(
+    linear=Vector3.fast(x=0.0, y=0.0, z=0.0), angular=Vector3.fast(x=0.0, y=0.0, z=0.0)
+)
+"""(0, 0): messages are immutable and shared, so one object serves every stop."""
 
-class Navigator(Actor):
+
+class GoalNavigator(Actor):
+    """What every navigator does around its decision: the ports, and at ``rate_hz`` the
+    inputs in a fixed order (odometry, goal, hardware status, scan) then one
+    :meth:`_step`, which publishes /cmd_vel and /nav/state (:meth:`_publish_command`).
+    Subclasses say what each input means to them (the ``_take_*`` hooks)."""
+
+    odom = Input(topics.ODOM, Odometry, topics.SENSOR_QOS)
+    scan = Input(topics.SCAN, LaserScan, topics.SENSOR_QOS)
+    goal_in = Input(topics.GOAL, PoseStamped, topics.LATCHED)
+    hardware = Input(topics.HARDWARE_STATUS, HardwareStatus, topics.HARDWARE_QOS)
+    cmd_vel = Output(topics.CMD_VEL, Twist, topics.COMMAND_QOS)
+    state = Output(topics.NAV_STATE, NavState, topics.COMMAND_QOS)
+
+    def __init__(
+        self, *, rate_hz: float, scan_timeout: float, name: str, remap: dict[str, str] | None
+    ) -> None:
+        super().__init__(name, remap=remap)
+        if not rate_hz > 0:
+            raise ValueError(f"nav.rate_hz must be > 0 Hz, got {rate_hz}")
+        self.rate_hz = rate_hz
+        self.scan_timeout = scan_timeout
+        self._hardware_fault = False
+
+    async def run(self) -> None:
+        rate = self.clock.rate(self.rate_hz)
+        while True:
+            await rate.sleep()
+            self._take_odometry()
+            goal_msg = self.goal_in.take_latest()
+            if goal_msg is not None:
+                self._take_goal((goal_msg.pose.position.x, goal_msg.pose.position.y))
+            status = self.hardware.take_latest()
+            if status is not None:
+                self._hardware_fault = status.faulted
+            scan = self.scan.take_latest()
+            if scan is not None:
+                self._take_scan(scan)
+            await self._step()
+
+    def _take_odometry(self) -> None:
+        raise NotImplementedError
+
+    def _take_goal(self, goal: tuple[float, float]) -> None:
+        raise NotImplementedError
+
+    def _take_scan(self, scan: LaserScan) -> None:
+        raise NotImplementedError
+
+    async def _step(self) -> None:
+        raise NotImplementedError
+
+    async def _publish_command(
+        self,
+        header: Header,
+        v: float,
+        omega: float,
+        state: str,
+        distance: float,
+        heading_error: float,
+        closest: float,
+    ) -> None:
+        await self.cmd_vel.publish(
+            STOP
+            if v == 0.0 and omega == 0.0
+            else Twist.fast(
+                linear=Vector3.fast(x=v, y=0.0, z=0.0),
+                angular=Vector3.fast(x=0.0, y=0.0, z=omega),
+            )
+        )
+        await self.state.publish(
+            NavState.fast(
+                header=header,
+                state=state,
+                distance_to_goal=distance,
+                heading_error=heading_error,
+                closest_ahead=closest,
+            )
+        )
+
+
+class Navigator(GoalNavigator):
     """At ``rate_hz``: drive toward the goal (turn, then drive; P-control) and stop when
     a valid return inside the guard's front sector is closer than its stop distance.
 
@@ -34,13 +120,6 @@ class Navigator(Actor):
     Publishes /cmd_vel and /nav/state (idle | driving | blocked | reached | fault).
     While /hardware/status reports a fault it commands zero and its state is ``fault``.
     """
-
-    odom = Input(topics.ODOM, Odometry, topics.SENSOR_QOS)
-    scan = Input(topics.SCAN, LaserScan, topics.SENSOR_QOS)
-    goal_in = Input(topics.GOAL, PoseStamped, topics.LATCHED)
-    hardware = Input(topics.HARDWARE_STATUS, HardwareStatus, topics.HARDWARE_QOS)
-    cmd_vel = Output(topics.CMD_VEL, Twist, topics.COMMAND_QOS)
-    state = Output(topics.NAV_STATE, NavState, topics.COMMAND_QOS)
 
     def __init__(
         self,
@@ -53,39 +132,28 @@ class Navigator(Actor):
         name: str = "nav",
         remap: dict[str, str] | None = None,
     ) -> None:
-        super().__init__(name, remap=remap)
-        if not rate_hz > 0:
-            raise ValueError(f"nav.rate_hz must be > 0 Hz, got {rate_hz}")
+        super().__init__(rate_hz=rate_hz, scan_timeout=scan_timeout, name=name, remap=remap)
         self.params = params
         self.guard = guard
-        self.rate_hz = rate_hz
         self.goal = goal
-        self.scan_timeout = scan_timeout
+        self._odom: Odometry | None = None
         self._scan: LaserScan | None = None
         self._scan_time = -math.inf
         self._ranges: NDArray[np.float32] = np.empty(0, np.float32)
-        self._hardware_fault = False
 
-    async def run(self) -> None:
-        rate = self.clock.rate(self.rate_hz)
-        odom: Odometry | None = None
-        while True:
-            await rate.sleep()
-            odom = self.odom.take_latest() or odom
-            goal_msg = self.goal_in.take_latest()
-            if goal_msg is not None:
-                self.goal = (goal_msg.pose.position.x, goal_msg.pose.position.y)
-            status = self.hardware.take_latest()
-            if status is not None:
-                self._hardware_fault = status.faulted
-            scan = self.scan.take_latest()
-            if scan is not None:
-                self._scan = scan
-                self._scan_time = self.clock.now()
-                self._ranges = np.asarray(scan.ranges, dtype=np.float32)
-            await self._step(odom)
+    def _take_odometry(self) -> None:
+        self._odom = self.odom.take_latest() or self._odom
 
-    async def _step(self, odom: Odometry | None) -> None:
+    def _take_goal(self, goal: tuple[float, float]) -> None:
+        self.goal = goal
+
+    def _take_scan(self, scan: LaserScan) -> None:
+        self._scan = scan
+        self._scan_time = self.clock.now()
+        self._ranges = np.asarray(scan.ranges, dtype=np.float32)
+
+    async def _step(self) -> None:
+        odom = self._odom
         stamp = Time.from_seconds(self.clock.now())
         if self._hardware_fault:
             await self._publish(stamp, 0.0, 0.0, "fault", math.inf, 0.0, math.inf)
@@ -131,18 +199,5 @@ class Navigator(Actor):
         heading_error: float,
         closest: float,
     ) -> None:
-        await self.cmd_vel.publish(
-            Twist.fast(
-                linear=Vector3.fast(x=v, y=0.0, z=0.0),
-                angular=Vector3.fast(x=0.0, y=0.0, z=omega),
-            )
-        )
-        await self.state.publish(
-            NavState.fast(
-                header=Header.fast(stamp=stamp, frame_id="odom"),
-                state=state,
-                distance_to_goal=distance,
-                heading_error=heading_error,
-                closest_ahead=closest,
-            )
-        )
+        header = Header.fast(stamp=stamp, frame_id="odom")
+        await self._publish_command(header, v, omega, state, distance, heading_error, closest)

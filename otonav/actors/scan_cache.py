@@ -6,10 +6,12 @@ reach); the nearest return's distance has its own cheaper function."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from otonav.msgs import LaserScan
-from otonav.nav.scan import ScanPoints, nearest_return, scan_points
+from otonav.nav.scan import ScanPoints, ScanRays, nearest_return, scan_points
 
 _last: tuple[LaserScan, float, ScanPoints] | None = None
 
@@ -44,4 +46,20 @@ def nearest_of(scan: LaserScan, laser_offset_x: float) -> float:
         float(f32(scan.range_min)),
         float(f32(scan.range_max)),
         laser_offset_x,
+    )
+
+
+def rays_of(scan: LaserScan, laser_offset_x: float, pose: tuple[float, float, float]) -> ScanRays:
+    """The scan as rays in odom, taken at the body pose ``pose`` (x, y, yaw)."""
+    f32 = np.float32
+    x, y, yaw = pose
+    return ScanRays(
+        x + laser_offset_x * math.cos(yaw),
+        y + laser_offset_x * math.sin(yaw),
+        yaw,
+        np.asarray(scan.ranges, dtype=np.float64),
+        float(f32(scan.angle_min)),
+        float(f32(scan.angle_increment)),
+        float(f32(scan.range_min)),
+        float(f32(scan.range_max)),
     )

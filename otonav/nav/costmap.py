@@ -5,9 +5,14 @@ Frames and units: odom, m. The grid is a square of ``2 * half_size`` m centred o
 ``(centre_x, centre_y)`` (the start pose), ``resolution`` m per cell (default 5 cm).
 Outside it nothing is known.
 
-* **Unknown is free.** A cell is occupied once a return fell in it; nothing clears it
-  (the worlds are static: a moving obstacle would leave a trail). A route through space
-  never seen is allowed; when the lidar sees it blocked the route is replanned.
+* **Unknown is free.** A cell is occupied once a return fell in it. A route through
+  space never seen is allowed; when the lidar sees it blocked the route is replanned.
+* **Seen through is free** (:meth:`ClearanceMap.clear_seen`, ADR 0026): an occupied
+  cell that a scan's beams pass beyond (the beam nearest its bearing and both
+  neighbours report a return, or nothing, farther than the cell plus a margin) is
+  cleared, and the distances around it are recomputed. So a moving obstacle's trail
+  or a misread does not wall the robot in for ever. The navigator runs it before a
+  replan, not on every scan (cost where it matters only).
 * **Distances, not costs.** :meth:`ClearanceMap.clearance` answers, for any points, a
   lower bound on the distance to the nearest recorded return, capped at
   ``max_distance``: the distance between cell centres minus ``resolution * sqrt(2)``
@@ -26,6 +31,8 @@ import math
 
 import numpy as np
 from numpy.typing import NDArray
+
+from otonav.nav.scan import ScanRays
 
 __all__ = ("ClearanceMap",)
 
@@ -78,13 +85,15 @@ class ClearanceMap:
             kernel >= max_distance, max_distance, np.maximum(kernel - slack, 0.0)
         ).astype(np.float32)
         self.marked = 0
+        self.cleared = 0
 
     def cell_of(
         self, x: NDArray[np.float64], y: NDArray[np.float64]
     ) -> tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.bool_]]:
         """Row (y) and column (x) indices of points, and which are inside the map."""
-        col = np.floor((x - self.origin_x) / self.resolution).astype(np.intp)
-        row = np.floor((y - self.origin_y) / self.resolution).astype(np.intp)
+        inv = 1.0 / self.resolution  # as mark() and clearance() compute it
+        col = np.floor((x - self.origin_x) * inv).astype(np.intp)
+        row = np.floor((y - self.origin_y) * inv).astype(np.intp)
         inside = (col >= 0) & (col < self.size) & (row >= 0) & (row < self.size)
         return row, col, inside
 
@@ -123,6 +132,57 @@ class ClearanceMap:
             np.minimum(window, kernel, out=window)
         self.marked += int(new.size)
         return int(new.size)
+
+    def clear_seen(self, rays: ScanRays, *, reach: float, margin: float) -> int:
+        """Clear the occupied cells within ``reach`` m of the laser that ``rays`` saw
+        through (module docstring), ``margin`` m short of the beams' returns; returns
+        how many. The distances are recomputed where a cleared cell could have set
+        them: reset to the cap, then every occupied cell near there stamped again
+        (stamping is idempotent elsewhere). Cells outside the scan's field of view,
+        or behind its returns, are kept."""
+        n, res = self.size, self.resolution
+        inv = 1.0 / res
+        c0 = max(math.floor((rays.x - reach - self.origin_x) * inv), 0)
+        c1 = min(math.floor((rays.x + reach - self.origin_x) * inv) + 1, n)
+        r0 = max(math.floor((rays.y - reach - self.origin_y) * inv), 0)
+        r1 = min(math.floor((rays.y + reach - self.origin_y) * inv) + 1, n)
+        if c0 >= c1 or r0 >= r1:
+            return 0
+        rows, cols = np.nonzero(self.occupied[r0:r1, c0:c1])
+        if rows.size == 0:
+            return 0
+        rows += r0
+        cols += c0
+        dx = self.origin_x + (cols + 0.5) * res - rays.x
+        dy = self.origin_y + (rows + 0.5) * res - rays.y
+        d = np.hypot(dx, dy)
+        beams = rays.ranges.shape[0]
+        raw = np.rint(
+            np.remainder(np.arctan2(dy, dx) - rays.yaw - rays.angle_min, math.tau)
+            / rays.angle_increment
+        ).astype(np.intp)
+        full_circle = abs(beams * rays.angle_increment - math.tau) < rays.angle_increment
+        beam = raw % beams if full_circle else np.minimum(raw, beams - 1)
+        in_view = np.ones(raw.shape, dtype=np.bool_) if full_circle else raw < beams
+        gone = in_view & (d <= reach) & (rays.seen_free()[beam] > d + margin)
+        if not gone.any():
+            return 0
+        rr, cc = rows[gone], cols[gone]
+        self.occupied[rr, cc] = False
+        k, pad = self._k, self._pad
+        ra, rb = max(int(rr.min()) - k, 0), min(int(rr.max()) + k + 1, n)
+        ca, cb = max(int(cc.min()) - k, 0), min(int(cc.max()) + k + 1, n)
+        self._lower[ra + pad : rb + pad, ca + pad : cb + pad] = self.max_distance
+        sa, sb = max(ra - k, 0), min(rb + k, n)
+        ta, tb = max(ca - k, 0), min(cb + k, n)
+        near_r, near_c = np.nonzero(self.occupied[sa:sb, ta:tb])
+        span, kernel, lower = 2 * k + 1, self._kernel, self._lower
+        for r, c in zip((near_r + sa).tolist(), (near_c + ta).tolist(), strict=True):
+            window = lower[r + 1 : r + 1 + span, c + 1 : c + 1 + span]
+            np.minimum(window, kernel, out=window)
+        cleared = int(rr.size)
+        self.cleared += cleared
+        return cleared
 
     def coarse(self, stride: int) -> NDArray[np.float32]:
         """clearance() at the centre cell of every ``stride`` x ``stride`` block: the

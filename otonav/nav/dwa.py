@@ -109,7 +109,7 @@ class DwaParams:
     w_speed: float = 0.3
     rotate_threshold: float = 0.6
     fast_path: bool = True
-    fast_margin: float = 0.05
+    fast_margin: float = 0.2
 
     def __post_init__(self) -> None:
         positive: tuple[str, ...] = ("max_v", "max_omega", "max_accel", "max_alpha")

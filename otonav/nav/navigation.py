@@ -5,15 +5,17 @@ Units: m, s of sim time, rad; poses in odom.
 
 Each :meth:`Navigation.step` (at the navigator's rate):
 
-1. no goal: ``idle``; within ``tolerance``: ``reached``; after giving up:
+1. no goal: ``idle``; within ``tolerance``: ``reached`` (latched until the robot is
+   twice as far: settling must not restart the approach); after giving up:
    ``unreachable`` (until a new goal);
 2. **global path** (:mod:`otonav.nav.global_path`) on the map's coarse grid, cells free
    when their clearance is at least the centre clearance; replanned when there is none,
    every ``replan_period`` s if the path ahead is blocked, and after each recovery.
+   Before each replan, the cells the last scan saw through are cleared (ADR 0026).
    No path, proven (the search exhausted every cell reachable from the goal): first
    look around (the ``spin`` stage), then, if still none, ``unreachable``: "no path
-   to the goal in the observed map". The map only gains obstacles, so a second proof
-   stands;
+   to the goal in the observed map" (proven again after the look-around, on a map
+   that kept only what the scans still show);
 3. within ``approach_radius`` of the goal, a proportional controller finishes, forward
    or in reverse (an overshoot is backed out of, not turned around); farther away,
    **DWA** (:mod:`otonav.nav.dwa`) toward a point ``lookahead`` m along the path:
@@ -43,6 +45,7 @@ from otonav.nav.dwa import DwaParams, DwaResult, clear_arc, dwa_step
 from otonav.nav.geometry import wrap_angle
 from otonav.nav.global_path import astar
 from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
+from otonav.nav.scan import ScanRays
 
 __all__ = ("LADDER", "NavOutput", "Navigation", "NavigationParams", "Points")
 
@@ -72,6 +75,9 @@ class NavigationParams:
         replan_period: blocked-path check period, s.
         lookahead: the DWA's target is this far along the path, m.
         max_expansions: A* gives up (no proof either way) after this many cells.
+        clear_range: before a replan, occupied cells within this distance of the laser
+            that the last observed scan saw through are cleared (ADR 0026), m; 0: the
+            map never clears.
         progress_distance: progress that counts, m.
         progress_window: time to move ``progress_distance``, s.
         goal_progress_window: time to get ``progress_distance`` closer to the goal, s.
@@ -97,6 +103,7 @@ class NavigationParams:
     replan_period: float = 0.5
     lookahead: float = 0.8
     max_expansions: int = 60_000
+    clear_range: float = 3.0
     progress_distance: float = 0.3
     progress_window: float = 4.0
     goal_progress_window: float = 15.0
@@ -160,6 +167,8 @@ class Navigation:
     _stage: _Stage | None = None
     _gave_up: str | None = None
     _stride: int = field(init=False)
+    _rays: ScanRays | Callable[[], ScanRays] | None = None
+    _reached: bool = False
 
     def __post_init__(self) -> None:
         p = self.params
@@ -182,14 +191,23 @@ class Navigation:
             self.goal = goal
             self.path = None
             self._gave_up = None
+            self._reached = False
             self._stage = None
             self._ladder = 0
             self._ladder_best = math.inf
             self._looked_around = False
             self._checker.reset()
 
-    def observe(self, points_odom: NDArray[np.float64]) -> int:
-        """Record a scan's returns (odom); returns how many map cells were new."""
+    def observe(
+        self,
+        points_odom: NDArray[np.float64],
+        rays: ScanRays | Callable[[], ScanRays] | None = None,
+    ) -> int:
+        """Record a scan's returns (odom); returns how many map cells were new.
+        ``rays`` (the same scan as rays, or a function making them): kept, and used
+        to clear what the scan saw through before the next replan."""
+        if rays is not None:
+            self._rays = rays
         return self.map.mark(points_odom)
 
     # -- the step ----------------------------------------------------------------------
@@ -213,9 +231,14 @@ class Navigation:
         heading = wrap_angle(math.atan2(gy - y, gx - x) - yaw)
         if self._gave_up is not None:
             return self._out(0.0, 0.0, "unreachable", self._gave_up, distance, heading)
-        if distance <= self.params.tolerance:
+        # Reached latches (Nav2's stateful goal checker): a robot settling or drifting a
+        # few mm back out of the tolerance stays arrived, until pushed twice as far.
+        tolerance = self.params.tolerance
+        if distance <= tolerance or (self._reached and distance <= 2.0 * tolerance):
             self._stage = None
+            self._reached = True
             return self._out(0.0, 0.0, "reached", "within tolerance", distance, heading)
+        self._reached = False
         if self._stage is not None:
             out = self._recover(now, pose, distance, heading, points)
             if out is not None:
@@ -324,6 +347,12 @@ class Navigation:
         assert self.goal is not None
         self._planned_at = self._checked_at = now
         self.replans += 1
+        if self._rays is not None and self.params.clear_range > 0.0:
+            rays = self._rays() if callable(self._rays) else self._rays
+            self._rays = None  # one scan clears once
+            self.map.clear_seen(
+                rays, reach=self.params.clear_range, margin=2.0 * self.map.resolution
+            )
         free, penalty = self._free_grid()
         result = astar(
             free,

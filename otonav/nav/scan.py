@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ("ScanPoints", "nearest_return", "scan_points", "to_frame")
+__all__ = ("ScanPoints", "ScanRays", "nearest_return", "scan_points", "to_frame")
 
 Points = NDArray[np.float64]
 
@@ -38,6 +38,38 @@ class ScanPoints:
 
     xy: Points
     blocked: bool
+
+
+@dataclass(frozen=True, slots=True)
+class ScanRays:
+    """One scan as rays in odom, for clearing what it saw through.
+
+    Attributes:
+        x, y, yaw: the laser's pose in odom when the scan was taken (m, m, rad).
+        ranges: the beams' ranges as in ``LaserScan`` (float64).
+        angle_min: beam 0's angle from the laser's x axis, rad.
+        angle_increment: rad between beams.
+        range_min, range_max: the valid range, m.
+    """
+
+    x: float
+    y: float
+    yaw: float
+    ranges: Points
+    angle_min: float
+    angle_increment: float
+    range_min: float
+    range_max: float
+
+    def seen_free(self) -> Points:
+        """Per beam, how far the beam is known empty, m: the range of a valid return,
+        ``range_max`` for ``+inf`` (nothing within range), 0 for NaN and for a blocked
+        beam; each the least of the beam and its two neighbours (a cell between two
+        beams is only as free as the shorter one says)."""
+        r = self.ranges
+        free = np.where((r >= self.range_min) & (r <= self.range_max), r, 0.0)
+        free = np.where(r == np.inf, self.range_max, free)
+        return np.minimum(np.minimum(free, np.roll(free, 1)), np.roll(free, -1))
 
 
 @lru_cache(maxsize=8)

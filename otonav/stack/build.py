@@ -246,6 +246,7 @@ def navigation_params(config: StackConfig, geometry: RobotGeometry) -> Navigatio
         replan_period=grid.replan_period,
         lookahead=grid.lookahead,
         max_expansions=grid.max_expansions,
+        clear_range=grid.clear_range,
         progress_distance=rec.progress_distance,
         progress_window=rec.progress_window,
         goal_progress_window=rec.goal_progress_window,

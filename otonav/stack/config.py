@@ -111,7 +111,7 @@ class DwaConfig(_Section):
     fast_path: bool = True
     """try the pure-pursuit arc to the target first and skip the sampling when it
     provably keeps ``fast_margin`` beyond the centre clearance (otonav.nav.dwa)."""
-    fast_margin: float = Field(0.05, ge=0.0, le=5.0)
+    fast_margin: float = Field(0.2, ge=0.0, le=5.0)
     """m, clearance beyond the centre clearance the fast path's arc keeps, in [0, 5]."""
 
 
@@ -134,6 +134,9 @@ class MapConfig(_Section):
     """m, the DWA heads for the path point this far ahead, in (0, 10]."""
     max_expansions: int = Field(60_000, ge=100, le=10_000_000)
     """A* gives up (no proof either way) after this many cells, in [100, 1e7]."""
+    clear_range: float = Field(3.0, ge=0.0, le=100.0)
+    """m, before a replan the map frees the cells within this range that the last
+    scan saw through (a moved obstacle, a misread); 0: never, in [0, 100]."""
 
 
 class RecoveryConfig(_Section):
