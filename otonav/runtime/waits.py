@@ -59,9 +59,13 @@ async def until(
         except Exception as exc:
             # Raised where time moves (the loop's idle path, or a real-time clock's
             # advance inside someone's now()): hand it to the task awaiting until().
-            done.set_exception(exc)
+            # A predicate that reads a real-time clock can move time and so run this
+            # watcher again inside itself: the inner call may have settled ``done``.
+            if not done.done():
+                done.set_exception(exc)
             return True
-        done.set_result(None)
+        if not done.done():
+            done.set_result(None)
         return True
 
     unwatch = clock.watch(watcher)

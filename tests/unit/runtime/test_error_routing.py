@@ -16,6 +16,7 @@ import pytest
 
 from otonav.runtime import (
     Actor,
+    Clock,
     JumpSource,
     RealTimeClock,
     System,
@@ -102,6 +103,67 @@ def test_a_failing_predicate_reaches_the_awaiting_task_in_real_time() -> None:
         return "not raised"
 
     assert anyio.run(main) == "caught"
+
+
+class MovesTimeWhenRead(Clock):
+    """A clock whose reading can move time and run the watchers, as
+    :meth:`RealTimeClock.now` does when the wall clock has moved on: a predicate that
+    reads it re-enters its own ``until()`` watcher."""
+
+    def __init__(self) -> None:
+        self.t = 0.0
+        self.watchers: list[Callable[[], bool]] = []
+
+    def now(self) -> float:
+        return self.t
+
+    def to_loop_time(self, sim_time: float) -> float:
+        return asyncio.get_running_loop().time() + 3600.0  # the test ends long before
+
+    def watch(self, check: Callable[[], bool]) -> Callable[[], None]:
+        self.watchers.append(check)
+        return lambda: self.watchers.remove(check) if check in self.watchers else None
+
+    def advance(self) -> None:
+        self.t += 0.01
+        for watcher in tuple(self.watchers):
+            if watcher() and watcher in self.watchers:
+                self.watchers.remove(watcher)
+
+
+def test_a_predicate_that_moves_time_and_fails_reaches_the_waiter_once() -> None:
+    # Seen under load in real time: the predicate read the clock, the clock stepped the
+    # world and ran the same watcher inside it, which failed first; the outer call then
+    # set the settled future again (InvalidStateError out of the clock's advance).
+    clock = MovesTimeWhenRead()
+    calls = 0
+
+    def predicate() -> bool:
+        nonlocal calls
+        calls += 1
+        if calls == 1:
+            return False  # until()'s first look, before it watches
+        if calls == 2:
+            clock.advance()  # reading the clock moved time: the watcher runs inside
+        raise KeyError("the predicate itself is broken")
+
+    async def main() -> tuple[str, BaseException | None]:
+        waiter = asyncio.ensure_future(until(predicate, within=5.0, clock=clock))
+        await asyncio.sleep(0)  # until() is watching now
+        try:
+            clock.advance()
+        except BaseException as exc:  # what escaped into whoever moved time
+            escaped: BaseException | None = exc
+        else:
+            escaped = None
+        try:
+            await waiter
+        except KeyError:
+            return "caught", escaped
+        return "not raised", escaped
+
+    assert asyncio.run(main()) == ("caught", None)
+    assert calls == 3
 
 
 def test_a_failing_advance_fails_the_virtual_run_as_a_time_source_error() -> None:
