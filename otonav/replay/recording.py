@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Collection
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any, BinaryIO
 
 from mcap.reader import make_reader
 from pydantic import ValidationError
@@ -58,6 +59,9 @@ class Recording:
     messages: list[RecordedMessage]
     """The messages of the topics asked for, in recorded order (sorted by time, stably)."""
     metadata: dict[str, dict[str, str]] = field(default_factory=dict)
+    summary: Any = None
+    """mcap's parsed summary section (channels, schemas, chunk indexes), for
+    :func:`read_topics`."""
 
 
 def _cut_off(path: Path) -> ReplayInputError:
@@ -94,38 +98,54 @@ def load_recording(path: Path, topics: Collection[str] | None) -> Recording:
                     schemas[channel.topic] = RecordedSchema(
                         schema.name, schema.encoding, schema.data
                     )
-            wanted = None if topics is None else [t for t in topics if t in types]
-            topic_of = {c.id: c.topic for c in summary.channels.values()}
-            ids = (
-                None
-                if wanted is None
-                else [i for i, topic in topic_of.items() if topic in set(wanted)]
-            )
-            messages = (
-                []
-                if ids == []
-                else [
-                    RecordedMessage(topic_of[channel], log_time, data)
-                    for channel, log_time, data in iter_raw_messages(f, summary, ids)
-                ]
-            )
+            messages = _messages(f, summary, topics)
             metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
-        except ChunkDamageError as exc:
-            raise ReplayInputError(
-                f"{describe_damage(path, [exc.damage])}; a replay would feed damaged data as "
-                f"recorded ('otonav info {path}' lists every damaged chunk)"
-            ) from None
-        except CUT_OFF_ERRORS as exc:
-            if isinstance(exc, ReplayInputError):
-                raise
-            if _finished(path):  # ends with the magic: not cut off, damaged
-                raise ReplayInputError(
-                    f"{path}: damaged: unreadable although finished ({_one_line(exc)}); "
-                    f"'otonav info {path}' says where"
-                ) from None
-            raise _cut_off(path) from None
+        except (ChunkDamageError, *CUT_OFF_ERRORS) as exc:
+            raise _unreadable(path, exc) from None
+    return Recording(path, _stack_of(path, metadata), types, schemas, messages, metadata, summary)
+
+
+def read_topics(recording: Recording, topics: Collection[str]) -> list[RecordedMessage]:
+    """The messages of ``topics`` in ``recording`` (loaded by :func:`load_recording`,
+    whose summary is reused), in recorded order."""
+    path = recording.path
+    try:
+        with path.open("rb") as f:
+            return _messages(f, recording.summary, topics)
+    except OSError as exc:
+        raise ReplayInputError(f"{path}: cannot read ({exc.strerror or exc})") from None
+    except (ChunkDamageError, *CUT_OFF_ERRORS) as exc:
+        raise _unreadable(path, exc) from None
+
+
+def _messages(f: BinaryIO, summary: Any, topics: Collection[str] | None) -> list[RecordedMessage]:
+    topic_of = {c.id: c.topic for c in summary.channels.values()}
+    wanted = None if topics is None else set(topics)
+    ids = None if wanted is None else [i for i, topic in topic_of.items() if topic in wanted]
+    if ids == []:
+        return []
+    messages = [
+        RecordedMessage(topic_of[channel], log_time, data)
+        for channel, log_time, data in iter_raw_messages(f, summary, ids)
+    ]
     messages.sort(key=lambda m: m.time_ns)  # stable: equal instants keep the file order
-    return Recording(path, _stack_of(path, metadata), types, schemas, messages, metadata)
+    return messages
+
+
+def _unreadable(path: Path, exc: BaseException) -> ReplayInputError:
+    if isinstance(exc, ReplayInputError):
+        return exc
+    if isinstance(exc, ChunkDamageError):
+        return ReplayInputError(
+            f"{describe_damage(path, [exc.damage])}; a replay would feed damaged data as "
+            f"recorded ('otonav info {path}' lists every damaged chunk)"
+        )
+    if _finished(path):  # ends with the magic: not cut off, damaged
+        return ReplayInputError(
+            f"{path}: damaged: unreadable although finished ({_one_line(exc)}); "
+            f"'otonav info {path}' says where"
+        )
+    return _cut_off(path)
 
 
 def _stack_of(path: Path, metadata: dict[str, dict[str, str]]) -> StackConfig | None:

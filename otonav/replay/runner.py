@@ -7,7 +7,7 @@ from __future__ import annotations
 import asyncio
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Literal
 
@@ -15,7 +15,13 @@ from otonav.msgs import Message
 from otonav.replay.compare import Divergence, Replayed, TopicComparison, compare_topic
 from otonav.replay.feed import Feeder, FeedSource, Gate, ReplayClock, plan_instants
 from otonav.replay.nodes import build_nodes
-from otonav.replay.recording import RecordedMessage, Recording, ReplayInputError, load_recording
+from otonav.replay.recording import (
+    RecordedMessage,
+    Recording,
+    ReplayInputError,
+    load_recording,
+    read_topics,
+)
 from otonav.runtime import (
     Actor,
     ActorCrashedError,
@@ -165,7 +171,7 @@ def replay_recording(
         raise ReplayInputError("--node: name at least one node to replay")
     ports = _ports(actors)
     _check_topics(meta, ports, actors)
-    full = load_recording(path, topics=[*ports.inputs, *ports.outputs])
+    full = replace(meta, messages=read_topics(meta, [*ports.inputs, *ports.outputs]))
     source = FeedSource(config.world.timestep)
     instants = plan_instants(
         full.messages,
