@@ -63,9 +63,9 @@ def step_times() -> None:
         pending[0] = 0.0
         return out
 
-    def observe(self: navigation.Navigation, points: Any) -> int:
+    def observe(self: navigation.Navigation, *args: Any) -> int:
         t0 = time.perf_counter()
-        new = original_observe(self, points)
+        new = original_observe(self, *args)
         dt = time.perf_counter() - t0
         observes.append(dt)
         pending[0] += dt
