@@ -30,8 +30,36 @@ from otonav.nav import GoToGoalParams, GuardParams, go_to_goal, guard_blocked
 from otonav.nav.navigation import Navigation
 from otonav.nav.safety import safe_command
 from otonav.nav.scan import scan_points, to_frame
-from otonav.stack import StackConfig
+from otonav.stack import BaseConfig, StackConfig
 from otonav.stack.build import navigation_params, safety_params
+
+
+def _drive(
+    hal: RobotHardwareInterface,
+    want_v: float,
+    want_omega: float,
+    v: float,
+    omega: float,
+    dt: float,
+    base: BaseConfig,
+    kin: DiffDriveGeometry,
+) -> tuple[float, float]:
+    """The base controller's step inline: limit the wanted twist, command the wheels;
+    returns the twist commanded."""
+    v, omega = limit_twist(
+        want_v,
+        want_omega,
+        prev_v=v,
+        prev_omega=omega,
+        dt=dt,
+        max_v=base.max_v,
+        max_omega=base.max_omega,
+        max_accel=base.max_accel,
+        max_alpha=base.max_alpha,
+    )
+    left, right = twist_to_wheels(v, omega, kin)
+    hal.write(WheelCommand(left, right))
+    return v, omega
 
 
 def run_bare(
@@ -86,19 +114,7 @@ def run_bare(
                 (0.0, 0.0) if cmd.reached or (blocked and cmd.v > 0) else (cmd.v, cmd.omega)
             )
         if k % base_every == 0:
-            v, omega = limit_twist(
-                want_v,
-                want_omega,
-                prev_v=v,
-                prev_omega=omega,
-                dt=base_every * tick,
-                max_v=base.max_v,
-                max_omega=base.max_omega,
-                max_accel=base.max_accel,
-                max_alpha=base.max_alpha,
-            )
-            left, right = twist_to_wheels(v, omega, kin)
-            hal.write(WheelCommand(left, right))
+            v, omega = _drive(hal, want_v, want_omega, v, omega, base_every * tick, base, kin)
 
 
 def run_bare_stack(
@@ -222,16 +238,4 @@ def run_bare_stack(
                     result = safe_command(v_in, w_in, odom_v, odom_omega, moved_points, safety)
                     want_v, want_omega = result.v, result.omega
         if k % base_every == 0:
-            v, omega = limit_twist(
-                want_v,
-                want_omega,
-                prev_v=v,
-                prev_omega=omega,
-                dt=base_every * tick,
-                max_v=base.max_v,
-                max_omega=base.max_omega,
-                max_accel=base.max_accel,
-                max_alpha=base.max_alpha,
-            )
-            left, right = twist_to_wheels(v, omega, kin)
-            hal.write(WheelCommand(left, right))
+            v, omega = _drive(hal, want_v, want_omega, v, omega, base_every * tick, base, kin)
