@@ -34,17 +34,11 @@ def test_gui_and_foxglove_together(cli_gui_child: Callable[..., _Child], tmp_pat
     )  # fmt: skip
     display, xauthority = _screen_of(child)
     expect = {"/odom", "/clock", "/tf", "/scan"}
+    # The CLI announces the server once it listens (the server binds before the line).
+    child.expect_stderr("foxglove: serving", timeout=30)
     client = FoxgloveClient(f"ws://127.0.0.1:{port}", expect=expect, subscribe={"/odom", "/clock"})
+    client.start()
     deadline = time.monotonic() + 30.0
-    while True:  # the server starts with the command, in the child
-        try:
-            client.start()
-            break
-        except OSError:
-            assert time.monotonic() < deadline, f"no server on port {port}{child}"
-            assert child.proc.poll() is None, str(child)
-            time.sleep(0.1)  # a wall-clock retry of the connect, not a timing check
-            client = FoxgloveClient(client.url, expect=expect, subscribe={"/odom", "/clock"})
     # The window is up and draws the robot while the client is served.
     seen = (0, 0.0, 0.0)
     while seen[0] < 30 and time.monotonic() < deadline and child.proc.poll() is None:

@@ -129,10 +129,12 @@ def _need(tool: str) -> str:
 
 @dataclass
 class _Child:
-    """A GUI child under xvfb-run, its stdout lines on a queue, stderr kept."""
+    """A GUI child under xvfb-run, its stdout lines on a queue, stderr kept (and its
+    lines on a queue of their own)."""
 
     proc: subprocess.Popen[str]
     lines: queue.Queue[str | None] = field(default_factory=queue.Queue)
+    err_lines: queue.Queue[str | None] = field(default_factory=queue.Queue)
     stderr: list[str] = field(default_factory=list)
     readers: list[threading.Thread] = field(default_factory=list)
 
@@ -146,9 +148,15 @@ class _Child:
                 self.lines.put(line.rstrip("\n"))
             self.lines.put(None)
 
+        def read_err() -> None:
+            for line in err:
+                self.stderr.append(line)
+                self.err_lines.put(line.rstrip("\n"))
+            self.err_lines.put(None)
+
         self.readers = [
             threading.Thread(target=read_out, daemon=True),
-            threading.Thread(target=lambda: self.stderr.extend(err), daemon=True),
+            threading.Thread(target=read_err, daemon=True),
         ]
         for reader in self.readers:
             reader.start()
@@ -177,6 +185,20 @@ class _Child:
                 raise AssertionError(f"child ended before a {prefix!r} line{self}")
             if line.startswith(prefix + " "):
                 return line.split(" ")[1:]
+
+    def expect_stderr(self, prefix: str, timeout: float) -> str:
+        """The next stderr line starting with ``prefix`` (blocks on the pipe, no polling)."""
+        deadline = time.monotonic() + timeout
+        while True:
+            try:
+                line = self.err_lines.get(timeout=max(0.0, deadline - time.monotonic()))
+            except queue.Empty:
+                raise AssertionError(f"no {prefix!r} on stderr in {timeout:g} s{self}") from None
+            if line is None:
+                self.proc.wait(timeout=5)
+                raise AssertionError(f"child ended before {prefix!r} on stderr{self}")
+            if line.startswith(prefix):
+                return line
 
     def send(self, text: str) -> None:
         assert self.proc.stdin is not None
