@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numpy.typing import NDArray
 
 from otonav.msgs import LaserScan
 from otonav.nav.scan import ScanPoints, ScanRays, nearest_return, scan_points
@@ -21,31 +22,27 @@ def points_of(scan: LaserScan, laser_offset_x: float) -> ScanPoints:
     global _last
     if _last is not None and _last[0] is scan and _last[1] == laser_offset_x:
         return _last[2]
-    # The LaserScan's angles and limits are float32 on the wire (ROS 2): use them as
-    # float32 here too, so a replay from the recording computes the same points.
-    f32 = np.float32
-    seen = scan_points(
-        np.asarray(scan.ranges, dtype=np.float64),
-        float(f32(scan.angle_min)),
-        float(f32(scan.angle_increment)),
-        float(f32(scan.range_min)),
-        float(f32(scan.range_max)),
-        laser_offset_x,
-    )
+    seen = scan_points(*_wire(scan), laser_offset_x)
     _last = (scan, laser_offset_x, seen)
     return seen
 
 
 def nearest_of(scan: LaserScan, laser_offset_x: float) -> float:
     """Base_link origin to the scan's nearest return, m (:func:`nearest_return`)."""
+    return nearest_return(*_wire(scan), laser_offset_x)
+
+
+def _wire(scan: LaserScan) -> tuple[NDArray[np.float64], float, float, float, float]:
+    """Ranges, angle_min, angle_increment, range_min, range_max as the pure functions
+    take them. The angles and limits are float32 on the wire (ROS 2): used as float32
+    here too, so a replay from the recording computes the same points."""
     f32 = np.float32
-    return nearest_return(
+    return (
         np.asarray(scan.ranges, dtype=np.float64),
         float(f32(scan.angle_min)),
         float(f32(scan.angle_increment)),
         float(f32(scan.range_min)),
         float(f32(scan.range_max)),
-        laser_offset_x,
     )
 
 
