@@ -84,6 +84,9 @@ class ClearanceMap:
         self._kernel = np.where(
             kernel >= max_distance, max_distance, np.maximum(kernel - slack, 0.0)
         ).astype(np.float32)
+        self._flat = self._lower.reshape(-1)  # a view: every update shows through it
+        self._cells = memoryview(self._flat.data)  # float32 items, read as Python floats
+        self._width = self.size + 2 * self._pad
         self.marked = 0
         self.cleared = 0
 
@@ -192,9 +195,33 @@ class ClearanceMap:
 
     def clearance(self, x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float32]:
         """Lower bound on the distance from each point to the nearest recorded return,
-        m, capped at ``max_distance`` (outside the map: ``max_distance``)."""
-        inv, pad = 1.0 / self.resolution, self._pad
-        hi = self.size + 2 * pad - 1
-        col = np.clip(np.floor((x - self.origin_x) * inv).astype(np.intp) + pad, 0, hi)
-        row = np.clip(np.floor((y - self.origin_y) * inv).astype(np.intp) + pad, 0, hi)
-        return self._lower[row, col]
+        m, capped at ``max_distance`` (outside the map: ``max_distance``).
+
+        The cell indices stay floats until the last step (in-place floor, offset and
+        clamp: integers this small are exact in float64) and one flat ``take`` reads
+        them: 9 points cost ~10 us instead of ~21 us with ``np.clip`` and 2-D fancy
+        indexing (measured; the DWA asks ~600 points per sampled step)."""
+        inv, pad, hi = 1.0 / self.resolution, self._pad, self._width - 1
+        col = x - self.origin_x
+        col *= inv
+        np.floor(col, out=col)
+        col += pad
+        np.maximum(col, 0.0, out=col)
+        np.minimum(col, hi, out=col)
+        row = y - self.origin_y
+        row *= inv
+        np.floor(row, out=row)
+        row += pad
+        np.maximum(row, 0.0, out=row)
+        np.minimum(row, hi, out=row)
+        row *= self._width
+        row += col
+        return self._flat.take(row.astype(np.intp))
+
+    def clearance_at(self, x: float, y: float) -> float:
+        """:meth:`clearance` of one point, in plain Python (~0.3 us: a handful of
+        points are cheaper this way than through numpy's per-call overhead)."""
+        inv, pad, hi = 1.0 / self.resolution, self._pad, self._width - 1
+        col = min(max(math.floor((x - self.origin_x) * inv) + pad, 0), hi)
+        row = min(max(math.floor((y - self.origin_y) * inv) + pad, 0), hi)
+        return self._cells[row * self._width + col]
