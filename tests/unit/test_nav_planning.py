@@ -4,6 +4,8 @@ the DWA step, progress and recovery, and the Navigation object on synthetic scan
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -477,3 +479,26 @@ def test_reached_latches_until_the_robot_is_pushed_twice_the_tolerance_away() ->
     fresh = Navigation(NavigationParams(tolerance=0.08), (0.0, 0.0))
     fresh.set_goal((1.0, 0.0))  # never arrived: 9 cm is not reached
     assert fresh.step(0.0, (0.91, 0.0, 0.0), 0.0, 0.0, none).state != "reached"
+
+
+def test_navigating_imports_nothing_more_than_its_modules() -> None:
+    """The first run of a process pays every lazy import inside its sim time: the
+    navigator's pure pieces (map, A*, DWA) must not pull numpy.ma (np.unique's first
+    call did, ~8 ms of the bench's first run), nor anything else new."""
+    script = (
+        "import sys\n"
+        "import numpy as np\n"
+        "from otonav.nav.navigation import Navigation, NavigationParams\n"
+        "nav = Navigation(NavigationParams(), (0.0, 0.0))\n"
+        "nav.set_goal((3.0, 0.0))\n"
+        "before = set(sys.modules)\n"
+        "wall = np.stack((np.full(40, 1.5), np.linspace(-0.4, 0.4, 40)), axis=1)\n"
+        "for i in range(40):\n"
+        "    nav.observe(wall - [0.01 * i, 0.0])\n"
+        "    nav.step(0.05 * i, (0.02 * i, 0.0, 0.0), 0.3, 0.0, wall)\n"
+        "print(sorted(set(sys.modules) - before))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=True, timeout=60
+    )
+    assert out.stdout.strip() == "[]"
