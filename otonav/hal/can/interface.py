@@ -31,7 +31,6 @@ import math
 import struct
 from collections import deque
 from dataclasses import dataclass
-from itertools import repeat
 from typing import Protocol
 
 from otonav.hal.can import protocol as p
@@ -116,6 +115,7 @@ class CanBusInterface(RobotHardwareInterface):
         self._sensors = sensors
         self._peer = peer
         self._axes = (left, right)
+        self._node_ids = (left.node_id, right.node_id)
         self._scale = (left.turns_per_rad(), right.turns_per_rad())
         self._vel_ids = (
             p.arbitration_id(left.node_id, p.CMD_SET_INPUT_VEL),
@@ -219,15 +219,16 @@ class CanBusInterface(RobotHardwareInterface):
         over = len(log) + len(frames) - self._log_limit
         if over > 0:  # the oldest frames leave the bounded log
             self.frames_dropped_from_log += min(over, len(frames))
-        log.extend(zip(repeat(t), frames))
+        append = log.append
         encoder_axis = self._encoder_axis
         for frame in frames:
+            append((t, frame))
             ident, data, is_error, is_remote = frame
             i = None if is_error or is_remote else encoder_axis.get(ident)
             if i is None:
                 self._receive_other(frame, t)
                 continue
-            self.monitor.encoder(self._axes[i].node_id, t)
+            self.monitor.encoder(self._node_ids[i], t)
             try:
                 position, velocity = p.unpack_two_f32(data)
             except struct.error:  # a short payload: ignored, like a bad frame on the wire
@@ -251,12 +252,12 @@ class CanBusInterface(RobotHardwareInterface):
             return
         node, cmd = ident >> 5 & p.MAX_NODE_ID, ident & 0x1F
         try:
-            if cmd == p.CMD_GET_ENCODER_ESTIMATES:  # a node we do not drive
+            if cmd == p.CMD_HEARTBEAT:
+                error, state = p.unpack_heartbeat(frame.data)
+                monitor.heartbeat(node, error, state, t)
+            elif cmd == p.CMD_GET_ENCODER_ESTIMATES:  # a node we do not drive
                 monitor.encoder(node, t)
-            elif cmd == p.CMD_HEARTBEAT:
-                beat = p.decode_heartbeat(frame.data)
-                monitor.heartbeat(node, beat.axis_error, beat.axis_state, t)
-        except (ValueError, struct.error):  # a short payload: ignored
+        except struct.error:  # a short payload: ignored
             return
 
     def _apply(self, actions: tuple[Action, ...], t: float) -> None:
@@ -309,10 +310,11 @@ class CanBusInterface(RobotHardwareInterface):
     def write(self, cmd: WheelCommand) -> None:
         """Send both setpoints as Set_Input_Vel; zero while the drives are not drivable
         (starting, faulted, recovering)."""
-        self._check_open()
+        if self._closed:
+            raise RuntimeError("CanBusInterface is closed")
         if not (math.isfinite(cmd.left) and math.isfinite(cmd.right)):
             raise ValueError(f"wheel command must be finite, got {cmd}")
-        drivable = self.monitor.health.drivable
+        drivable = self.monitor.drivable
         now = self._sensors.ticks
         t = now * self._tick
         sl, sr = self._scale

@@ -114,6 +114,8 @@ class DriveMonitor:
         # RUNNING: no check can find a fault before this instant (see check()).
         self._quiet_until = -math.inf
         self.events: list[tuple[float, str]] = []
+        self.drivable = False
+        """``health.drivable``, kept as a plain attribute (read at every wheel write)."""
         self.health = HardwareHealth(
             level=HealthLevel.WARN,
             ready=False,
@@ -381,6 +383,7 @@ class DriveMonitor:
             since=now,
             values=(("phase", self.phase.value), *values),
         )
+        self.drivable = self.health.drivable
         self.events.append((now, message))
 
 

@@ -70,7 +70,7 @@ class BusFaults:
 
 
 class _Drive:
-    __slots__ = ("axis", "encoder_id", "heartbeat_silent", "k", "mount", "node_id")
+    __slots__ = ("axis", "encoder_id", "heartbeat_id", "heartbeat_silent", "k", "mount", "node_id")
 
     def __init__(self, params: AxisParams, mount: DriveMount) -> None:
         self.axis = AxisModel(params)
@@ -79,6 +79,7 @@ class _Drive:
         self.heartbeat_silent = False
         # Precomputed for the 10 ms encoder frames: the id, and wheel rad -> motor turns.
         self.encoder_id = p.arbitration_id(params.node_id, p.CMD_GET_ENCODER_ESTIMATES)
+        self.heartbeat_id = p.arbitration_id(params.node_id, p.CMD_HEARTBEAT)
         self.k = mount.sign * mount.gear_ratio / _TWO_PI
 
 
@@ -302,7 +303,5 @@ class DriveEmulator:
             if drive.heartbeat_silent:
                 continue
             axis = drive.axis
-            ident, data = p.encode_heartbeat(
-                drive.node_id, p.Heartbeat(int(axis.error), int(axis.state))
-            )
-            self._transmit(RawFrame(ident, data), now, t)
+            data = p.pack_heartbeat(int(axis.error), int(axis.state))
+            self._transmit(RawFrame(drive.heartbeat_id, data), now, t)
