@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from otonav.msgs import LaserScan
-from otonav.nav.scan import ScanPoints, ScanRays, nearest_return, scan_points
+from otonav.nav.scan import ScanPoints, ScanRays, nearest_return, scan_in_frame, scan_points
 
 Wire = tuple[NDArray[np.float64], float, float, float, float]
 
@@ -29,6 +29,15 @@ def points_of(scan: LaserScan, laser_offset_x: float) -> ScanPoints:
     seen = scan_points(*_wire(scan), laser_offset_x)
     _last = (scan, laser_offset_x, seen)
     return seen
+
+
+def odom_xy_of(
+    scan: LaserScan, laser_offset_x: float, pose: tuple[float, float, float]
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """The scan's returns in odom at the body pose ``pose``, as x and y arrays
+    (:func:`otonav.nav.scan.scan_in_frame`: the floats of ``to_frame(points_of(...))``
+    with ~6 fewer numpy calls and no (N, 2) arrays)."""
+    return scan_in_frame(*_wire(scan), laser_offset_x, pose)
 
 
 def nearest_of(scan: LaserScan, laser_offset_x: float) -> float:

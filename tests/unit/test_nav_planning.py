@@ -18,7 +18,7 @@ from otonav.nav.footprint import centre_clearance
 from otonav.nav.global_path import astar
 from otonav.nav.navigation import Navigation, NavigationParams
 from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
-from otonav.nav.scan import ScanRays, nearest_return, scan_points, to_frame
+from otonav.nav.scan import ScanRays, nearest_return, scan_in_frame, scan_points, to_frame
 
 pytestmark = pytest.mark.unit
 
@@ -70,6 +70,24 @@ def test_scan_points_in_base_link_and_blocked_beams() -> None:
     clean = scan_points(np.array([1.0, np.inf]), 0.0, inc, 0.12, 8.0, 0.0)
     assert not clean.blocked
     assert clean.xy.shape == (1, 2)
+
+
+def test_scan_in_frame_is_scan_points_moved_to_odom() -> None:
+    """The map update's fused path gives the floats of to_frame(scan_points(...)),
+    blocked beams, NaN, +-inf and out-of-range values included."""
+    rng = np.random.default_rng(9)
+    odd = [math.nan, math.inf, -math.inf, 0.05, 9.0]
+    for trial in range(60):
+        ranges = rng.uniform(0.12, 8.0, 72)
+        ranges[rng.integers(0, 72, int(rng.integers(0, 8)))] = odd[trial % len(odd)]
+        pose = (float(rng.uniform(-3, 3)), float(rng.uniform(-3, 3)), float(rng.uniform(-4, 4)))
+        args = (ranges, -math.pi, 2 * math.pi / 72, 0.12, 8.0, 0.06)
+        x, y = scan_in_frame(*args, pose)
+        expected = to_frame(scan_points(*args).xy, pose)
+        assert x.tolist() == expected[:, 0].tolist()
+        assert y.tolist() == expected[:, 1].tolist()
+    empty = scan_in_frame(np.empty(0), -math.pi, 0.1, 0.12, 8.0, 0.06, (0.0, 0.0, 0.0))
+    assert empty[0].shape == (0,)
 
 
 def test_nearest_return_is_the_nearest_of_the_scan_points() -> None:
