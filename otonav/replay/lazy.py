@@ -19,6 +19,7 @@ publisher's slow path asks the object for its ``__class__``, which decodes it.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any, TypeVar
 
 from pydantic import BaseModel
@@ -26,7 +27,7 @@ from pydantic import BaseModel
 from otonav.msgs import Message
 from otonav.record.cdr_decode import decode
 
-__all__ = ("is_lazy", "lazy", "materialize")
+__all__ = ("is_lazy", "lazy", "lazy_maker", "materialize")
 
 M = TypeVar("M", bound=Message)
 
@@ -35,6 +36,7 @@ _KEY = "\0cdr"
 so every field lookup misses and reaches ``__getattribute__``."""
 
 _get = object.__getattribute__
+_new = object.__new__
 _set_class = object.__setattr__
 _set_dict = BaseModel.__dict__["__dict__"].__set__
 _set_fields_set = BaseModel.__dict__["__pydantic_fields_set__"].__set__
@@ -109,6 +111,23 @@ def lazy(message_type: type[M], data: bytes) -> M:
     _set_extra(message, None)
     _set_private(message, None)
     return message
+
+
+def lazy_maker(message_type: type[M]) -> Callable[[bytes], M]:
+    """``lambda data: lazy(message_type, data)``, with the class looked up once (the
+    replay's feeder makes one per recorded input)."""
+    cls = _LAZY.get(message_type) or _lazy_class(message_type)
+    fields = message_type._otonav_fields
+
+    def make(data: bytes) -> M:
+        message: M = _new(cls)  # type: ignore[assignment]
+        _set_dict(message, {_KEY: data})
+        _set_fields_set(message, fields)
+        _set_extra(message, None)
+        _set_private(message, None)
+        return message
+
+    return make
 
 
 def is_lazy(message: object) -> bool:
