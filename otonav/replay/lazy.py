@@ -24,8 +24,9 @@ from typing import Any, TypeVar
 
 from pydantic import BaseModel
 
-from otonav.msgs import Message
+from otonav.msgs import Header, Message
 from otonav.record.cdr_decode import decode
+from otonav.record.schemas import layout_for
 
 __all__ = ("is_lazy", "lazy", "lazy_maker", "materialize")
 
@@ -57,13 +58,37 @@ def materialize(message: M) -> M:
     # No bytes: a copy taken from an already decoded message (pydantic's __copy__ builds
     # the copy with type(self), read before the original decoded itself).
     if data is not None:
-        _set_dict(message, _get(decode(real, data), "__dict__"))
+        decoded = _get(decode(real, data), "__dict__")
+        header = fields.get("header")
+        if header is not None:  # read before (see _lazy_class): keep the object handed out
+            decoded["header"] = header
+        _set_dict(message, decoded)
     _set_class(message, "__class__", real)
     return message
 
 
 def _lazy_class(real: type[Message]) -> type[Message]:
+    layout = layout_for(real)
+    stamped = bool(layout.fields) and layout.fields[0].name == "header"
+    stamped = stamped and layout.fields[0].type is Header
+
     def __getattribute__(self: Message, name: str) -> Any:
+        if name == "header" and stamped:
+            # A stamped message's header comes first on the wire, where a Header alone
+            # would be: decode just it, and keep the message lazy. The navigator reads
+            # the stamps of ~4 queued /odom per scan to find the pose at the scan's
+            # stamp, and the rest of only one (Odometry 5.0 us, its Header 1.2 us).
+            fields = _get(self, "__dict__")
+            data = fields.get(_KEY)
+            if data is not None:
+                header = fields.get("header")
+                if header is None:
+                    try:
+                        header = fields["header"] = decode(Header, data)
+                    except ValueError:  # damaged: the whole message's decode says so
+                        header = None
+                if header is not None:
+                    return header
         materialize(self)
         return _get(self, name)
 
