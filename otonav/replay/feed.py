@@ -36,7 +36,7 @@ import asyncio
 from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
 from functools import partial
-from typing import Any
+from typing import Any, NamedTuple
 
 from otonav.msgs import Message
 from otonav.replay.lazy import lazy
@@ -91,8 +91,10 @@ class Settle:
 Step = RecordedMessage | Settle
 
 
-@dataclass(frozen=True, slots=True)
-class Instant:
+class Instant(NamedTuple):
+    """One instant the feeder works at. (A named tuple: a replay plans one per instant
+    with input, 1,334 for the navigator on the acceptance recording.)"""
+
     tick: int
     steps: tuple[Step, ...]
     """Inputs to publish, in recorded order, with a Settle where actors ran in between."""
@@ -118,39 +120,49 @@ def plan_instants(
     the replayed actors (an instant where all of them ran before its inputs is marked
     ``after_idle``)."""
     everyone = frozenset(actors)
-    groups: list[tuple[int, list[RecordedMessage]]] = []
-    for message in messages:
-        if message.topic not in inputs and message.topic not in publishers_of:
-            continue
-        tick = round(message.time_ns * rate / 1e9)
-        if not groups or groups[-1][0] != tick:
-            groups.append((tick, []))
-        groups[-1][1].append(message)
     instants: list[Instant] = []
-    for index, (tick, group) in enumerate(groups):
-        last = index == len(groups) - 1
-        steps: list[Step] = []
-        ran: set[str] = set()  # replayed actors that published since the last input
-        for message in group:
-            if message.topic in publishers_of:
-                ran.update(publishers_of[message.topic])
-                continue
-            if ran:
-                steps.append(Settle(frozenset(ran)))
-                ran = set()
-            steps.append(message)
+    tick = -1  # of the group being planned
+    steps: list[Step] = []
+    ran: set[str] = set()  # replayed actors that published since the last input
+    settles = 0
+
+    def close(last: bool) -> None:
+        nonlocal settles
         if last:
             steps.append(Settle(frozenset(ran)))
-        if steps:
-            settles = [step for step in steps if isinstance(step, Settle)]
-            after_idle = (
-                not last
-                and len(settles) == 1
-                and steps[0] is settles[0]
-                and bool(everyone)
-                and settles[0].actors == everyone
-            )
-            instants.append(Instant(tick, tuple(steps), last, last or bool(settles), after_idle))
+            settles += 1
+        if not steps:
+            return
+        first = steps[0]
+        after_idle = (
+            not last
+            and settles == 1
+            and isinstance(first, Settle)
+            and bool(everyone)
+            and first.actors == everyone
+        )
+        instants.append(Instant(tick, tuple(steps), last, last or settles > 0, after_idle))
+
+    for message in messages:
+        topic = message.topic
+        publishers = publishers_of.get(topic)
+        if publishers is None and topic not in inputs:
+            continue
+        at = round(message.time_ns * rate / 1e9)
+        if at != tick:
+            if tick >= 0:
+                close(last=False)
+            tick, steps, ran, settles = at, [], set(), 0
+        if publishers is not None:
+            ran.update(publishers)
+            continue
+        if ran:
+            steps.append(Settle(frozenset(ran)))
+            settles += 1
+            ran = set()
+        steps.append(message)
+    if tick >= 0:
+        close(last=True)
     return instants
 
 

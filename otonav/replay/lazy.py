@@ -87,8 +87,13 @@ def _lazy_class(real: type[Message]) -> type[Message]:
         "__qualname__": f"Lazy{real.__name__}",
         "__doc__": f"A {real.__name__} still in CDR: decoded on first use.",
     }
-    metaclass: Any = type(real)  # pydantic's: the subclass is a model like its base
-    cls: type[Message] = metaclass(f"Lazy{real.__name__}", (real,), namespace)
+    namespace["__slots__"] = ()  # the base's layout exactly, so __class__ can switch
+    # type.__new__ with pydantic's metaclass, not the metaclass's own __new__: the
+    # subclass is a model class like its base (type(cls) is the same), without pydantic
+    # collecting its fields and building its validator again (~0.5 ms per message type,
+    # paid by the first replay of a process; the class only exists until first use).
+    metaclass: Any = type(real)
+    cls: type[Message] = type.__new__(metaclass, f"Lazy{real.__name__}", (real,), namespace)
     _LAZY[real] = cls
     _REAL[cls] = real
     return cls

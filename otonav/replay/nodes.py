@@ -10,6 +10,11 @@ built with no arguments, or a callable ``f(stack: StackConfig) -> Actor``.
 An actor is replayed through its declared ports only (``Actor.ports()``): its inputs
 are fed from the recording, its outputs compared with it, so a new actor needs nothing
 here beyond being built by the stack or named by path.
+
+The actors are built for the recorded robot: given its recorded geometry
+(:mod:`otonav.replay.world`), no world is built unless an actor asks for more than the
+geometry; without it (an older recording, or ``--set world.*``), the robot model is
+compiled as the stack does.
 """
 
 from __future__ import annotations
@@ -17,25 +22,34 @@ from __future__ import annotations
 import importlib
 from collections.abc import Sequence
 
-from otonav.hal import RobotHardwareInterface
+from otonav.hal import RobotGeometry, RobotHardwareInterface
 from otonav.hal.mujoco import SceneError
 from otonav.replay.recording import ReplayInputError
+from otonav.replay.world import RecordedRobot
 from otonav.runtime import Actor
 from otonav.stack import StackConfig, build_actors, build_world
 
 NOT_REPLAYABLE: dict[str, str] = {
     "bridge": "it owns the hardware: its inputs are physics, not topics",
+    "can_tap": "it reads the CAN bus, not topics",
 }
 """Stack actors that cannot be replayed, and why."""
 
 
-def stack_actor_names(stack: StackConfig) -> list[str]:
+def stack_actor_names(stack: StackConfig, geometry: RobotGeometry | None = None) -> list[str]:
     """The names of the actors the stack builds from ``stack`` that replay can run."""
-    hal = _world(stack)
+    hal = _robot(stack, geometry)
     try:
         return [a.name for a in build_actors(stack, hal) if a.name not in NOT_REPLAYABLE]
     finally:
         hal.close()
+
+
+def _robot(stack: StackConfig, geometry: RobotGeometry | None) -> RobotHardwareInterface:
+    """The recorded robot (its world built on demand), or the world for ``stack``."""
+    if geometry is None:
+        return _world(stack)
+    return RecordedRobot(geometry, lambda: _world(stack))
 
 
 def _world(stack: StackConfig) -> RobotHardwareInterface:
@@ -57,11 +71,14 @@ def _valid_names(stack_names: Sequence[str]) -> str:
     )
 
 
-def build_nodes(specs: Sequence[str], stack: StackConfig) -> list[Actor]:
-    """The actors named by ``specs`` (stack names or import paths), built from ``stack``."""
+def build_nodes(
+    specs: Sequence[str], stack: StackConfig, geometry: RobotGeometry | None = None
+) -> list[Actor]:
+    """The actors named by ``specs`` (stack names or import paths), built from ``stack``
+    for a robot of ``geometry`` (None: the one ``stack``'s world compiles to)."""
     if not specs:
         raise ReplayInputError("--node: name at least one node to replay")
-    hal = _world(stack)
+    hal = _robot(stack, geometry)
     try:
         stack_actors = {a.name: a for a in build_actors(stack, hal)}
     finally:

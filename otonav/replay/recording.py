@@ -12,13 +12,14 @@ from __future__ import annotations
 
 from collections.abc import Collection
 from dataclasses import dataclass, field
+from operator import itemgetter
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import Any, BinaryIO, NamedTuple
 
 from mcap.reader import make_reader
 from pydantic import ValidationError
 
-from otonav.record.fastreader import ChunkDamageError, iter_raw_messages
+from otonav.record.fastreader import ChunkDamageError, read_raw_messages
 from otonav.record.reader import CUT_OFF_ERRORS, MAGIC
 from otonav.record.verify import _finished, _one_line, describe_damage
 from otonav.stack import StackConfig
@@ -28,9 +29,10 @@ class ReplayInputError(ValueError):
     """Bad input to a replay (a file, a node name, a topic): one line, what is valid."""
 
 
-@dataclass(frozen=True, slots=True)
-class RecordedMessage:
-    """One recorded message, still encoded (CDR)."""
+class RecordedMessage(NamedTuple):
+    """One recorded message, still encoded (CDR). A named tuple: a replay makes one per
+    message it reads (2,241 for the navigator on the acceptance recording), and a frozen
+    dataclass took 0.5 us more each to build."""
 
     topic: str
     time_ns: int
@@ -124,12 +126,16 @@ def _messages(f: BinaryIO, summary: Any, topics: Collection[str] | None) -> list
     ids = None if wanted is None else [i for i, topic in topic_of.items() if topic in wanted]
     if ids == []:
         return []
+    new = tuple.__new__
     messages = [
-        RecordedMessage(topic_of[channel], log_time, data)
-        for channel, log_time, data in iter_raw_messages(f, summary, ids)
+        new(RecordedMessage, (topic_of[channel], log_time, data))
+        for channel, log_time, data in read_raw_messages(f, summary, ids)
     ]
-    messages.sort(key=lambda m: m.time_ns)  # stable: equal instants keep the file order
+    messages.sort(key=_time_of)  # stable: equal instants keep the file order
     return messages
+
+
+_time_of = itemgetter(1)
 
 
 def _unreadable(path: Path, exc: BaseException) -> ReplayInputError:

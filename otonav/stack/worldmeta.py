@@ -1,14 +1,15 @@
 """What a recording says about its world: an MCAP metadata record, ``otonav.world``,
 written by :class:`~otonav.stack.session.StackSession` when the recording opens (so a
-cut-off file keeps it), holding every obstacle and wall box. ``otonav plot`` draws
-them from the recording alone."""
+cut-off file keeps it), holding every obstacle and wall box and the robot's geometry.
+``otonav plot`` draws the boxes from the recording alone; ``otonav replay`` builds the
+actors for the recorded robot without compiling its MJCF (ADR 0036)."""
 
 from __future__ import annotations
 
 import json
 from collections.abc import Mapping
 
-from otonav.hal import BoxObstacle, RobotHardwareInterface
+from otonav.hal import BoxObstacle, RobotGeometry, RobotHardwareInterface
 
 WORLD_METADATA = "otonav.world"
 """The metadata record's name."""
@@ -20,8 +21,46 @@ def _boxes(boxes: tuple[BoxObstacle, ...]) -> str:
 
 def world_metadata(hal: RobotHardwareInterface) -> dict[str, str]:
     """The record for ``hal``'s world: ``obstacles`` and ``walls`` as JSON lists of
-    ``[x, y, half_x, half_y, yaw]`` (m, m, m, m, rad; world frame)."""
-    return {"obstacles": _boxes(hal.obstacles()), "walls": _boxes(hal.walls())}
+    ``[x, y, half_x, half_y, yaw]`` (m, m, m, m, rad; world frame), and ``robot``, the
+    :class:`~otonav.hal.RobotGeometry` the actors were built for, as a JSON object of its
+    fields (floats as Python writes them: each reads back as the same double)."""
+    g = hal.geometry
+    robot = {
+        "wheel_radius": g.wheel_radius,
+        "wheel_separation": g.wheel_separation,
+        "laser_offset_x": g.laser_offset_x,
+        "laser_offset_z": g.laser_offset_z,
+        "base_height": g.base_height,
+        "imu_offset": list(g.imu_offset),
+        "footprint": [list(corner) for corner in g.footprint],
+    }
+    return {
+        "obstacles": _boxes(hal.obstacles()),
+        "walls": _boxes(hal.walls()),
+        "robot": json.dumps(robot),
+    }
+
+
+def geometry_from_metadata(record: Mapping[str, str]) -> RobotGeometry | None:
+    """The robot geometry of a :func:`world_metadata` record (None: a recording made
+    before it was written, or one whose entry does not read as a geometry)."""
+    text = record.get("robot")
+    if text is None:
+        return None
+    try:
+        robot = json.loads(text)
+        x, y, z = (float(v) for v in robot["imu_offset"])
+        return RobotGeometry(
+            wheel_radius=float(robot["wheel_radius"]),
+            wheel_separation=float(robot["wheel_separation"]),
+            laser_offset_x=float(robot["laser_offset_x"]),
+            laser_offset_z=float(robot["laser_offset_z"]),
+            base_height=float(robot["base_height"]),
+            imu_offset=(x, y, z),
+            footprint=tuple((float(cx), float(cy)) for cx, cy in robot["footprint"]),
+        )
+    except (ValueError, TypeError, KeyError):
+        return None
 
 
 def boxes_from_metadata(record: Mapping[str, str]) -> tuple[BoxObstacle, ...]:

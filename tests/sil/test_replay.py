@@ -15,17 +15,19 @@ from typing import TypeVarTuple
 import pytest
 
 from otonav.cli import main as cli_main
+from otonav.hal import RobotHardwareInterface
 from otonav.msgs import Message, Odometry, PoseStamped, Twist
 from otonav.nav import GoalCommand, go_to_goal
 from otonav.record.cdr_decode import decode
 from otonav.record.reader import MAGIC, read_messages, summarize
 from otonav.record.writer import RecordingWriter
-from otonav.replay import replay_recording
+from otonav.replay import nodes, replay_recording
 from otonav.replay.nodes import stack_actor_names
 from otonav.replay.recording import load_recording
 from otonav.runtime import JumpSource, VirtualTimeLoop
 from otonav.scenario import ScenarioConfig, run_scenario
-from otonav.stack import NavConfig, SafetyConfig, StackConfig
+from otonav.stack import NavConfig, SafetyConfig, StackConfig, build_world
+from otonav.stack.worldmeta import WORLD_METADATA, geometry_from_metadata, world_metadata
 from otonav.testing import replay
 
 pytestmark = pytest.mark.sil
@@ -52,11 +54,50 @@ def test_every_replayable_actor_is_byte_identical_on_the_acceptance_run(
     names = stack_actor_names(STOP_ONLY)
     assert {"nav", "base"} <= set(names)
     assert "bridge" not in names
-    for nodes in [[name] for name in names] + [names]:
-        result = replay_recording(acceptance, nodes)
-        assert result.byte_identical, (nodes, result.first_divergence, result.crash)
+    for replayed in [[name] for name in names] + [names]:
+        result = replay_recording(acceptance, replayed)
+        assert result.byte_identical, (replayed, result.first_divergence, result.crash)
         assert all(t.recorded > 100 for t in result.topics), result.topics
         assert result.sim_time_s == pytest.approx(summarize(acceptance).duration_s, abs=0.02)
+
+
+def test_the_recorded_robot_spares_building_the_world(
+    acceptance: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The recording keeps the geometry the run's actors were built for...
+    with build_world(STOP_ONLY) as world:
+        geometry = world.geometry
+    stored = load_recording(acceptance, ()).metadata[WORLD_METADATA]
+    assert geometry_from_metadata(stored) == geometry
+    # ...so the replayed actors are built for it without compiling the robot model.
+    built: list[StackConfig] = []
+    build = nodes._world
+
+    def counted(stack: StackConfig) -> RobotHardwareInterface:
+        built.append(stack)
+        return build(stack)
+
+    monkeypatch.setattr(nodes, "_world", counted)
+    for names in (["nav"], ["base"], ["nav", "base"]):
+        result = replay_recording(acceptance, names)
+        assert result.byte_identical, (names, result.first_divergence)
+    assert built == []
+    # Asking for another world (--set world.*) builds that one.
+    result = replay_recording(acceptance, ["base"], overrides=["world.lidar_range_max=7.5"])
+    assert result.byte_identical, result.first_divergence  # the base ignores the lidar
+    assert [stack.world.lidar_range_max for stack in built] == [7.5]
+    # A recording made before the geometry was kept builds the world, as it did.
+    monkeypatch.setattr(
+        "otonav.stack.session.world_metadata",
+        lambda hal: {k: v for k, v in world_metadata(hal).items() if k != "robot"},
+    )
+    run_scenario(ScenarioConfig(sim_budget=1.0), stack=STOP_ONLY, out_dir=tmp_path, plot=False)
+    older = tmp_path / "recording.mcap"
+    assert "robot" not in load_recording(older, ()).metadata[WORLD_METADATA]
+    built.clear()
+    result = replay_recording(older, ["nav", "base"])
+    assert result.byte_identical, result.first_divergence
+    assert len(built) == 1
 
 
 def test_the_pytest_helper_and_a_user_actor_by_import_path(acceptance: Path) -> None:

@@ -1,0 +1,110 @@
+"""The robot a replay builds its actors for, without building its world.
+
+The stack builder derives what the actors need from the hardware interface's
+``geometry`` (wheel radius and separation for the base, the footprint radius and the
+laser offset for the navigator and the safety layer); no replayed actor steps physics.
+Compiling the MJCF for that was the largest part of bringing the actors up (3.4 ms warm,
+7 ms in a fresh process, of a ~70 ms navigator replay). A recording made since ADR 0036
+keeps the geometry the run's actors were built for (``otonav.world``'s ``robot``), so
+:class:`RecordedRobot` answers ``geometry`` from it and builds the world itself only when
+an actor asks for anything else: a node that needs the world still gets it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from otonav.hal import (
+    BoxObstacle,
+    GroundTruth,
+    HardwareHealth,
+    ImuSample,
+    RangeScan,
+    RobotGeometry,
+    RobotHardwareInterface,
+    WheelCommand,
+    WheelState,
+)
+from otonav.replay.recording import Recording
+from otonav.stack import StackConfig
+from otonav.stack.worldmeta import WORLD_METADATA, geometry_from_metadata
+
+__all__ = ("RecordedRobot", "recorded_geometry")
+
+
+def recorded_geometry(recording: Recording, stack: StackConfig) -> RobotGeometry | None:
+    """The robot geometry ``recording`` was made with, when it holds one and ``stack``
+    (the replay's config, after ``--set``) has the recorded world and hardware: changing
+    ``world.*`` or ``hal.*`` asks for another robot, which is then built (None)."""
+    recorded = recording.stack
+    if recorded is None or stack.world != recorded.world or stack.hal != recorded.hal:
+        return None
+    return geometry_from_metadata(recording.metadata.get(WORLD_METADATA, {}))
+
+
+class RecordedRobot(RobotHardwareInterface):
+    """A hardware interface whose ``geometry`` is the recorded one; every other call
+    builds the world (``build()``, once) and goes to it."""
+
+    def __init__(
+        self, geometry: RobotGeometry, build: Callable[[], RobotHardwareInterface]
+    ) -> None:
+        self._geometry = geometry
+        self._build = build
+        self._world: RobotHardwareInterface | None = None
+
+    @property
+    def built(self) -> bool:
+        """Whether an actor needed more than the geometry (the world was built)."""
+        return self._world is not None
+
+    def world(self) -> RobotHardwareInterface:
+        if self._world is None:
+            self._world = self._build()
+        return self._world
+
+    @property
+    def geometry(self) -> RobotGeometry:
+        return self._geometry
+
+    @property
+    def tick(self) -> float:
+        return self.world().tick
+
+    @property
+    def ticks(self) -> int:
+        return self.world().ticks
+
+    def advance(self, n: int) -> None:
+        self.world().advance(n)
+
+    def write(self, cmd: WheelCommand) -> None:
+        self.world().write(cmd)
+
+    def read_wheels(self) -> WheelState:
+        return self.world().read_wheels()
+
+    def read_imu(self) -> ImuSample:
+        return self.world().read_imu()
+
+    def read_scan(self) -> RangeScan:
+        return self.world().read_scan()
+
+    def ground_truth(self) -> GroundTruth:
+        return self.world().ground_truth()
+
+    def obstacles(self) -> tuple[BoxObstacle, ...]:
+        return self.world().obstacles()
+
+    def walls(self) -> tuple[BoxObstacle, ...]:
+        return self.world().walls()
+
+    def clearance_boxes(self) -> tuple[BoxObstacle, ...]:
+        return self.world().clearance_boxes()
+
+    def health(self) -> HardwareHealth:
+        return self.world().health()
+
+    def close(self) -> None:
+        if self._world is not None:
+            self._world.close()
