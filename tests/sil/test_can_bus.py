@@ -169,6 +169,24 @@ async def test_a_tap_that_crashes_and_restarts_leaves_the_drives_running() -> No
     assert emulator.drive(0).state == p.AxisState.IDLE
 
 
+@pytest.mark.sim(wall_ceiling=60)
+async def test_a_full_frame_mailbox_holds_the_tap_back_and_loses_no_frame() -> None:
+    # A reliable subscriber that does not read: its mailbox fills and the tap waits
+    # for room (backpressure) instead of dropping. Read later, every frame arrives,
+    # in order: the left drive's encoder estimates 10 ms apart with no gap.
+    async with running_stack(CAN) as stack:
+        system = stack.system
+        slow = system.subscribe(FRAMES_TOPIC, Frame, QoS(depth=3))
+        await system.clock.sleep(0.3)
+        assert slow.statistics().dropped == 0
+        frames = [await slow.recv() for _ in range(300)]
+    left = p.arbitration_id(CAN.hal.sim.left_node_id, p.CMD_GET_ENCODER_ESTIMATES)
+    stamps = [_secs(f.header.stamp) for f in frames if f.id == left]
+    assert stamps[-1] > 0.5
+    assert stamps[0] == pytest.approx(0.0, abs=0.011)
+    assert [round(b - a, 6) for a, b in itertools.pairwise(stamps)] == [0.01] * (len(stamps) - 1)
+
+
 # -- the interface alone: startup, shutdown, encoders only from frames -------------------
 
 
@@ -285,6 +303,35 @@ def test_an_unchanged_setpoint_is_resent_only_after_the_keepalive(
         assert len([f for f in setpoints if f.arbitration_id >> 5 == node]) == expected
     left = [f for f in changed if f.arbitration_id == p.arbitration_id(0, p.CMD_SET_INPUT_VEL)]
     assert struct_f32(left[0].data) == pytest.approx(-5.0 / (2 * math.pi), rel=1e-6)
+
+
+def test_short_payloads_on_the_bus_are_ignored_not_fatal() -> None:
+    # A third node puts truncated frames on the bus: an encoder estimate from a drive
+    # we drive, a heartbeat, and a Set_Input_Vel to a drive. Both ends ignore them, like
+    # bad frames on a wire, and the robot keeps running on the good ones.
+    hal, emulator, _world = _bench("test-short")
+    rogue = open_endpoint("virtual", "test-short")
+    with hal:
+        hal.advance(50)
+        assert hal.health().drivable
+        hal.write(WheelCommand(6.0, 6.0))
+        hal.advance(5)
+        for ident in (
+            p.arbitration_id(1, p.CMD_GET_ENCODER_ESTIMATES),
+            p.arbitration_id(1, p.CMD_HEARTBEAT),
+            p.arbitration_id(0, p.CMD_SET_INPUT_VEL),
+        ):
+            rogue.send(RawFrame(ident, b"\x01\x02"))
+        before = hal.read_wheels()
+        hal.advance(1)  # an instant between the drives' frames: only the rogue ones
+        assert hal.read_wheels() == before
+        for _ in range(20):
+            hal.write(WheelCommand(6.0, 6.0))
+            hal.advance(5)
+        assert hal.health().drivable
+        assert emulator.drive(0).state == p.AxisState.CLOSED_LOOP_CONTROL
+        assert hal.read_wheels().right_velocity > 1.0
+    rogue.close()
 
 
 def test_a_wrong_direction_sign_drives_the_wheel_backwards() -> None:

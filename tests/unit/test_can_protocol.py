@@ -240,3 +240,60 @@ def test_recovery_gives_up_after_max_attempts() -> None:
     assert monitor.phase is Phase.FAULT
     assert "gave up after 2 recovery attempts" in monitor.health.message
     assert math.isfinite(monitor.health.since)
+
+
+class _CheckedEveryInstant(DriveMonitor):
+    """The reference: the full check at every instant (no quiet interval)."""
+
+    def check(self, now: float) -> tuple[Action, ...]:
+        self._quiet_until = -math.inf
+        return super().check(now)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_skipping_quiet_checks_detects_every_fault_at_the_same_instant(seed: int) -> None:
+    # The monitor skips the running check while no condition can hold; the same
+    # traffic (random gaps, losses, errors, recoveries) must give the same actions and
+    # health at every 10 ms instant as a check of everything every time.
+    import random
+
+    rng = random.Random(seed)
+    limits = MonitorLimits(recovery_delay=0.05, max_recovery_attempts=100)
+    gated, reference = DriveMonitor(NODES, limits), _CheckedEveryInstant(NODES, limits)
+    silent = {0: 0, 1: 0}  # instants left without heartbeats / encoders, per node
+    mute = {0: 0, 1: 0}
+    faults = set()
+    for monitor in (gated, reference):
+        monitor.requested(0.0)
+    for k in range(1, 3000):
+        t = k / 100
+        events: list[tuple[str, int, int, int]] = []
+        for node in (0, 1):
+            roll = rng.random()
+            if roll < 0.004:
+                silent[node] = rng.randint(5, 40)
+            elif roll < 0.008:
+                mute[node] = rng.randint(2, 12)
+            if mute[node]:
+                mute[node] -= 1
+            elif rng.random() > 0.1:  # 10 % of encoder frames lost
+                events.append(("encoder", node, 0, 0))
+            if silent[node]:
+                silent[node] -= 1
+            elif k % 10 == node:  # heartbeats every 100 ms, nodes out of phase
+                error = int(p.AxisError.DRV_FAULT) if rng.random() < 0.03 else 0
+                state = 1 if error or rng.random() < 0.01 else CLOSED
+                events.append(("heartbeat", node, error, state))
+        for monitor in (gated, reference):
+            for kind, node, error, state in events:
+                if kind == "encoder":
+                    monitor.encoder(node, t)
+                else:
+                    monitor.heartbeat(node, error, state, t)
+        actions = gated.check(t)
+        assert actions == reference.check(t), t
+        assert gated.health == reference.health, t
+        if gated.health.fault:
+            faults.add(gated.health.fault)
+    # The traffic did exercise the faults the quiet interval could hide.
+    assert {"encoder_stale", "heartbeat_lost", "axis_error"} <= faults

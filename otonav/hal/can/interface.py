@@ -28,6 +28,7 @@ Units: wheel rad = ``sign * 2 pi * motor turns / gear_ratio`` per axis.
 from __future__ import annotations
 
 import math
+import struct
 from collections import deque
 from dataclasses import dataclass
 from typing import Protocol
@@ -114,12 +115,18 @@ class CanBusInterface(RobotHardwareInterface):
         self._sensors = sensors
         self._peer = peer
         self._axes = (left, right)
-        self._index = {left.node_id: 0, right.node_id: 1}
+        self._node_ids = (left.node_id, right.node_id)
         self._scale = (left.turns_per_rad(), right.turns_per_rad())
         self._vel_ids = (
             p.arbitration_id(left.node_id, p.CMD_SET_INPUT_VEL),
             p.arbitration_id(right.node_id, p.CMD_SET_INPUT_VEL),
         )
+        # The receive path's dispatch: an expected drive's encoder id -> its axis.
+        # Everything else (heartbeats, other nodes, error frames) takes the slow path.
+        self._encoder_axis = {
+            p.arbitration_id(axis.node_id, p.CMD_GET_ENCODER_ESTIMATES): i
+            for i, axis in enumerate((left, right))
+        }
         self.monitor = DriveMonitor(
             (NodeLabel(left.node_id, left.label), NodeLabel(right.node_id, right.label)),
             limits,
@@ -128,6 +135,7 @@ class CanBusInterface(RobotHardwareInterface):
         self._vel = [0.0, 0.0]
         self._wheels: WheelState | None = WheelState(0.0, 0.0, 0.0, 0.0)
         self._log: deque[tuple[float, RawFrame]] = deque(maxlen=frame_log)
+        self._log_limit = frame_log
         self._logged = 0
         self.frames_dropped_from_log = 0
         self._closed = False
@@ -161,21 +169,22 @@ class CanBusInterface(RobotHardwareInterface):
         return self._sensors.ticks
 
     def advance(self, n: int) -> None:
-        self._check_open()
+        if self._closed:
+            raise RuntimeError("CanBusInterface is closed")
         if n < 0:
             raise ValueError(f"cannot advance by a negative number of ticks ({n})")
         sensors, peer = self._sensors, self._peer
-        target = sensors.ticks + n
-        while True:
-            now = sensors.ticks
-            # The instant we stopped at last time was serviced then; again only if
-            # something was sent since (a wheel command the drives must apply now).
-            if now != self._serviced_at or self._sent:
-                self._service(now)
-            if now >= target:
-                return
+        now = sensors.ticks
+        target = now + n
+        # The instant we stopped at last time was serviced then; again only if
+        # something was sent since (a wheel command the drives must apply now).
+        if now != self._serviced_at or self._sent:
+            self._service(now)
+        while now < target:
             nxt = target if peer is None else min(target, peer.next_event_tick(now))
             sensors.advance(nxt - now)
+            now = nxt
+            self._service(now)
 
     def _service(self, now: int) -> None:
         """One bus instant: the peer exchanges, we drain and decode, the monitor checks.
@@ -184,13 +193,13 @@ class CanBusInterface(RobotHardwareInterface):
         just takes them in: it sends nothing more at that tick, and no time passed for
         the monitor (saves a poll and a check every base period)."""
         t = now * self._tick
-        repeat = now == self._serviced_at
+        repeat_instant = now == self._serviced_at
         self._serviced_at = now
         self._sent = False
         monitor = self.monitor
         if self._peer is not None:
             self._peer.exchange(now)
-            if repeat:
+            if repeat_instant:
                 return
         try:
             frames = self._endpoint.poll()
@@ -199,46 +208,57 @@ class CanBusInterface(RobotHardwareInterface):
             frames = []
         if frames:
             self._receive(frames, t)
-        self._apply(monitor.check(t), t)
+        actions = monitor.check(t)
+        if actions:
+            self._apply(actions, t)
 
     def _receive(self, frames: list[RawFrame], t: float) -> None:
         """Log and decode the frames of one bus instant (the hot path: two encoder
-        frames every 10 ms; the id split and dispatch are inlined)."""
-        monitor, log = self.monitor, self._log
-        maxlen = log.maxlen
+        frames every 10 ms, found by arbitration id in one dict lookup)."""
+        log = self._log
+        over = len(log) + len(frames) - self._log_limit
+        if over > 0:  # the oldest frames leave the bounded log
+            self.frames_dropped_from_log += min(over, len(frames))
+        append = log.append
+        encoder_axis = self._encoder_axis
         for frame in frames:
-            if len(log) == maxlen:
-                self.frames_dropped_from_log += 1
-            log.append((t, frame))
-            ident = frame.arbitration_id
-            if frame.is_error:
-                if ident & CAN_ERR_BUSOFF:
-                    monitor.bus_off(t, "error frame from the controller (CAN_ERR_BUSOFF)")
-                if ident & CAN_ERR_RESTARTED:
-                    monitor.bus_restarted(t)
+            append((t, frame))
+            ident, data, is_error, is_remote = frame
+            i = None if is_error or is_remote else encoder_axis.get(ident)
+            if i is None:
+                self._receive_other(frame, t)
                 continue
-            if frame.is_remote:
-                continue
-            node, cmd = ident >> 5 & p.MAX_NODE_ID, ident & 0x1F
+            self.monitor.encoder(self._node_ids[i], t)
             try:
-                if cmd == p.CMD_GET_ENCODER_ESTIMATES:
-                    self._on_encoder(node, frame.data, t)
-                elif cmd == p.CMD_HEARTBEAT:
-                    beat = p.decode_heartbeat(frame.data)
-                    monitor.heartbeat(node, beat.axis_error, beat.axis_state, t)
-            except ValueError:  # a short payload: ignored, like a bad frame on the wire
+                position, velocity = p.unpack_two_f32(data)
+            except struct.error:  # a short payload: ignored, like a bad frame on the wire
                 continue
+            scale = self._scale[i]
+            self._pos[i] = position / scale
+            self._vel[i] = velocity / scale
+            self._wheels = None
 
-    def _on_encoder(self, node: int, data: bytes, t: float) -> None:
-        self.monitor.encoder(node, t)
-        i = self._index.get(node)
-        if i is None:
+    def _receive_other(self, frame: RawFrame, t: float) -> None:
+        """Error frames, heartbeats, and frames of nodes we do not drive."""
+        monitor = self.monitor
+        ident = frame.arbitration_id
+        if frame.is_error:
+            if ident & CAN_ERR_BUSOFF:
+                monitor.bus_off(t, "error frame from the controller (CAN_ERR_BUSOFF)")
+            if ident & CAN_ERR_RESTARTED:
+                monitor.bus_restarted(t)
             return
-        position, velocity = p.unpack_two_f32(data)
-        scale = self._scale[i]
-        self._pos[i] = position / scale
-        self._vel[i] = velocity / scale
-        self._wheels = None
+        if frame.is_remote:
+            return
+        node, cmd = ident >> 5 & p.MAX_NODE_ID, ident & 0x1F
+        try:
+            if cmd == p.CMD_HEARTBEAT:
+                error, state = p.unpack_heartbeat(frame.data)
+                monitor.heartbeat(node, error, state, t)
+            elif cmd == p.CMD_GET_ENCODER_ESTIMATES:  # a node we do not drive
+                monitor.encoder(node, t)
+        except struct.error:  # a short payload: ignored
+            return
 
     def _apply(self, actions: tuple[Action, ...], t: float) -> None:
         for action in actions:
@@ -267,9 +287,8 @@ class CanBusInterface(RobotHardwareInterface):
 
     def _send(self, ident: int, data: bytes, t: float) -> bool:
         """Send and log one frame; False if the bus refused it (a bus-off fault)."""
-        frame = RawFrame(ident, data)
         try:
-            self._endpoint.send(frame, t)
+            self._endpoint.send_data(ident, data, t)
         except BusError as exc:
             self.monitor.bus_off(t, str(exc))
             return False
@@ -277,7 +296,7 @@ class CanBusInterface(RobotHardwareInterface):
         log = self._log
         if len(log) == log.maxlen:
             self.frames_dropped_from_log += 1
-        log.append((t, frame))
+        log.append((t, RawFrame(ident, data)))
         return True
 
     def take_frames(self) -> list[tuple[float, RawFrame]]:
@@ -291,10 +310,11 @@ class CanBusInterface(RobotHardwareInterface):
     def write(self, cmd: WheelCommand) -> None:
         """Send both setpoints as Set_Input_Vel; zero while the drives are not drivable
         (starting, faulted, recovering)."""
-        self._check_open()
+        if self._closed:
+            raise RuntimeError("CanBusInterface is closed")
         if not (math.isfinite(cmd.left) and math.isfinite(cmd.right)):
             raise ValueError(f"wheel command must be finite, got {cmd}")
-        drivable = self.monitor.health.drivable
+        drivable = self.monitor.drivable
         now = self._sensors.ticks
         t = now * self._tick
         sl, sr = self._scale

@@ -40,6 +40,8 @@ from otonav.hal.health import HardwareHealth, HealthLevel
 
 __all__ = ["Action", "DriveMonitor", "MonitorLimits", "NodeLabel", "Phase"]
 
+_CLOSED_LOOP = AxisState.CLOSED_LOOP_CONTROL
+
 
 class Phase(enum.Enum):
     STARTING = "starting"
@@ -109,7 +111,11 @@ class DriveMonitor:
         self._bus_off = False
         self._bus_restarted = False
         self._loss_due = -math.inf
+        # RUNNING: no check can find a fault before this instant (see check()).
+        self._quiet_until = -math.inf
         self.events: list[tuple[float, str]] = []
+        self.drivable = False
+        """``health.drivable``, kept as a plain attribute (read at every wheel write)."""
         self.health = HardwareHealth(
             level=HealthLevel.WARN,
             ready=False,
@@ -128,6 +134,8 @@ class DriveMonitor:
             self._foreign.add(node_id)
             return
         node.heartbeat_at, node.error, node.state = now, error, state
+        if error or state != _CLOSED_LOOP:
+            self._quiet_until = -math.inf  # an axis error: the next check must see it
 
     def encoder(self, node_id: int, now: float) -> None:
         node = self._nodes.get(node_id)
@@ -156,11 +164,21 @@ class DriveMonitor:
     # -- the check -----------------------------------------------------------------------
 
     def check(self, now: float) -> tuple[Action, ...]:
+        """The interface calls this at every bus instant (every 10 ms).
+
+        While running, a full check runs only from the first instant at which one of
+        its conditions could hold: the oldest heartbeat or encoder estimate reaching
+        its timeout, the next frame-loss judgement, or at once after a heartbeat that
+        shows an error or a state other than closed loop. Frames arriving in between
+        only push those instants later, so detection happens at the same instant as
+        with a full check every time (the fault tests pin it), for a fifth of the cost."""
         phase = self.phase
+        if phase is Phase.RUNNING:
+            if now < self._quiet_until:
+                return ()
+            return self._check_running(now)
         if phase is Phase.STARTING or phase is Phase.RECOVERING:
             return self._check_starting(now)
-        if phase is Phase.RUNNING:
-            return self._check_running(now)
         return self._check_fault(now)
 
     def _in_closed_loop(self, node: _Node) -> bool:
@@ -178,6 +196,7 @@ class DriveMonitor:
             recovering = self.phase is Phase.RECOVERING
             self.phase = Phase.RUNNING
             self._running_since = now
+            self._quiet_until = -math.inf
             self._attempts = 0
             for node in nodes:
                 node.arrivals.clear()
@@ -271,6 +290,12 @@ class DriveMonitor:
                 return (Action.ZERO_ALL,)
         if now >= self._loss_due:
             self._loss_due = now + limits.loss_window / 10.0
+        nodes = self._nodes.values()
+        self._quiet_until = min(
+            min(n.heartbeat_at for n in nodes) + limits.heartbeat_timeout,
+            min(n.encoder_at for n in nodes) + limits.encoder_timeout,
+            self._loss_due,
+        )
         return ()
 
     def _loss(self, node: _Node, now: float, since: float) -> float | None:
@@ -358,6 +383,7 @@ class DriveMonitor:
             since=now,
             values=(("phase", self.phase.value), *values),
         )
+        self.drivable = self.health.drivable
         self.events.append((now, message))
 
 

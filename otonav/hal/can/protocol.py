@@ -47,11 +47,13 @@ __all__ = [
     "encode_heartbeat",
     "error_names",
     "estop",
+    "pack_heartbeat",
     "pack_two_f32",
     "set_axis_state",
     "set_controller_mode",
     "set_input_vel",
     "split_id",
+    "unpack_heartbeat",
     "unpack_two_f32",
 ]
 
@@ -144,6 +146,7 @@ _U32: Final = struct.Struct("<I")
 _TWO_U32: Final = struct.Struct("<II")
 _TWO_F32: Final = struct.Struct("<ff")
 _HEARTBEAT: Final = struct.Struct("<IBBBx")
+_HEARTBEAT_HEAD: Final = struct.Struct("<IB")
 
 
 # -- host -> drive --------------------------------------------------------------------
@@ -238,3 +241,14 @@ pack_two_f32 = _TWO_F32.pack
 unpack_two_f32 = _TWO_F32.unpack_from
 """``(a, b)`` from two little-endian float32: the hot-path decoder of encoder estimates
 and Set_Input_Vel (a frozen dataclass per frame cost 9 us of a 10 ms instant)."""
+
+
+def pack_heartbeat(axis_error: int, axis_state: int) -> bytes:
+    """A heartbeat payload with no procedure result and no trajectory (the emulator's
+    cyclic frame): the bytes of :func:`encode_heartbeat`, without a ``Heartbeat``."""
+    return _HEARTBEAT.pack(axis_error, axis_state, 0, 0)
+
+
+unpack_heartbeat = _HEARTBEAT_HEAD.unpack_from
+"""``(axis_error, axis_state)`` of a heartbeat payload (the host's receive path);
+``struct.error`` if it is shorter than 5 bytes."""
