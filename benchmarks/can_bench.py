@@ -1,6 +1,6 @@
 """The CAN HAL against the MuJoCo HAL: the acceptance scenario, both ways.
 
-    python benchmarks/can_bench.py [--reps N] [--split]
+    python benchmarks/can_bench.py [--reps N] [--split] [--baseline DIR]
 
 Each run is a fresh process (``python -c``), the two HALs interleaved, so both see the
 same machine load; with and without the recorder. Prints the median wall time and
@@ -18,6 +18,9 @@ costs per run whatever otonav does around it, as a share of the MuJoCo run.
 per endpoint (a measuring instrument only: the product never does this), interleaved
 with the real thing: the difference is what python-can costs *in the run*, where its
 code runs cold between the stack's other work (more than in the tight floor loop).
+
+``--baseline DIR`` interleaves the same runs on another commit's checkout (made with
+``git archive REV | tar -x -C DIR``), so a before/after is measured under one load.
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ import os
 import statistics
 import subprocess
 import sys
-import tempfile
+from pathlib import Path
 
 _CHILD = """
 import json, sys, tempfile, time
@@ -97,7 +100,6 @@ from otonav.hal.can import bus
 from otonav.hal.can.bus import RawFrame
 from otonav.scenario import run_scenario
 from otonav.stack import StackConfig
-from otonav.stack import build
 from otonav.stack.overrides import apply_overrides
 
 class DequeEndpoint:
@@ -139,24 +141,20 @@ print(json.dumps({"passed": v.passed, "wall": v.wall_time_s, "cpu": cpu}))
 """
 
 
-def run_child(code: str, *args: str) -> dict[str, float]:
+def run_child(code: str, *args: str, tree: str | None = None) -> dict[str, float]:
+    """Run ``code`` in a fresh interpreter, on ``tree``'s otonav when given."""
+    env = dict(os.environ)
+    if tree is not None:
+        env["PYTHONPATH"] = os.pathsep.join(filter(None, [tree, env.get("PYTHONPATH")]))
     result = subprocess.run(
-        [sys.executable, "-c", code, *args], capture_output=True, text=True, check=True
-    )
-    figures: dict[str, float] = json.loads(result.stdout.strip().splitlines()[-1])
-    return figures
-
-
-def run_once(kind: str, record: bool) -> dict[str, float]:
-    result = subprocess.run(
-        [sys.executable, "-c", _CHILD, kind, "1" if record else "0"],
+        [sys.executable, "-c", code, *args],
         capture_output=True,
         text=True,
         check=True,
+        env=env,
+        cwd=tree,
     )
     figures: dict[str, float] = json.loads(result.stdout.strip().splitlines()[-1])
-    if not figures["passed"]:
-        raise SystemExit(f"the acceptance scenario failed with hal.kind={kind}")
     return figures
 
 
@@ -168,41 +166,56 @@ def main() -> int:
         action="store_true",
         help="also time the CAN run with python-can's bus replaced by deques (instrument)",
     )
+    parser.add_argument(
+        "--baseline",
+        metavar="DIR",
+        help="a checkout of another commit (git archive REV | tar -x -C DIR): its runs "
+        "are interleaved with this tree's, for a before/after under the same load",
+    )
     args = parser.parse_args()
+    trees: dict[str, str | None] = {"": None}
+    if args.baseline:
+        trees = {"baseline ": str(Path(args.baseline).resolve()), "": None}
     mujoco_walls: list[float] = []
     mujoco_cpus: list[float] = []
     # The machine is shared: say how busy it was, so a figure can be judged.
     print("load average before: {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
-    with tempfile.TemporaryDirectory():
-        for record in (False, True):
-            walls: dict[str, list[float]] = {"mujoco": [], "can": []}
-            cpus: dict[str, list[float]] = {"mujoco": [], "can": []}
-            runs: dict[str, list[float]] = {"mujoco": [], "can": []}
-            sim = 0.0
-            for _ in range(args.reps):
-                for kind in ("mujoco", "can"):
-                    figures = run_once(kind, record)
-                    walls[kind].append(figures["wall"])
-                    cpus[kind].append(figures["cpu"])
-                    runs[kind].append(figures["cpu_run"])
-                    sim = figures["sim"]
-            if not record:
-                mujoco_walls, mujoco_cpus = walls["mujoco"], runs["mujoco"]
-            label = "with recorder" if record else "no recorder"
-            med = {k: statistics.median(v) for k, v in walls.items()}
-            cpu = {k: statistics.median(v) for k, v in cpus.items()}
-            run = {k: statistics.median(v) for k, v in runs.items()}
-            for kind in ("mujoco", "can"):
-                print(
-                    f"{label:14s} hal.kind={kind:6s} wall median {med[kind]:.3f} s "
-                    f"(of {args.reps}: {', '.join(f'{w:.3f}' for w in walls[kind])}), "
-                    f"RTF {sim / med[kind]:.0f}x, CPU median {cpu[kind]:.3f} s "
-                    f"({run[kind]:.3f} s without the CAN modules' imports)"
-                )
+    for record in (False, True):
+        keys = [(name, kind) for name in trees for kind in ("mujoco", "can")]
+        walls: dict[tuple[str, str], list[float]] = {k: [] for k in keys}
+        cpus: dict[tuple[str, str], list[float]] = {k: [] for k in keys}
+        runs: dict[tuple[str, str], list[float]] = {k: [] for k in keys}
+        sim = 0.0
+        for _ in range(args.reps):
+            for name, kind in keys:
+                figures = run_child(_CHILD, kind, "1" if record else "0", tree=trees[name])
+                if not figures["passed"]:
+                    raise SystemExit(f"the acceptance scenario failed with hal.kind={kind}")
+                walls[name, kind].append(figures["wall"])
+                cpus[name, kind].append(figures["cpu"])
+                runs[name, kind].append(figures["cpu_run"])
+                sim = figures["sim"]
+        if not record:
+            mujoco_walls, mujoco_cpus = walls["", "mujoco"], runs["", "mujoco"]
+        label = "with recorder" if record else "no recorder"
+        med = {k: statistics.median(v) for k, v in walls.items()}
+        cpu = {k: statistics.median(v) for k, v in cpus.items()}
+        run = {k: statistics.median(v) for k, v in runs.items()}
+        for name, kind in keys:
+            k = name, kind
             print(
-                f"{label:14s} CAN / MuJoCo: wall time {med['can'] / med['mujoco']:.2f}, "
-                f"CPU time {cpu['can'] / cpu['mujoco']:.2f} "
-                f"({run['can'] / run['mujoco']:.2f} without the imports)"
+                f"{name}{label:14s} hal.kind={kind:6s} wall median {med[k]:.3f} s "
+                f"(of {args.reps}: {', '.join(f'{w:.3f}' for w in walls[k])}), "
+                f"RTF {sim / med[k]:.0f}x, CPU median {cpu[k]:.3f} s "
+                f"({run[k]:.3f} s without the CAN modules' imports)"
+            )
+        for name in trees:
+            can, mj = (name, "can"), (name, "mujoco")
+            print(
+                f"{name}{label:14s} CAN / MuJoCo: wall time {med[can] / med[mj]:.2f}, "
+                f"CPU time {cpu[can] / cpu[mj]:.2f} ({run[can] / run[mj]:.2f} without the "
+                f"imports); CAN adds {med[can] - med[mj]:.3f} s wall, "
+                f"{run[can] - run[mj]:.3f} s CPU"
             )
     floor = run_child(_FLOOR, str(max(3, args.reps)))
     wall_m, cpu_m = statistics.median(mujoco_walls), statistics.median(mujoco_cpus)
