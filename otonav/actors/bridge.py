@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import math
 
 import anyio
 import numpy as np
@@ -37,6 +38,7 @@ from otonav.msgs import (
     Vector3,
     WheelCommand,
 )
+from otonav.msgs.flat import FlatLayout
 from otonav.runtime import Actor, Input, Output
 
 log = logging.getLogger("otonav.hal")
@@ -63,6 +65,88 @@ def _f32(*values: float) -> list[float]:
 # (x, y, z, roll, pitch, yaw): planar robot; z, roll and pitch are not estimated.
 _POSE_COV = _diag6(1e-3, 1e-3, 1e6, 1e6, 1e6, 1e-3)
 _TWIST_COV = _diag6(1e-3, 1e6, 1e6, 1e6, 1e6, 1e-3)
+
+
+def _header(frame_id: str) -> Header:
+    return Header.fast(stamp=Time.fast(sec=0, nanosec=0), frame_id=frame_id)
+
+
+def _vector(x: float = 0.0, y: float = 0.0, z: float = 0.0) -> Vector3:
+    return Vector3.fast(x=x, y=y, z=z)
+
+
+_IDENTITY = Quaternion.fast(x=0.0, y=0.0, z=0.0, w=1.0)
+_STAMP = ("header.stamp.sec", "header.stamp.nanosec")
+
+# The four 100 Hz streams as fixed layouts (otonav.msgs.flat, ADR 0033): what varies
+# per message, in the order the bridge gives it; everything else is the template's.
+# The values are the ones the eager construction used (the quaternion of a yaw is
+# (0, 0, sin(yaw/2), cos(yaw/2)), as Quaternion.from_yaw builds it).
+CLOCK = FlatLayout(Clock.fast(clock=Time.fast(sec=0, nanosec=0)), ("clock.sec", "clock.nanosec"))
+"""/clock: sec, nanosec."""
+ODOM = FlatLayout(
+    Odometry.fast(
+        header=_header("odom"),
+        child_frame_id="base_link",
+        pose=PoseWithCovariance.fast(
+            pose=Pose.fast(position=Point.fast(x=0.0, y=0.0, z=0.0), orientation=_IDENTITY),
+            covariance=_POSE_COV,
+        ),
+        twist=TwistWithCovariance.fast(
+            twist=Twist.fast(linear=_vector(), angular=_vector()), covariance=_TWIST_COV
+        ),
+    ),
+    (
+        *_STAMP,
+        "pose.pose.position.x",
+        "pose.pose.position.y",
+        "pose.pose.orientation.z",
+        "pose.pose.orientation.w",
+        "twist.twist.linear.x",
+        "twist.twist.angular.z",
+    ),
+)
+"""/odom: sec, nanosec, x, y, qz, qw, v, omega."""
+TF = FlatLayout(
+    TFMessage.fast(
+        transforms=(
+            TransformStamped.fast(
+                header=_header("odom"),
+                child_frame_id="base_link",
+                transform=Transform.fast(translation=_vector(), rotation=_IDENTITY),
+            ),
+        )
+    ),
+    (
+        "transforms.0.header.stamp.sec",
+        "transforms.0.header.stamp.nanosec",
+        "transforms.0.transform.translation.x",
+        "transforms.0.transform.translation.y",
+        "transforms.0.transform.rotation.z",
+        "transforms.0.transform.rotation.w",
+    ),
+)
+"""/tf odom -> base_link: sec, nanosec, x, y, qz, qw."""
+IMU = FlatLayout(
+    Imu.fast(
+        header=_header("imu_link"),
+        orientation=_IDENTITY,
+        orientation_covariance=(0.0,) * 9,
+        angular_velocity=_vector(),
+        angular_velocity_covariance=(0.0,) * 9,
+        linear_acceleration=_vector(),
+        linear_acceleration_covariance=(0.0,) * 9,
+    ),
+    (
+        *_STAMP,
+        "orientation.x",
+        "orientation.y",
+        "orientation.z",
+        "orientation.w",
+        *(f"{v}.{a}" for v in ("angular_velocity", "linear_acceleration") for a in "xyz"),
+    ),
+)
+"""/imu: sec, nanosec, orientation x y z w, angular velocity x y z, acceleration x y z."""
 
 
 class Bridge(Actor):
@@ -187,17 +271,18 @@ class Bridge(Actor):
             now = clock.now()
             if self.hal.health() is not self._health:
                 await self._check_health(now)
-            stamp = Time.from_seconds(now)
+            # Time.from_seconds(now)'s two integers, without the Time object.
+            sec, nanosec = divmod(round(now * 1e9), 1_000_000_000)
             for i, (period, publish) in enumerate(publishers):
                 if due[i] <= instant + 1e-12:
                     counts[i] += 1
                     due[i] = start + counts[i] * period  # no drift: k periods from start
-                    await publish(stamp, now)
+                    await publish(sec, nanosec, now)
 
-    async def _publish_clock(self, stamp: Time, _now: float) -> None:
-        await self.clock_out.publish(Clock.fast(clock=stamp))
+    async def _publish_clock(self, sec: int, nanosec: int, _now: float) -> None:
+        await self.clock_out.publish(CLOCK(sec, nanosec))
 
-    async def _publish_odom(self, stamp: Time, now: float) -> None:
+    async def _publish_odom(self, sec: int, nanosec: int, now: float) -> None:
         hal = self.hal
         wheels = hal.read_wheels()
         gyro_z = self._imu_at(now).angular_velocity[2]
@@ -216,42 +301,9 @@ class Bridge(Actor):
             v = self._v = distance / dt
             self._pose = integrate_odometry(self._pose, v, gyro_z, dt)
         pose = self._pose
-        header = Header.fast(stamp=stamp, frame_id="odom")
-        orientation = Quaternion.from_yaw(pose.yaw)
-        await self.odom.publish(
-            Odometry.fast(
-                header=header,
-                child_frame_id="base_link",
-                pose=PoseWithCovariance.fast(
-                    pose=Pose.fast(
-                        position=Point.fast(x=pose.x, y=pose.y, z=0.0),
-                        orientation=orientation,
-                    ),
-                    covariance=_POSE_COV,
-                ),
-                twist=TwistWithCovariance.fast(
-                    twist=Twist.fast(
-                        linear=Vector3.fast(x=v, y=0.0, z=0.0),
-                        angular=Vector3.fast(x=0.0, y=0.0, z=gyro_z),
-                    ),
-                    covariance=_TWIST_COV,
-                ),
-            )
-        )
-        await self.tf.publish(
-            TFMessage.fast(
-                transforms=(
-                    TransformStamped.fast(
-                        header=header,
-                        child_frame_id="base_link",
-                        transform=Transform.fast(
-                            translation=Vector3.fast(x=pose.x, y=pose.y, z=0.0),
-                            rotation=orientation,
-                        ),
-                    ),
-                )
-            )
-        )
+        qz, qw = math.sin(pose.yaw / 2), math.cos(pose.yaw / 2)  # Quaternion.from_yaw's
+        await self.odom.publish(ODOM(sec, nanosec, pose.x, pose.y, qz, qw, v, gyro_z))
+        await self.tf.publish(TF(sec, nanosec, pose.x, pose.y, qz, qw))
 
     def _imu_at(self, now: float) -> ImuSample:
         """One IMU read per instant, shared by odometry and /imu (it was read twice)."""
@@ -260,24 +312,15 @@ class Bridge(Actor):
             self._imu_time = now
         return self._imu_sample
 
-    async def _publish_imu(self, stamp: Time, now: float) -> None:
+    async def _publish_imu(self, sec: int, nanosec: int, now: float) -> None:
         sample = self._imu_at(now)
         w, x, y, z = sample.orientation
-        gx, gy, gz = sample.angular_velocity
-        ax, ay, az = sample.linear_acceleration
         await self.imu.publish(
-            Imu.fast(
-                header=Header.fast(stamp=stamp, frame_id="imu_link"),
-                orientation=Quaternion.fast(x=x, y=y, z=z, w=w),
-                orientation_covariance=(0.0,) * 9,
-                angular_velocity=Vector3.fast(x=gx, y=gy, z=gz),
-                angular_velocity_covariance=(0.0,) * 9,
-                linear_acceleration=Vector3.fast(x=ax, y=ay, z=az),
-                linear_acceleration_covariance=(0.0,) * 9,
-            )
+            IMU(sec, nanosec, x, y, z, w, *sample.angular_velocity, *sample.linear_acceleration)
         )
 
-    async def _publish_scan(self, stamp: Time, _now: float) -> None:
+    async def _publish_scan(self, sec: int, nanosec: int, _now: float) -> None:
+        stamp = Time.fast(sec=sec, nanosec=nanosec)
         scan = self.hal.read_scan()
         # float32 like the ROS 2 message and the recording, so every subscriber (the
         # live view, a replay from the file) sees the values the file holds; the ranges
@@ -325,7 +368,7 @@ class Bridge(Actor):
                 message=health.message,
             )
         )
-        await self._publish_diagnostics(stamp, now)
+        await self._publish_diagnostics(stamp.sec, stamp.nanosec, now)
         if first and health.level == HealthLevel.OK and health.ready:
             return
         # Starting and recovered are news, not warnings; recovering is a warning.
@@ -345,7 +388,8 @@ class Bridge(Actor):
                 )
             )
 
-    async def _publish_diagnostics(self, stamp: Time, _now: float) -> None:
+    async def _publish_diagnostics(self, sec: int, nanosec: int, _now: float) -> None:
+        stamp = Time.fast(sec=sec, nanosec=nanosec)
         health = self._health if self._health is not None else self.hal.health()
         values = (
             ("ready", "true" if health.ready else "false"),

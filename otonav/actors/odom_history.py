@@ -6,18 +6,35 @@ from collections import deque
 from collections.abc import Iterable
 
 from otonav.msgs import Odometry
+from otonav.msgs.flat import reader
+from otonav.msgs.geometry import quaternion_yaw
 
 Pose = tuple[float, float, float]
 
 
+# Read through otonav.msgs.flat.reader: the bridge's odometry is a flat message, whose
+# nested objects are never built this way (4.4 us each; the numbers are the same).
+_read_stamp = reader(Odometry, "header.stamp.sec", "header.stamp.nanosec")
+_read_pose = reader(
+    Odometry,
+    "pose.pose.position.x",
+    "pose.pose.position.y",
+    "pose.pose.orientation.x",
+    "pose.pose.orientation.y",
+    "pose.pose.orientation.z",
+    "pose.pose.orientation.w",
+)
+_read_twist = reader(Odometry, "twist.twist.linear.x", "twist.twist.angular.z")
+
+
 def _stamp(odom: Odometry) -> float:
-    t = odom.header.stamp
-    return t.sec + t.nanosec * 1e-9
+    sec, nanosec = _read_stamp(odom)
+    return float(sec + nanosec * 1e-9)
 
 
 def _pose(odom: Odometry) -> Pose:
-    p = odom.pose.pose
-    return (p.position.x, p.position.y, p.orientation.yaw())
+    x, y, qx, qy, qz, qw = _read_pose(odom)
+    return (x, y, quaternion_yaw(qx, qy, qz, qw))
 
 
 class OdomHistory:
@@ -40,8 +57,8 @@ class OdomHistory:
         if not self._items:
             return None
         odom = self._items[-1]
-        twist = odom.twist.twist
-        return _stamp(odom), _pose(odom), twist.linear.x, twist.angular.z
+        v, omega = _read_twist(odom)
+        return _stamp(odom), _pose(odom), v, omega
 
     def pose_at(self, stamp: float) -> Pose | None:
         """The pose with the stamp nearest ``stamp`` (None with no odometry yet)."""

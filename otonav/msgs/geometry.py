@@ -11,6 +11,11 @@ from otonav.msgs.std import Header
 _ZERO36 = (0.0,) * 36
 
 
+def quaternion_yaw(x: float, y: float, z: float, w: float) -> float:
+    """The yaw (rotation about z, rad) of the unit quaternion (x, y, z, w)."""
+    return math.atan2(2 * (w * z + x * y), 1 - 2 * (y**2 + z**2))
+
+
 class Vector3(Message):
     ros_type: ClassVar[str] = "geometry_msgs/msg/Vector3"
     x: float = 0.0
@@ -37,7 +42,7 @@ class Quaternion(Message):
         return cls.fast(x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2))
 
     def yaw(self) -> float:
-        return math.atan2(2 * (self.w * self.z + self.x * self.y), 1 - 2 * (self.y**2 + self.z**2))
+        return quaternion_yaw(self.x, self.y, self.z, self.w)
 
 
 class Pose(Message):

@@ -272,7 +272,7 @@ class Navigation:
         target = self._target(pose)
         dwa = self.params.dwa
         result = (
-            clear_arc(pose, v0, omega0, target, distance, self.map.clearance, dwa)
+            clear_arc(pose, v0, omega0, target, distance, self.map.clearance_at, dwa)
             if dwa.fast_path
             else None
         ) or dwa_step(pose, v0, omega0, target, distance, self.map.clearance, dwa)

@@ -31,6 +31,7 @@ from operator import attrgetter
 from typing import Any, Final
 
 from otonav.msgs import Message
+from otonav.msgs.flat import FlatLayout, flat_state, materialize, real_type
 from otonav.record.schemas import SEQUENCE, layout_for
 
 __all__ = ("encode",)
@@ -373,10 +374,114 @@ def encode(message: Message) -> bytes:
     """The CDR bytes (with encapsulation header) of ``message``, as ROS 2 would write
     them for its ``ros_type``. Raises ValueError for a value the ROS type cannot hold
     (out-of-range integer, wrong fixed-array length, float too large for float32)."""
-    step = _TOP.get(type(message)) or _top(type(message))
+    step = _TOP.get(type(message))
+    if step is None:
+        flat = flat_state(message)
+        if flat is not None:  # a flat message (never in _TOP): its layout's one pack
+            layout, values = flat
+            try:
+                return (layout.cdr or _flat_packer(layout))(*values)
+            except (struct.error, OverflowError) as error:
+                raise ValueError(f"cannot encode {message.ros_type}: {error}") from error
+        step = _top(real_type(type(message)))
     buf = bytearray(ENCAPSULATION)
     try:
         step(message, buf)
     except (struct.error, OverflowError) as error:
         raise ValueError(f"cannot encode {message.ros_type}: {error}") from error
     return bytes(buf)
+
+
+# -- fixed layouts ---------------------------------------------------------------------
+
+
+def _offsets(
+    message: Message, prefix: str = "", offset: int = 0
+) -> tuple[dict[str, tuple[int, str]], int]:
+    """Where each scalar primitive of ``message`` lands (payload offset, struct code),
+    by path, and the offset after it: the CDR rules of the module docstring walked over
+    one message's values (its strings and sequences have the lengths they have)."""
+    found: dict[str, tuple[int, str]] = {}
+    layout = layout_for(real_type(type(message)))
+    if not layout.fields:
+        return found, offset + 1
+    for field in layout.fields:
+        path = prefix + field.name
+        value = getattr(message, field.name)
+        if field.array is not None and field.array == SEQUENCE:
+            offset += -offset % 4 + 4  # the count
+        if not isinstance(field.type, str):
+            for i, item in enumerate((value,) if field.array is None else value):
+                where = f"{path}." if field.array is None else f"{path}.{i}."
+                inner, offset = _offsets(item, where, offset)
+                found.update(inner)
+        elif field.type == "string":
+            for text in (value,) if field.array is None else value:
+                offset += -offset % 4 + 4 + len(text.encode()) + 1
+        else:
+            code = _CODES[field.type]
+            size = struct.calcsize(code)
+            count = 1 if field.array is None else len(value)
+            if count:
+                offset += -offset % size
+            if field.array is None:
+                found[path] = (offset, code)
+            offset += size * count
+    return found, offset
+
+
+def _flat_packer(layout: FlatLayout[Any]) -> Callable[..., bytes]:
+    """The CDR encoder of ``layout``'s messages: the template's bytes with the values
+    packed in place, as one precompiled ``Struct`` whose constant stretches are ``s``
+    items (the template's own bytes, padding included). Checked once against the
+    field-by-field encoder with a distinct value in every varying field; cached on the
+    layout (``layout.cdr``). An Odometry: 2.25 us field by field, ~0.6 us this way."""
+    template = encode(layout.template)
+    offsets, end = _offsets(layout.template)
+    if end + len(ENCAPSULATION) != len(template):
+        raise AssertionError(
+            f"{layout}: walked {end} payload bytes, the encoder wrote {len(template) - 4}"
+        )
+    places = sorted(
+        (len(ENCAPSULATION) + offsets[path][0], offsets[path][1], i)
+        for i, path in enumerate(layout.paths)
+    )
+    fmt, pos = "<", 0
+    args: list[str] = []
+    names: dict[str, object] = {}
+    for at, code, i in places:
+        if at > pos:
+            name = f"_c{len(names)}"
+            names[name] = template[pos:at]
+            fmt += f"{at - pos}s"
+            args.append(name)
+        fmt += code
+        args.append(f"v{i}")
+        pos = at + struct.calcsize(code)
+    if pos < len(template):
+        names[f"_c{len(names)}"] = template[pos:]
+        fmt += f"{len(template) - pos}s"
+        args.append(f"_c{len(names) - 1}")
+    names["_pack"] = struct.Struct(fmt).pack
+    params = ", ".join(f"v{i}" for i in range(len(layout.paths)))
+    source = (
+        f"def pack_{layout.message_type.__name__}({params}):\n    return _pack({', '.join(args)})\n"
+    )
+    exec(compile(source, f"<cdr packer of {layout!r}>", "exec"), names)
+    pack: Callable[..., bytes] = names[f"pack_{layout.message_type.__name__}"]  # type: ignore[assignment]
+    pack.__doc__ = f"{source}\nformat {fmt}"
+    probe = tuple(_probe(code, i) for _at, code, i in sorted(places, key=lambda p: p[2]))
+    if pack(*probe) != encode(materialize(layout(*probe))):
+        raise AssertionError(f"{layout}: the fixed-layout packer disagrees with the encoder")
+    layout.cdr = pack
+    return pack
+
+
+def _probe(code: str, i: int) -> object:
+    """A value for a field of struct ``code``, distinct for each ``i`` (the check of
+    :func:`_flat_packer`)."""
+    if code in "fd":
+        return 1.0 + 0.25 * i
+    if code == "?":
+        return i % 2 == 0
+    return 1 + i % 100

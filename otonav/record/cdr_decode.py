@@ -6,8 +6,9 @@ range as the same float32 value). The decoder is compiled per message class from
 same layouts (:func:`~otonav.record.schemas.layout_for`) and the same leaf flattening as
 the encoder: each run of fixed-size fields is one precompiled ``unpack_from`` (one per
 start offset mod 8, since the padding inside a run depends on where it starts);
-strings and sequences are read one by one; then the flat values are built back into
-the nested messages with ``Message.fast``. ``decode(type(m), encode(m)) == m`` for every
+strings and sequences are read one by one; then the values are built back into the
+nested messages as ``Message.fast`` builds them. Both are generated per class as one
+straight-line function (:func:`_compile_decoder`). ``decode(type(m), encode(m)) == m`` for every
 message (a property test), and the values agree with ``mcap_ros2``'s generic decoder on
 recordings (a test), which is the independent oracle.
 
@@ -224,26 +225,145 @@ def _plan(message: type[Message]) -> tuple[tuple[ReadStep, ...], Builder]:
     return plan
 
 
+Decoder = Callable[[bytes], Any]
+"""Decode one message from CDR data that starts with its encapsulation header."""
+
+
+def _compile_decoder(message: type[Message]) -> Decoder:
+    """One generated function per class, straight-line: each fixed run one
+    ``unpack_from`` into a tuple, each string read inline, the other variable parts
+    through their read steps; then every message built bottom-up with ``_new`` and the
+    slot setters, no call per message and no flat list: an Odometry 6.3 -> 5.0 us, a
+    360-beam LaserScan 6.5 -> 5.9 us (the navigator's replay decodes ~860 inputs). The
+    same values and objects as the steps and builder above (which nested message arrays
+    still use); ``tests/unit/record/test_cdr.py`` checks every message type, and strings
+    of every length mod 4 before each field, against the original."""
+    names: dict[str, object] = {
+        "_new": _new,
+        "_sd": _set_dict,
+        "_sf": _set_fields_set,
+        "_se": _set_extra,
+        "_sp": _set_private,
+        "_U32": _U32,
+        "_len": len,
+    }
+    lines: list[str] = []
+    values: list[str] = []  # flat value index -> its expression
+    runs: dict[int, tuple[str, int]] = {}  # flat index -> (run tuple name, index in it)
+    run: list[_Fixed] = []
+
+    def flush_run() -> None:
+        if not run:
+            return
+        k = len([n for n in names if n.startswith("_S")])
+        structs = tuple(struct.Struct(_run_format(run, start)) for start in range(8))
+        names[f"_S{k}"] = structs
+        lines.append(f"u = _S{k}[(pos - 4) & 7]")
+        lines.append(f"t{k} = u.unpack_from(data, pos)")
+        lines.append("pos += u.size")
+        at = 0
+        for leaf in run:
+            for _ in range(1 if leaf.count is None else leaf.count):
+                runs[len(values)] = (f"t{k}", at)
+                values.append(f"t{k}[{at}]")
+                at += 1
+        run.clear()
+
+    for leaf in _leaves(message):
+        if isinstance(leaf, _Fixed):
+            run.append(leaf)
+            continue
+        flush_run()
+        v = f"v{len(values)}"
+        if leaf.kind == "string":
+            lines += [
+                "pos += -(pos - 4) & 3",
+                "(n,) = _U32.unpack_from(data, pos)",
+                "pos += 4",
+                "if n:",
+                "    end = pos + n",
+                "    if end > _len(data):",
+                "        raise ValueError('string runs past the end of the message')",
+                f"    {v} = data[pos : end - 1].decode()",
+                "    pos = end",
+                "else:",
+                f"    {v} = ''",
+            ]
+        else:
+            step = f"_r{len(values)}"
+            names[step] = _var(leaf)
+            lines += ["out = []", f"pos = {step}(data, pos, out)", f"{v} = out[0]"]
+        values.append(v)
+    flush_run()
+
+    made = 0
+
+    def build(current: type[Message], i: int) -> tuple[str, int]:
+        """Lines that make a ``current`` from the flat values at ``i``; its name."""
+        nonlocal made
+        made += 1
+        name = f"m{made}"
+        cls = f"_c{made}"
+        names[cls] = current
+        names[cls + "_fields"] = current._otonav_fields
+        layout = layout_for(current)
+        parts = []
+        if not layout.fields:
+            i += 1
+        for field in layout.fields:
+            if not isinstance(field.type, str) and field.array is None:
+                code, i = build(field.type, i)
+            elif isinstance(field.type, str) and field.type != "string" and (field.array or 0) > 0:
+                n = field.array or 0
+                (tup, at), (tup_end, at_end) = runs[i], runs[i + n - 1]
+                assert tup == tup_end, "an array lies in one run"
+                assert at_end == at + n - 1
+                code, i = f"{tup}[{at}:{at + n}]", i + n
+            else:  # one value: a scalar, a string, a sequence, an array of messages/strings
+                code, i = values[i], i + 1
+            parts.append(f"{field.name!r}: {code}")
+        lines.extend(
+            [
+                f"{name} = _new({cls})",
+                f"_sd({name}, {{{', '.join(parts)}}})",
+                f"_sf({name}, {cls}_fields)",
+                f"_se({name}, None)",
+                f"_sp({name}, None)",
+            ]
+        )
+        return name, i
+
+    top, used = build(message, 0)
+    assert used == len(values)
+    # The reads (in wire order), then the builds (innermost messages first).
+    body = "\n".join("    " + line for line in ["pos = 4", *lines])
+    source = f"def decode_{message.__name__}(data):\n{body}\n    return {top}, pos\n"
+    exec(compile(source, f"<cdr decoder of {message.__name__}>", "exec"), names)
+    decoder: Decoder = names[f"decode_{message.__name__}"]  # type: ignore[assignment]
+    return decoder
+
+
+_DECODERS: dict[type[Message], Decoder] = {}
+
+
 def decode(message: type[M], data: bytes) -> M:
     """The ``message`` encoded in ``data`` (CDR with its encapsulation header).
 
     Raises ValueError for data that is not little-endian CDR of that type (too short,
     a string past the end, trailing garbage is tolerated as ROS 2 pads to 4 bytes).
     """
-    if data[:4] != ENCAPSULATION:
+    if not data.startswith(ENCAPSULATION):
         raise ValueError(
             f"cannot decode {message.ros_type}: not little-endian plain CDR "
-            f"(encapsulation {data[:4].hex() or 'missing'}, expected {ENCAPSULATION.hex()})"
+            f"(encapsulation {bytes(data[:4]).hex() or 'missing'}, expected {ENCAPSULATION.hex()})"
         )
-    steps, build = _PLANS.get(message) or _plan(message)
-    values: list[Any] = []
-    pos = 4
+    decoder = _DECODERS.get(message)
+    if decoder is None:
+        decoder = _DECODERS[message] = _compile_decoder(message)
     try:
-        for step in steps:
-            pos = step(data, pos, values)
+        result, pos = decoder(data)
     except (struct.error, UnicodeDecodeError) as error:
         raise ValueError(f"cannot decode {message.ros_type}: {error}") from error
     if pos > len(data):
         raise ValueError(f"cannot decode {message.ros_type}: the data ends early")
-    result: M = build(values, 0)[0]
-    return result
+    return result  # type: ignore[no-any-return]

@@ -22,6 +22,7 @@ from typing import IO
 from mcap.writer import CompressionType
 
 from otonav.msgs import Message
+from otonav.msgs.flat import real_type
 from otonav.record.cdr import encode
 from otonav.record.fastwriter import FastWriter
 from otonav.record.schemas import schema_for
@@ -72,7 +73,7 @@ class RecordingWriter:
         True when this completed a chunk (it is in the file now)."""
         channel_id = self._channels.get(topic)
         if channel_id is None:
-            channel_id = self._channel(topic, type(message))
+            channel_id = self._channel(topic, real_type(type(message)))
         stamp = round(sim_time * 1e9)
         self._sequence[channel_id] += 1
         # Messages accumulate in memory until a chunk is full; when one was written,
@@ -101,7 +102,7 @@ class RecordingWriter:
             for topic, sim_time, message in deliveries:
                 channel_id = channels.get(topic)
                 if channel_id is None:
-                    channel_id = self._channel(topic, type(message))
+                    channel_id = self._channel(topic, real_type(type(message)))
                 stamp = round(sim_time * 1e9)
                 sequence = sequences[channel_id] = sequences[channel_id] + 1
                 if add(channel_id, stamp, encode(message), stamp, sequence):

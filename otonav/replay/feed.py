@@ -39,7 +39,7 @@ from functools import partial
 from typing import Any, NamedTuple
 
 from otonav.msgs import Message
-from otonav.replay.lazy import lazy
+from otonav.replay.lazy import lazy, lazy_maker
 from otonav.replay.recording import RecordedMessage
 from otonav.runtime import Clock, Publisher, VirtualTimeLoop
 from otonav.runtime.timesource import tick_rate
@@ -250,6 +250,13 @@ class ReplayClock(Clock):
             handle.cancel()
 
 
+class _Route(NamedTuple):
+    publisher: Publisher[Any]
+    make: Callable[[bytes], Message]
+    subscriptions: Sequence[Any]
+    reliable: tuple[Any, ...]
+
+
 class Feeder:
     """Publishes the planned instants on ``publishers`` (topic -> publisher), each
     recorded message as a :func:`~otonav.replay.lazy.lazy` one (decoded on first use).
@@ -287,6 +294,28 @@ class Feeder:
         self.after_idle = 0
         """Of those, instants delivered once their actors had run (``after_idle``)."""
         self._idle_watcher = self._at_idle  # one bound method, to know it among watchers
+        self._routes: dict[str, _Route] = {}
+
+    def _route(self, topic: str) -> _Route:
+        """How to deliver on ``topic`` (~1 us less per recorded input than looking it
+        all up per message): its publisher, a lazy-message maker, its subscriptions and
+        the reliable ones among them (only those can make the feeder wait). Made again
+        when the topic's subscriptions change (the topic replaces its list then)."""
+        publisher = self._publishers[topic]
+        subscriptions = publisher._topic.subscriptions
+        route = self._routes[topic] = _Route(
+            publisher,
+            lazy_maker(publisher.msg_type),
+            subscriptions,
+            tuple(s for s in subscriptions if s._reliable),
+        )
+        return route
+
+    def _route_of(self, topic: str) -> _Route:
+        route = self._routes.get(topic)
+        if route is None or route.subscriptions is not route.publisher._topic.subscriptions:
+            route = self._route(topic)
+        return route
 
     async def run(self) -> None:
         instants, source = self._instants, self._source
@@ -406,13 +435,13 @@ class Feeder:
         due_before = (instant.tick - 1) / self._rate + loop._clock_resolution
         if any(timer.when() < due_before for timer in rest):
             return False
-        publishers = self._publishers
         n = len(instant.steps)
-        return all(
-            not s._reliable or len(s._queue) + n <= s._depth
-            for step in instant.steps
-            for s in publishers[step.topic]._topic.subscriptions  # type: ignore[union-attr]
-        )
+        route_of = self._route_of
+        for step in instant.steps:
+            for s in route_of(step.topic).reliable:  # type: ignore[union-attr]
+                if len(s._queue) + n > s._depth:
+                    return False
+        return True
 
     def _hand_over(self, index: int, step: int) -> None:
         resume, self._resume = self._resume, None
@@ -423,15 +452,16 @@ class Feeder:
         """Offer the instant's messages from step ``start`` on to their mailboxes; the
         index of the first one a full reliable mailbox would make wait (None: all
         delivered)."""
-        publishers = self._publishers
-        for k in range(start, len(instant.steps)):
-            step = instant.steps[k]
+        route_of = self._route_of
+        steps = instant.steps
+        for k in range(start, len(steps)):
+            step = steps[k]
             assert not isinstance(step, Settle)
-            publisher = publishers[step.topic]
-            subscriptions = publisher._topic.subscriptions
-            if any(s._full() for s in subscriptions):
-                return k
-            message = lazy(publisher.msg_type, step.data)
+            publisher, make, subscriptions, reliable = route_of(step.topic)
+            for s in reliable:
+                if len(s._queue) >= s._depth:
+                    return k
+            message = make(step.data)
             publisher.published += 1
             if publisher._history is not None:
                 publisher._history.append(message)

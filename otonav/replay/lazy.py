@@ -19,14 +19,16 @@ publisher's slow path asks the object for its ``__class__``, which decodes it.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any, TypeVar
 
 from pydantic import BaseModel
 
-from otonav.msgs import Message
+from otonav.msgs import Header, Message
 from otonav.record.cdr_decode import decode
+from otonav.record.schemas import layout_for
 
-__all__ = ("is_lazy", "lazy", "materialize")
+__all__ = ("is_lazy", "lazy", "lazy_maker", "materialize")
 
 M = TypeVar("M", bound=Message)
 
@@ -35,6 +37,7 @@ _KEY = "\0cdr"
 so every field lookup misses and reaches ``__getattribute__``."""
 
 _get = object.__getattribute__
+_new = object.__new__
 _set_class = object.__setattr__
 _set_dict = BaseModel.__dict__["__dict__"].__set__
 _set_fields_set = BaseModel.__dict__["__pydantic_fields_set__"].__set__
@@ -55,13 +58,37 @@ def materialize(message: M) -> M:
     # No bytes: a copy taken from an already decoded message (pydantic's __copy__ builds
     # the copy with type(self), read before the original decoded itself).
     if data is not None:
-        _set_dict(message, _get(decode(real, data), "__dict__"))
+        decoded = _get(decode(real, data), "__dict__")
+        header = fields.get("header")
+        if header is not None:  # read before (see _lazy_class): keep the object handed out
+            decoded["header"] = header
+        _set_dict(message, decoded)
     _set_class(message, "__class__", real)
     return message
 
 
 def _lazy_class(real: type[Message]) -> type[Message]:
+    layout = layout_for(real)
+    stamped = bool(layout.fields) and layout.fields[0].name == "header"
+    stamped = stamped and layout.fields[0].type is Header
+
     def __getattribute__(self: Message, name: str) -> Any:
+        if name == "header" and stamped:
+            # A stamped message's header comes first on the wire, where a Header alone
+            # would be: decode just it, and keep the message lazy. The navigator reads
+            # the stamps of ~4 queued /odom per scan to find the pose at the scan's
+            # stamp, and the rest of only one (Odometry 5.0 us, its Header 1.2 us).
+            fields = _get(self, "__dict__")
+            data = fields.get(_KEY)
+            if data is not None:
+                header = fields.get("header")
+                if header is None:
+                    try:
+                        header = fields["header"] = decode(Header, data)
+                    except ValueError:  # damaged: the whole message's decode says so
+                        header = None
+                if header is not None:
+                    return header
         materialize(self)
         return _get(self, name)
 
@@ -109,6 +136,23 @@ def lazy(message_type: type[M], data: bytes) -> M:
     _set_extra(message, None)
     _set_private(message, None)
     return message
+
+
+def lazy_maker(message_type: type[M]) -> Callable[[bytes], M]:
+    """``lambda data: lazy(message_type, data)``, with the class looked up once (the
+    replay's feeder makes one per recorded input)."""
+    cls = _LAZY.get(message_type) or _lazy_class(message_type)
+    fields = message_type._otonav_fields
+
+    def make(data: bytes) -> M:
+        message: M = _new(cls)  # type: ignore[assignment]
+        _set_dict(message, {_KEY: data})
+        _set_fields_set(message, fields)
+        _set_extra(message, None)
+        _set_private(message, None)
+        return message
+
+    return make
 
 
 def is_lazy(message: object) -> bool:

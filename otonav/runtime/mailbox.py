@@ -196,7 +196,16 @@ class Subscription(Generic[M]):
 class Publisher(Generic[M]):
     """The sending end of a topic for one publisher."""
 
-    __slots__ = ("_history", "_topic", "endpoint", "msg_type", "published", "qos", "topic")
+    __slots__ = (
+        "_accepted",
+        "_history",
+        "_topic",
+        "endpoint",
+        "msg_type",
+        "published",
+        "qos",
+        "topic",
+    )
 
     def __init__(
         self,
@@ -214,8 +223,15 @@ class Publisher(Generic[M]):
             deque(maxlen=qos.depth) if qos.durability is Durability.TRANSIENT_LOCAL else None
         )
         self.published = 0
+        self._accepted: type[Any] = self.msg_type
+        """Another class whose messages this publisher takes as ``msg_type`` ones."""
 
     def _check_type(self, message: object) -> None:
+        # A class that stands for the topic's type (a flat message, otonav.msgs.flat,
+        # built on first use): accepted as it is, and from now on without this call.
+        if getattr(type(message), "stands_for", None) is self.msg_type:
+            self._accepted = type(message)
+            return
         # What the object says it is: a replayed input decoded on first use becomes its
         # message class when asked (otonav.replay.lazy), e.g. by an actor relaying it.
         if message.__class__ is self.msg_type:
@@ -230,7 +246,7 @@ class Publisher(Generic[M]):
     async def publish(self, message: M) -> None:
         """Deliver ``message`` to every subscriber; waits only while a reliable
         subscriber's mailbox is full (backpressure)."""
-        if type(message) is not self.msg_type:
+        if type(message) is not self.msg_type and type(message) is not self._accepted:
             self._check_type(message)
         self.published += 1
         if self._history is not None:
@@ -244,7 +260,7 @@ class Publisher(Generic[M]):
     def publish_nowait(self, message: M) -> None:
         """Like :meth:`publish` for callers that cannot wait: raises ``anyio.WouldBlock``
         rather than wait when a reliable mailbox is full (no subscriber receives it)."""
-        if type(message) is not self.msg_type:
+        if type(message) is not self.msg_type and type(message) is not self._accepted:
             self._check_type(message)
         for subscription in self._topic.subscriptions:
             if subscription._full():

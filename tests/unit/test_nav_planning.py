@@ -4,6 +4,8 @@ the DWA step, progress and recovery, and the Navigation object on synthetic scan
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -128,6 +130,28 @@ def test_a_scan_adding_no_new_cell_leaves_the_map_as_it_was() -> None:
     assert m.clearance(np.array([3.0]), np.array([0.0]))[0] == pytest.approx(0.6)
 
 
+def test_clearance_lookups_agree_with_the_plain_formula_everywhere() -> None:
+    """clearance() (float indices, flat take) and clearance_at() (plain Python) read
+    the cell the plain formula names: floor((x - origin) / res) + pad, clipped into
+    the padded grid; points outside the map (and far outside) included."""
+    rng = np.random.default_rng(3)
+    m = ClearanceMap(0.3, -0.2, half_size=2.0, resolution=0.05, max_distance=0.6)
+    m.mark(rng.uniform(-2.5, 2.5, (40, 2)))
+    x = np.concatenate((rng.uniform(-4.0, 4.0, 3000), [-1.7, 2.3, -1e6, 1e6]))
+    y = np.concatenate((rng.uniform(-4.0, 4.0, 3000), [-2.2, 1.8, 1e6, -1e6]))
+    inv, pad = 1.0 / m.resolution, m._pad
+    hi = m._lower.shape[0] - 1
+    col = np.clip(np.floor((x - m.origin_x) * inv).astype(np.intp) + pad, 0, hi)
+    row = np.clip(np.floor((y - m.origin_y) * inv).astype(np.intp) + pad, 0, hi)
+    expected = m._lower[row, col]
+    assert (m.clearance(x, y) == expected).all()
+    assert [m.clearance_at(float(a), float(b)) for a, b in zip(x, y, strict=True)] == [
+        float(e) for e in expected
+    ]
+    assert (expected < m.max_distance).any()
+    assert (expected == m.max_distance).any()
+
+
 def _rays(ranges: np.ndarray, x: float = 0.0, y: float = 0.0, yaw: float = 0.0) -> ScanRays:
     n = ranges.shape[0]
     return ScanRays(x, y, yaw, ranges.astype(np.float64), -math.pi, 2 * math.pi / n, 0.12, 8.0)
@@ -247,21 +271,21 @@ def test_dwa_does_not_crawl_into_a_goal_inside_its_horizon() -> None:
 def test_fast_path_in_the_open_is_the_pure_pursuit_arc_at_the_top_of_the_window() -> None:
     m = _map_with(np.empty((0, 2)))
     p = DwaParams()
-    r = clear_arc((0.0, 0.0, 0.0), 0.2, 0.0, (2.0, 0.4), 3.0, m.clearance, p)
+    r = clear_arc((0.0, 0.0, 0.0), 0.2, 0.0, (2.0, 0.4), 3.0, m.clearance_at, p)
     assert r is not None
     assert r.reason == "clear arc"
     assert r.v == pytest.approx(0.2 + p.max_accel * p.period)
     # curvature 2 y / L^2 toward the target, within the yaw-rate window
     assert r.omega == pytest.approx(r.v * 2 * 0.4 / (2.0**2 + 0.4**2))
     # a target far off the heading, or no speed in reach: the full step decides
-    assert clear_arc((0.0, 0.0, 0.0), 0.2, 0.0, (-1.0, 1.0), 3.0, m.clearance, p) is None
-    assert clear_arc((0.0, 0.0, 0.0), 0.0, 0.0, (2.0, 0.0), 0.0, m.clearance, p) is None
+    assert clear_arc((0.0, 0.0, 0.0), 0.2, 0.0, (-1.0, 1.0), 3.0, m.clearance_at, p) is None
+    assert clear_arc((0.0, 0.0, 0.0), 0.0, 0.0, (2.0, 0.0), 0.0, m.clearance_at, p) is None
 
 
 def test_fast_path_gives_way_to_the_sampling_near_an_obstacle() -> None:
     p = DwaParams()
     m = _map_with(_wall(0.9, -0.3, 0.3))
-    assert clear_arc((0.0, 0.0, 0.0), 0.4, 0.0, (2.0, 0.0), 3.0, m.clearance, p) is None
+    assert clear_arc((0.0, 0.0, 0.0), 0.4, 0.0, (2.0, 0.0), 3.0, m.clearance_at, p) is None
     nav = Navigation(NavigationParams(), (0.0, 0.0))
     nav.set_goal((2.0, 0.0))
     nav.observe(_wall(0.9, -0.3, 0.3))
@@ -283,7 +307,7 @@ def test_fast_path_arcs_keep_their_margin_everywhere_not_only_at_their_poses() -
         v0, w0 = float(rng.uniform(0, 0.4)), float(rng.uniform(-1, 1))
         ang = pose[2] + float(rng.uniform(-0.6, 0.6))
         target = (pose[0] + 0.8 * math.cos(ang), pose[1] + 0.8 * math.sin(ang))
-        r = clear_arc(pose, v0, w0, target, 3.0, m.clearance, p)
+        r = clear_arc(pose, v0, w0, target, 3.0, m.clearance_at, p)
         if r is None:
             continue
         taken += 1
@@ -295,6 +319,43 @@ def test_fast_path_arcs_keep_their_margin_everywhere_not_only_at_their_poses() -
         gap = np.hypot(xs[:, None] - pts[None, :, 0], ys[:, None] - pts[None, :, 1]).min()
         assert gap >= p.radius + p.fast_margin - 1e-9
     assert taken > 30  # the property was exercised, not skipped
+
+
+def test_fast_path_is_the_vectorised_rollout_it_replaced() -> None:
+    """clear_arc walks the arc's poses in plain Python; the same poses rolled out with
+    numpy (as dwa_step does) give the same verdict, command and clearance."""
+    rng = np.random.default_rng(11)
+    p = DwaParams()
+    taken = refused = 0
+    for _ in range(300):
+        m = _map_with(rng.uniform(-2.0, 2.0, (5, 2)))
+        pose = (float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), float(rng.uniform(-3, 3)))
+        v0, w0 = float(rng.uniform(0, 0.4)), float(rng.uniform(-1.2, 1.2))
+        ang = pose[2] + float(rng.uniform(-0.6, 0.6))
+        target = (pose[0] + 0.8 * math.cos(ang), pose[1] + 0.8 * math.sin(ang))
+        r = clear_arc(pose, v0, w0, target, 3.0, m.clearance_at, p)
+        v = min(v0 + p.max_accel * p.period, p.max_v)
+        c, s = math.cos(pose[2]), math.sin(pose[2])
+        dx, dy = target[0] - pose[0], target[1] - pose[1]
+        bx, by = c * dx + s * dy, c * dy - s * dx
+        span2 = bx * bx + by * by
+        lo = max(w0 - p.max_alpha * p.period, -p.max_omega)
+        hi = min(w0 + p.max_alpha * p.period, p.max_omega)
+        omega = min(max(v * 2.0 * by / span2, lo), hi)
+        w = omega if abs(omega) >= 1e-6 else math.copysign(1e-6, omega)
+        th = pose[2] + w * (p.dt * np.arange(round(p.horizon / p.dt) + 1, dtype=np.float64))
+        xs = pose[0] + v / w * (np.sin(th) - s)
+        ys = pose[1] - v / w * (np.cos(th) - c)
+        least = float(m.clearance(xs, ys).min())
+        if least < p.radius + p.fast_margin + 0.5 * v * p.dt:
+            assert r is None
+            refused += 1
+            continue
+        assert r is not None
+        assert (r.v, r.omega, r.clearance) == (v, omega, least)
+        taken += 1
+    assert taken > 30
+    assert refused > 30
 
 
 def test_dwa_turns_first_toward_a_target_behind() -> None:
@@ -418,3 +479,26 @@ def test_reached_latches_until_the_robot_is_pushed_twice_the_tolerance_away() ->
     fresh = Navigation(NavigationParams(tolerance=0.08), (0.0, 0.0))
     fresh.set_goal((1.0, 0.0))  # never arrived: 9 cm is not reached
     assert fresh.step(0.0, (0.91, 0.0, 0.0), 0.0, 0.0, none).state != "reached"
+
+
+def test_navigating_imports_nothing_more_than_its_modules() -> None:
+    """The first run of a process pays every lazy import inside its sim time: the
+    navigator's pure pieces (map, A*, DWA) must not pull numpy.ma (np.unique's first
+    call did, ~8 ms of the bench's first run), nor anything else new."""
+    script = (
+        "import sys\n"
+        "import numpy as np\n"
+        "from otonav.nav.navigation import Navigation, NavigationParams\n"
+        "nav = Navigation(NavigationParams(), (0.0, 0.0))\n"
+        "nav.set_goal((3.0, 0.0))\n"
+        "before = set(sys.modules)\n"
+        "wall = np.stack((np.full(40, 1.5), np.linspace(-0.4, 0.4, 40)), axis=1)\n"
+        "for i in range(40):\n"
+        "    nav.observe(wall - [0.01 * i, 0.0])\n"
+        "    nav.step(0.05 * i, (0.02 * i, 0.0, 0.0), 0.3, 0.0, wall)\n"
+        "print(sorted(set(sys.modules) - before))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=True, timeout=60
+    )
+    assert out.stdout.strip() == "[]"

@@ -4,6 +4,7 @@ the same side of their wake-ups as in the recording (no physics: JumpSource worl
 from __future__ import annotations
 
 import asyncio
+import gc
 from pathlib import Path
 
 import pytest
@@ -13,7 +14,7 @@ from otonav.msgs import Twist, Vector3
 from otonav.record.cdr import encode
 from otonav.record.reader import read_messages
 from otonav.record.writer import RecordingWriter
-from otonav.replay import replay_recording
+from otonav.replay import ReplayInputError, replay_recording
 from otonav.replay.feed import Settle, plan_instants
 from otonav.replay.recording import RecordedMessage
 from otonav.runtime import Actor, Input, JumpSource, Output, System, virtual_loop_factory
@@ -182,3 +183,29 @@ def test_plan_marks_instants_where_every_actor_ran_before_the_inputs() -> None:
     assert [(i.holds, i.after_idle) for i in both] == [(True, False), (True, True), (True, False)]
     only_a = plan_instants([a1, i1, i3, a3], {"/in"}, {"/a": {"A"}}, rate=500.0, actors=["A"])
     assert [(i.holds, i.after_idle) for i in only_a] == [(True, True), (True, False)]
+
+
+class ThresholdSpy(Sampler):
+    """A sampler that notes the garbage collector's thresholds while it runs."""
+
+    seen: tuple[int, int, int] | None = None
+
+    async def run(self) -> None:
+        ThresholdSpy.seen = gc.get_threshold()
+        await super().run()
+
+
+def test_a_replay_collects_garbage_less_often_and_restores_the_collector(
+    tmp_path: Path,
+) -> None:
+    path = tmp_path / "run.mcap"
+    _record(path)
+    before = gc.get_threshold()
+    result = replay_recording(path, [ThresholdSpy()])
+    assert result.byte_identical, result.first_divergence
+    assert ThresholdSpy.seen is not None
+    assert ThresholdSpy.seen[0] >= 10_000 > before[0]
+    assert gc.get_threshold() == before
+    with pytest.raises(ReplayInputError):
+        replay_recording(tmp_path / "missing.mcap", [Sampler()])
+    assert gc.get_threshold() == before

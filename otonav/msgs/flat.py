@@ -1,0 +1,325 @@
+"""Messages of a fixed layout, made from the few numbers that vary (ADR 0033).
+
+The bridge publishes /clock, /odom, /tf and /imu every 10 ms. Built eagerly, one instant
+is 18 nested pydantic objects (an Odometry alone is 11: Header, Time, Pose, Point, ...),
+~11 us, and the recorder then reads them back field by field to encode them, ~5 us more.
+Yet in the stack nobody walks the nesting: the recorder wants CDR bytes, the safety
+layer and the navigator want six numbers of an Odometry.
+
+A :class:`FlatLayout` is a *template* message and the *paths* of the scalar fields that
+vary (``header.stamp.sec``, ``pose.pose.position.x``, ``transforms.0.header.stamp.sec``).
+``layout(*values)`` makes a message holding only those values (0.4 us). It is an
+instance of a subclass of the template's class (``FlatOdometry`` for an Odometry), like
+a lazily decoded replay input (:mod:`otonav.replay.lazy`): its first attribute access
+of any kind (a field, a method, ``__dict__``, which every pydantic method goes through,
+comparison, hashing, ``repr``, pickling, copying) builds the nested objects -- the
+template's, with the values in place -- and switches the object's class to the message
+class itself. From then on it *is* that message, field for field and type for type
+(``type(m) is Odometry``), equal to the eagerly built one (tests check each operation).
+Before its first use only ``type(m)`` tells it apart; ``isinstance`` holds throughout.
+
+Three readers use the values without building anything:
+
+- :func:`reader`: the values at some paths, from a flat message's values (or the
+  template's constants), or through the attributes of any other message;
+- :func:`otonav.record.cdr.encode`: the template's bytes with the values packed in
+  place, by one precompiled ``struct.Struct`` per layout (the same bytes as the
+  field-by-field encoder: tested with random values, -0.0, NaN, infinities, extremes);
+- a publisher's type check (:attr:`FlatMessage.stands_for`).
+
+The template must be an ordinary message (not flat); the values must be of the types
+the fields hold (the stack's hot path: nothing is validated per message).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from operator import attrgetter
+from typing import Any, ClassVar, Generic, TypeVar
+
+from pydantic import BaseModel
+
+from otonav.msgs._base import Message
+
+__all__ = ("FlatLayout", "flat_state", "is_flat", "reader", "real_type")
+
+M = TypeVar("M", bound=Message)
+
+_KEY = "\0flat"
+"""Where a flat message keeps ``(layout, values)`` in its ``__dict__``: no field can
+have this name, so every field lookup misses and reaches ``__getattribute__``."""
+
+_get = object.__getattribute__
+_set_class = object.__setattr__
+_new = object.__new__
+_set_dict = BaseModel.__dict__["__dict__"].__set__
+_set_fields_set = BaseModel.__dict__["__pydantic_fields_set__"].__set__
+_set_extra = BaseModel.__dict__["__pydantic_extra__"].__set__
+_set_private = BaseModel.__dict__["__pydantic_private__"].__set__
+
+_FLAT: dict[type[Message], type[Message]] = {}
+"""message class -> its flat subclass"""
+_REAL: dict[type[Message], type[Message]] = {}
+"""flat subclass -> its message class"""
+
+
+def _make(cls: type[Message], fields: dict[str, Any], fields_set: set[str]) -> Message:
+    """A message of ``cls`` with these fields, built as :meth:`Message.fast` does."""
+    message: Message = _new(cls)
+    _set_dict(message, fields)
+    _set_fields_set(message, fields_set)
+    _set_extra(message, None)
+    _set_private(message, None)
+    return message
+
+
+def materialize(message: M) -> M:
+    """Build a flat ``message``'s nested objects in place (no-op for any other); returns
+    it, now of its message class."""
+    real = _REAL.get(type(message))
+    if real is None:
+        return message
+    state = _get(message, "__dict__").get(_KEY)
+    # No state: a copy of an already built one (pydantic's __copy__ builds the copy with
+    # type(self), read before the original built itself): it has its fields already.
+    if state is not None:
+        layout, values = state
+        _set_dict(message, layout._build(values))
+    _set_class(message, "__class__", real)
+    return message
+
+
+def _flat_class(real: type[Message]) -> type[Message]:
+    def __getattribute__(self: Message, name: str) -> Any:
+        materialize(self)
+        return _get(self, name)
+
+    def __eq__(self: Message, other: object) -> bool:
+        return materialize(self) == other
+
+    def __hash__(self: Message) -> int:
+        return hash(materialize(self))
+
+    def __repr__(self: Message) -> str:
+        return repr(materialize(self))
+
+    def __str__(self: Message) -> str:
+        return str(materialize(self))
+
+    namespace = {
+        "__getattribute__": __getattribute__,
+        "__eq__": __eq__,
+        "__hash__": __hash__,
+        "__repr__": __repr__,
+        "__str__": __str__,
+        "__module__": __name__,
+        "__qualname__": f"Flat{real.__name__}",
+        "__doc__": f"A {real.__name__} of a fixed layout: built on first use.",
+        "stands_for": real,
+        "__annotations__": {"stands_for": ClassVar[type[Message]]},
+    }
+    metaclass: Any = type(real)  # pydantic's: the subclass is a model like its base
+    cls: type[Message] = metaclass(f"Flat{real.__name__}", (real,), namespace)
+    _FLAT[real] = cls
+    _REAL[cls] = real
+    return cls
+
+
+class FlatLayout(Generic[M]):
+    """Messages like ``template`` with the scalar fields at ``paths`` given per message.
+
+    A path is field names (and tuple indices) joined by dots: ``header.stamp.sec``,
+    ``transforms.0.transform.translation.x``. Each must end at an ``int``, ``float`` or
+    ``bool`` of the template; no path may be given twice. ``layout(*values)`` makes one
+    message, ``values`` in the order of ``paths``.
+    """
+
+    __slots__ = ("_build", "_cls", "_fields_set", "cdr", "message_type", "paths", "template")
+
+    def __init__(self, template: M, paths: Sequence[str]) -> None:
+        if type(template) in _REAL:
+            raise TypeError("FlatLayout: the template must be an ordinary message, not a flat one")
+        self.template = template
+        self.message_type: type[M] = type(template)
+        self.paths = tuple(paths)
+        tree = _tree(self.paths)
+        for path in self.paths:
+            leaf = _resolve(template, path)
+            if not isinstance(leaf, int | float):
+                raise ValueError(
+                    f"FlatLayout of {self.message_type.__name__}: '{path}' is a "
+                    f"{type(leaf).__name__}; a path must end at an int, float or bool field"
+                )
+        self._build = _compile_builder(template, tree)
+        self._cls = _FLAT.get(self.message_type) or _flat_class(self.message_type)
+        self._fields_set = _get(template, "__pydantic_fields_set__")
+        self.cdr: Callable[..., bytes] | None = None
+        """Its CDR packer: set by :mod:`otonav.record.cdr` the first time it encodes one."""
+
+    def __call__(self, *values: Any) -> M:
+        """A message of this layout with ``values`` at ``paths`` (not checked)."""
+        message: M = _new(self._cls)  # type: ignore[assignment]  # its flat subclass
+        _set_dict(message, {_KEY: (self, values)})
+        _set_fields_set(message, self._fields_set)
+        _set_extra(message, None)
+        _set_private(message, None)
+        return message
+
+    def index(self, path: str) -> int:
+        """The position of ``path`` in :attr:`paths`."""
+        return self.paths.index(path)
+
+    def constant(self, path: str) -> Any:
+        """The template's value at ``path`` (a field the layout does not vary)."""
+        return _resolve(self.template, path)
+
+    def __repr__(self) -> str:
+        return f"FlatLayout({self.message_type.__name__}, {self.paths!r})"
+
+
+def is_flat(message: object) -> bool:
+    """Whether ``message`` is a flat message whose nested objects are not built yet."""
+    return type(message) in _REAL and _KEY in _get(message, "__dict__")
+
+
+def flat_state(message: object) -> tuple[FlatLayout[Any], tuple[Any, ...]] | None:
+    """``(layout, values)`` of a flat message not built yet; None for any other."""
+    if type(message) not in _REAL:
+        return None
+    state: tuple[FlatLayout[Any], tuple[Any, ...]] | None = _get(message, "__dict__").get(_KEY)
+    return state
+
+
+def real_type(cls: type[M]) -> type[M]:
+    """The message class a flat class stands for; any other class itself."""
+    real: type[M] = _REAL.get(cls, cls)  # type: ignore[assignment]
+    return real
+
+
+def reader(message_type: type[M], *paths: str) -> Callable[[M], tuple[Any, ...]]:
+    """A function giving the values at ``paths`` of a ``message_type`` message, as a
+    tuple: from a flat message's values and its template (nothing built), from any
+    other message through its attributes. The same values either way."""
+    if not paths:
+        raise ValueError("reader: name at least one path")
+    get = attrgetter(*paths)
+
+    def through_attributes(m: Any) -> tuple[Any, ...]:
+        return (get(m),) if len(paths) == 1 else get(m)
+
+    picks: dict[FlatLayout[Any], Callable[[tuple[Any, ...]], tuple[Any, ...]]] = {}
+
+    def pick_for(layout: FlatLayout[Any]) -> Callable[[tuple[Any, ...]], tuple[Any, ...]]:
+        names: dict[str, object] = {}
+        parts = []
+        for path in paths:
+            if path in layout.paths:
+                parts.append(f"v[{layout.paths.index(path)}]")
+            else:
+                name = f"_c{len(names)}"
+                names[name] = layout.constant(path)
+                parts.append(name)
+        pick: Callable[[tuple[Any, ...]], tuple[Any, ...]] = eval(  # our own paths only
+            f"lambda v: ({', '.join(parts)},)", names
+        )
+        picks[layout] = pick
+        return pick
+
+    def read(message: M) -> tuple[Any, ...]:
+        if type(message) in _REAL:
+            state = _get(message, "__dict__").get(_KEY)
+            if state is not None:
+                layout, values = state
+                return (picks.get(layout) or pick_for(layout))(values)
+        result: tuple[Any, ...] = through_attributes(message)
+        return result
+
+    return read
+
+
+# -- building ----------------------------------------------------------------------------
+
+_Tree = dict[str, "int | _Tree"]
+
+
+def _tree(paths: Sequence[str]) -> _Tree:
+    """The paths as a tree of names; a leaf holds the value's index."""
+    root: _Tree = {}
+    for i, path in enumerate(paths):
+        node = root
+        *parents, last = path.split(".")
+        for name in parents:
+            child = node.setdefault(name, {})
+            if not isinstance(child, dict):
+                raise ValueError(f"FlatLayout: '{path}' is inside '{paths[child]}', a number")
+            node = child
+        if last in node:
+            raise ValueError(f"FlatLayout: '{path}' is given twice or has paths inside it")
+        node[last] = i
+    return root
+
+
+def _resolve(value: Any, path: str) -> Any:
+    """The value at ``path`` inside ``value`` (a message or a tuple)."""
+    for name in path.split("."):
+        if isinstance(value, tuple):
+            if not name.isdigit() or int(name) >= len(value):
+                raise ValueError(f"FlatLayout: no element '{name}' of {len(value)} in '{path}'")
+            value = value[int(name)]
+        elif isinstance(value, Message):
+            if name not in type(value).model_fields:
+                raise ValueError(
+                    f"FlatLayout: {type(value).__name__} has no field '{name}' (path '{path}')"
+                )
+            value = _get(value, "__dict__")[name]
+        else:
+            raise ValueError(f"FlatLayout: '{path}' goes inside a {type(value).__name__}")
+    return value
+
+
+def _compile_builder(template: Message, tree: _Tree) -> Callable[[tuple[Any, ...]], dict[str, Any]]:
+    """One generated function: the template's top-level field dict with the nested
+    objects on each path rebuilt around the values (``v[i]``); every other subtree is
+    the template's own (frozen) object, shared."""
+    names: dict[str, object] = {"_make": _make}
+
+    def const(value: object) -> str:
+        name = f"_k{len(names)}"
+        names[name] = value
+        return name
+
+    def fields(message: Message, node: _Tree) -> str:
+        parts = []
+        for name, value in _get(message, "__dict__").items():
+            sub = node.get(name)
+            code = (
+                const(value)
+                if sub is None
+                else f"v[{sub}]"
+                if isinstance(sub, int)
+                else expr(value, sub)
+            )
+            parts.append(f"{name!r}: {code}")
+        return "{" + ", ".join(parts) + "}"
+
+    def expr(value: Any, node: _Tree) -> str:
+        if isinstance(value, tuple):
+            items = []
+            for i, item in enumerate(value):
+                sub = node.get(str(i))
+                code = (
+                    const(item)
+                    if sub is None
+                    else f"v[{sub}]"
+                    if isinstance(sub, int)
+                    else expr(item, sub)
+                )
+                items.append(code)
+            return "(" + "".join(f"{item}, " for item in items) + ")"
+        cls = const(type(value))
+        fields_set = const(_get(value, "__pydantic_fields_set__"))
+        return f"_make({cls}, {fields(value, node)}, {fields_set})"
+
+    source = f"lambda v: {fields(template, tree)}"
+    build: Callable[[tuple[Any, ...]], dict[str, Any]] = eval(source, names)  # our paths only
+    return build
