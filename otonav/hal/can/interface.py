@@ -152,6 +152,7 @@ class CanBusInterface(RobotHardwareInterface):
         self.read_imu = sensors.read_imu  # type: ignore[method-assign]
         self.read_scan = sensors.read_scan  # type: ignore[method-assign]
         self.ground_truth = sensors.ground_truth  # type: ignore[method-assign]
+        self._geometry = sensors.geometry  # the robot's shape does not change as it runs
         self._start(sensors.ticks * self._tick)
 
     @property
@@ -358,7 +359,7 @@ class CanBusInterface(RobotHardwareInterface):
 
     @property
     def geometry(self) -> RobotGeometry:
-        return self._sensors.geometry
+        return self._geometry
 
     def obstacles(self) -> tuple[BoxObstacle, ...]:
         return self._sensors.obstacles()
