@@ -1,6 +1,6 @@
 """The CAN HAL against the MuJoCo HAL: the acceptance scenario, both ways.
 
-    python benchmarks/can_bench.py [--reps N] [--split] [--baseline DIR]
+    python benchmarks/can_bench.py [--reps N] [--warm ROUNDS] [--split] [--baseline DIR]
 
 Each run is a fresh process (``python -c``), the two HALs interleaved, so both see the
 same machine load; with and without the recorder. Prints the median wall time and
@@ -18,6 +18,10 @@ costs per run whatever otonav does around it, as a share of the MuJoCo run.
 per endpoint (a measuring instrument only: the product never does this), interleaved
 with the real thing: the difference is what python-can costs *in the run*, where its
 code runs cold between the stack's other work (more than in the tight floor loop).
+
+``--warm ROUNDS`` adds ROUNDS processes per tree that each run both HALs ``--reps`` times
+in turn, warm, and keep the least CPU time of each (the run least disturbed by the rest
+of the machine): on a shared machine this moves far less than fresh processes' medians.
 
 ``--baseline DIR`` interleaves the same runs on another commit's checkout (made with
 ``git archive REV | tar -x -C DIR``), so a before/after is measured under one load.
@@ -141,6 +145,31 @@ print(json.dumps({"passed": v.passed, "wall": v.wall_time_s, "cpu": cpu}))
 """
 
 
+_WARM = """
+import gc, json, sys, tempfile, time
+from pathlib import Path
+from otonav.scenario import run_scenario
+from otonav.stack import StackConfig
+from otonav.stack.overrides import apply_overrides
+import otonav.hal.can, otonav.hal.can.tap, otonav.hal.sim
+record = sys.argv[2] == "1"
+stacks = {k: apply_overrides(StackConfig(), [f"hal.kind={k}"]) for k in ("mujoco", "can")}
+cpu = {k: [] for k in stacks}
+for i in range(int(sys.argv[1]) + 1):  # the first pair warms up
+    for kind, stack in stacks.items():
+        gc.collect()
+        with tempfile.TemporaryDirectory() as out:
+            c = time.process_time()
+            v = run_scenario(stack=stack, out_dir=Path(out), record=record, plot=False)
+            c = time.process_time() - c
+        if not v.passed:
+            raise SystemExit(f"the acceptance scenario failed with hal.kind={kind}")
+        if i:
+            cpu[kind].append(c)
+print(json.dumps({k: min(v) for k, v in cpu.items()}))
+"""
+
+
 def run_child(code: str, *args: str, tree: str | None = None) -> dict[str, float]:
     """Run ``code`` in a fresh interpreter, on ``tree``'s otonav when given."""
     env = dict(os.environ)
@@ -165,6 +194,15 @@ def main() -> int:
         "--split",
         action="store_true",
         help="also time the CAN run with python-can's bus replaced by deques (instrument)",
+    )
+    parser.add_argument(
+        "--warm",
+        type=int,
+        metavar="ROUNDS",
+        default=0,
+        help="also ROUNDS processes per tree, each timing --reps warm runs of both HALs "
+        "in turn (CPU, the least disturbed of each): steadier than fresh processes on a "
+        "busy machine",
     )
     parser.add_argument(
         "--baseline",
@@ -227,6 +265,22 @@ def main() -> int:
         f"{floor['cpu'] / cpu_m:.1%} of its CPU time (no recorder): CAN / MuJoCo cannot go "
         f"below {1 + floor['wall'] / wall_m:.2f} (wall) over python-can's virtual bus"
     )
+    for record in (False, True) if args.warm else ():
+        added: dict[str, list[float]] = {name: [] for name in trees}
+        ratio: dict[str, list[float]] = {name: [] for name in trees}
+        for _ in range(args.warm):
+            for name, tree in trees.items():
+                best = run_child(_WARM, str(args.reps), "1" if record else "0", tree=tree)
+                added[name].append(best["can"] - best["mujoco"])
+                ratio[name].append(best["can"] / best["mujoco"])
+        label = "with recorder" if record else "no recorder"
+        for name in trees:
+            print(
+                f"{name}{label:14s} warm, CPU (least of {args.reps} per process, median of "
+                f"{args.warm} processes): CAN adds {statistics.median(added[name]):.3f} s "
+                f"({', '.join(f'{a:.3f}' for a in added[name])}), CAN / MuJoCo "
+                f"{statistics.median(ratio[name]):.2f}"
+            )
     if args.split:
         split: dict[str, list[dict[str, float]]] = {"python-can": [], "deque": []}
         for _ in range(args.reps):
