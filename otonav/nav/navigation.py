@@ -36,6 +36,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -119,9 +120,9 @@ class NavigationParams:
     kp_ang: float = 2.0
 
 
-@dataclass(frozen=True, slots=True)
-class NavOutput:
-    """One step's command and what explains it."""
+class NavOutput(NamedTuple):
+    """One step's command and what explains it. A named tuple, immutable like a frozen
+    dataclass but made in ~0.7 us instead of ~2.7 us (one per step)."""
 
     v: float
     omega: float
@@ -200,14 +201,17 @@ class Navigation:
 
     def observe(
         self,
-        points_odom: NDArray[np.float64],
+        points_odom: NDArray[np.float64] | tuple[NDArray[np.float64], NDArray[np.float64]],
         rays: ScanRays | Callable[[], ScanRays] | None = None,
     ) -> int:
-        """Record a scan's returns (odom); returns how many map cells were new.
-        ``rays`` (the same scan as rays, or a function making them): kept, and used
-        to clear what the scan saw through before the next replan."""
+        """Record a scan's returns (odom: ``(N, 2)``, or x and y arrays); returns how
+        many map cells were new. ``rays`` (the same scan as rays, or a function making
+        them): kept, and used to clear what the scan saw through before the next
+        replan."""
         if rays is not None:
             self._rays = rays
+        if isinstance(points_odom, tuple):
+            return self.map.mark_xy(*points_odom)
         return self.map.mark(points_odom)
 
     # -- the step ----------------------------------------------------------------------
@@ -397,12 +401,12 @@ class Navigation:
         if path is None:
             return self.goal
         d = np.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1])
-        i = int(np.argmin(d))
-        beyond = np.flatnonzero(d[i:] >= self.params.lookahead)
-        if beyond.size == 0:
+        i = int(d.argmin())  # (the array methods: no np.argmin/np.flatnonzero wrappers)
+        beyond = d[i:] >= self.params.lookahead
+        j = i + int(beyond.argmax())  # the first True, or i when there is none
+        if not beyond[j - i]:
             return self.goal
-        p = path[i + int(beyond[0])]
-        return float(p[0]), float(p[1])
+        return float(path[j, 0]), float(path[j, 1])
 
     def _begin(
         self,
