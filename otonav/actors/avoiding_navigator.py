@@ -10,7 +10,7 @@ import numpy as np
 from otonav.actors import topics
 from otonav.actors.navigator import GoalNavigator
 from otonav.actors.odom_history import OdomHistory
-from otonav.actors.scan_cache import points_of, rays_of
+from otonav.actors.scan_cache import odom_xy_of, points_of, rays_of
 from otonav.msgs import Header, LaserScan, NavDiagnostics, Time
 from otonav.nav.navigation import Navigation, NavigationParams, NavOutput
 from otonav.nav.scan import to_frame
@@ -75,9 +75,7 @@ class AvoidingNavigator(GoalNavigator):
         # (and the points: at rest a scan costs nothing here).
         if moved:
             offset = self.laser_offset_x
-            self.nav.observe(
-                to_frame(points_of(scan, offset).xy, pose), lambda: rays_of(scan, offset, pose)
-            )
+            self.nav.observe(odom_xy_of(scan, offset, pose), lambda: rays_of(scan, offset, pose))
 
     async def _step(self) -> None:
         now = self.clock.now()

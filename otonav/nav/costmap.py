@@ -114,11 +114,15 @@ class ClearanceMap:
         then the update is a dozen numpy calls on the N points (no sort: the new
         cells are deduplicated in a set). Measured on the acceptance course: 87 -> ~35 us
         per scan in the stack."""
-        if xy.shape[0] == 0:
+        return self.mark_xy(xy[:, 0], xy[:, 1])
+
+    def mark_xy(self, x: NDArray[np.float64], y: NDArray[np.float64]) -> int:
+        """:meth:`mark` of returns given as x and y arrays (odom, m)."""
+        if x.shape[0] == 0:
             return 0
         inv, n = 1.0 / self.resolution, self.size
-        col = np.floor((xy[:, 0] - self.origin_x) * inv).astype(np.intp)
-        row = np.floor((xy[:, 1] - self.origin_y) * inv).astype(np.intp)
+        col = np.floor((x - self.origin_x) * inv).astype(np.intp)
+        row = np.floor((y - self.origin_y) * inv).astype(np.intp)
         # Negative indices wrap to huge unsigned values: one comparison per axis.
         inside = (col.view(np.uintp) < n) & (row.view(np.uintp) < n)
         flat = (row * n + col)[inside]

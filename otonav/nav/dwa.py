@@ -188,6 +188,15 @@ def _tie_break(steps: int) -> NDArray[np.float64]:
     return b
 
 
+@lru_cache(maxsize=8)
+def _rows(v_count: int, w_count: int) -> NDArray[np.intp]:
+    """Per sample of the grid, its row among the distinct yaw rates: the ``w_count``
+    rates for each of the ``v_count`` speeds, then the braking sample's (``w_count``)."""
+    r = np.append(np.tile(np.arange(w_count), v_count), w_count)
+    r.flags.writeable = False
+    return r
+
+
 def _window(lo: float, hi: float, n: int) -> NDArray[np.float64]:
     # np.linspace costs ~10 us a call; the cached fractions make this one multiply-add.
     return lo + (hi - lo) * _fractions(n) if n > 1 and hi > lo else np.array([0.5 * (lo + hi)])
@@ -281,36 +290,44 @@ def dwa_step(
     vs = _window(v_lo, v_lo if off > p.rotate_threshold else v_hi, p.v_samples)
     ws = _window(w_lo, w_hi, p.omega_samples)
     brake_w = min(max(0.0, w_lo), w_hi)
-    # The grid by broadcasting into views (np.tile + np.repeat + 2 concatenations cost
-    # ~10 us; this ~3 us): v = [vs repeated per omega..., v_lo], w = [ws tiled..., brake].
-    n = vs.size * ws.size + 1
+    # The grid: v = [vs repeated per omega..., v_lo], w = [ws tiled..., brake_w]. The
+    # headings, sines and cosines depend on omega only: computed per distinct rate
+    # (13 + 1 rows, not 66) and spread to the samples by one index (the same floats;
+    # with the other trims below ~10 % of the step).
+    nv, nw = vs.size, ws.size
+    n = nv * nw + 1
     v = np.empty(n)
-    w = np.empty(n)
-    v[:-1].reshape(vs.size, ws.size)[...] = vs[:, None]
-    w[:-1].reshape(vs.size, ws.size)[...] = ws
-    v[-1], w[-1] = v_lo, brake_w
+    v[:-1].reshape(nv, nw)[...] = vs[:, None]
+    v[-1] = v_lo
+    wu = np.empty(nw + 1)  # (np.append is a Python function: ~3 us more)
+    wu[:nw] = ws
+    wu[nw] = brake_w
+    rows = _rows(nv, nw)
+    w = wu[rows]
     steps = max(1, round(p.horizon / p.dt))
     t = _times(p.dt, steps)  # (K+1,): column 0 is the start pose
     columns = _columns(steps)
     # Exact arcs: x = x0 + v/w (sin(th) - sin(th0)), y = y0 - v/w (cos(th) - cos(th0)).
     # A straight line is the limit w -> 0; |w| >= 1e-6 rad/s keeps v/w finite and
     # errs by < 1e-6 m over the horizon (no branch, no extra numpy calls).
-    w_eff = np.where(np.abs(w) < 1e-6, np.copysign(1e-6, w), w)
-    th = th0 + w_eff[:, None] * t[None, :]  # (N, K+1) heading
-    r = (v / w_eff)[:, None]
-    xs = x0 + r * (np.sin(th) - math.sin(th0))
-    ys = y0 - r * (np.cos(th) - math.cos(th0))
+    wu_eff = np.where(np.abs(wu) < 1e-6, np.copysign(1e-6, wu), wu)
+    thu = th0 + wu_eff[:, None] * t[None, :]  # (distinct rates, K+1) heading
+    r = (v / wu_eff[rows])[:, None]
+    xs = x0 + r * (np.sin(thu) - math.sin(th0))[rows]
+    ys = y0 - r * (np.cos(thu) - math.cos(th0))[rows]
     clear = clearance(xs.ravel(), ys.ravel()).reshape(n, steps + 1)
     here = float(clear[0, 0])
     threshold = min(p.radius, here - 1e-3)
-    hit = clear[:, 1:] < threshold
-    any_hit = hit.any(axis=1)
-    # The last pose before the first one under the threshold (column 0: the start).
-    last = np.where(any_hit, np.argmax(hit, axis=1), steps)
-    free = np.where(any_hit, v * t[last], np.inf)
+    # The first pose under the threshold, by argmax over the poses after the start and
+    # a sentinel column (no hit: `steps`); the pose before it is the last free one.
+    hit = np.empty((n, steps + 1), dtype=np.bool_)
+    np.less(clear[:, 1:], threshold, out=hit[:, :steps])
+    hit[:, steps] = True
+    last = hit.argmax(axis=1)
+    free = np.where(last < steps, v * t[last], np.inf)
     stop = v * p.latency + v * v / (2.0 * p.max_accel)
     admissible = stop <= free
-    count = int(admissible.sum())
+    count = int(np.count_nonzero(admissible))
     if count == 0:
         return DwaResult(
             v=float(v_lo),
@@ -327,19 +344,19 @@ def dwa_step(
     # fast arc that passes the goal within the horizon is not worse than a slow one
     # that stops short of it (judged at the end, the DWA crawls into every goal).
     to_target = np.hypot(tx - xs, ty - ys)
-    beyond = columns[None, :] > last[:, None]
     # Ties (a turn on the spot stays at one point) go to the latest pose: its heading.
     late = to_target - _tie_break(steps)[None, :]
-    best_i = np.argmin(np.where(beyond, np.inf, late), axis=1)
+    np.putmask(late, columns[None, :] > last[:, None], np.inf)  # beyond the cut
+    best_i = late.argmin(axis=1)
     flat = best_i + columns.size * _columns(n - 1)  # (row, best_i) in the raveled arrays
     ex, ey = xs.ravel()[flat], ys.ravel()[flat]
     closest = to_target.ravel()[flat]
-    bearing = np.arctan2(ty - ey, tx - ex) - th.ravel()[flat]
+    bearing = np.arctan2(ty - ey, tx - ex) - thu.ravel()[best_i + columns.size * rows]
     bearing = np.abs(np.remainder(bearing + math.pi, math.tau) - math.pi)
-    bearing = np.where(closest < 0.05, 0.0, bearing)  # at the target: no bearing to keep
+    np.putmask(bearing, closest < 0.05, 0.0)  # at the target: no bearing to keep
     d0 = math.hypot(tx - x0, ty - y0)
     gain = (d0 - closest) / (p.max_v * p.horizon)
-    min_clear = clear.min(axis=1)
+    min_clear = np.minimum.reduce(clear, axis=1)
     # np.minimum(np.maximum()) is np.clip's result without its ~4 us Python wrapper.
     room = np.minimum(np.maximum(min_clear - p.radius, 0.0), p.clearance_cap) / p.clearance_cap
     score = (
@@ -348,8 +365,8 @@ def dwa_step(
         + p.w_clearance * room
         + p.w_speed * v / p.max_v
     )
-    score = np.where(admissible, score, -np.inf)
-    best = int(np.argmax(score))
+    np.putmask(score, ~admissible, -np.inf)
+    best = int(score.argmax())
     reason = "toward target" if room[best] >= 1.0 else "avoiding"
     return DwaResult(
         v=float(v[best]),

@@ -200,14 +200,17 @@ class Navigation:
 
     def observe(
         self,
-        points_odom: NDArray[np.float64],
+        points_odom: NDArray[np.float64] | tuple[NDArray[np.float64], NDArray[np.float64]],
         rays: ScanRays | Callable[[], ScanRays] | None = None,
     ) -> int:
-        """Record a scan's returns (odom); returns how many map cells were new.
-        ``rays`` (the same scan as rays, or a function making them): kept, and used
-        to clear what the scan saw through before the next replan."""
+        """Record a scan's returns (odom: ``(N, 2)``, or x and y arrays); returns how
+        many map cells were new. ``rays`` (the same scan as rays, or a function making
+        them): kept, and used to clear what the scan saw through before the next
+        replan."""
         if rays is not None:
             self._rays = rays
+        if isinstance(points_odom, tuple):
+            return self.map.mark_xy(*points_odom)
         return self.map.mark(points_odom)
 
     # -- the step ----------------------------------------------------------------------

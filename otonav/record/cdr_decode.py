@@ -24,7 +24,7 @@ from typing import Any, Final, TypeVar
 
 from pydantic import BaseModel
 
-from otonav.msgs import Message
+from otonav.msgs import Header, Message
 from otonav.record.cdr import ENCAPSULATION, _Fixed, _leaves, _run_format, _Var
 from otonav.record.schemas import SEQUENCE, layout_for
 
@@ -225,8 +225,9 @@ def _plan(message: type[Message]) -> tuple[tuple[ReadStep, ...], Builder]:
     return plan
 
 
-Decoder = Callable[[bytes], Any]
-"""Decode one message from CDR data that starts with its encapsulation header."""
+Decoder = Callable[[bytes, Any], tuple[Any, int]]
+"""Decode one message from CDR data that starts with its encapsulation header (and, for
+a stamped message, its Header if already decoded); returns it and where it ended."""
 
 
 def _compile_decoder(message: type[Message]) -> Decoder:
@@ -269,7 +270,24 @@ def _compile_decoder(message: type[Message]) -> Decoder:
                 at += 1
         run.clear()
 
-    for leaf in _leaves(message):
+    leaves = _leaves(message)
+    stamped = _stamped(message)
+    if stamped:
+        # Its header comes first, where a Header alone would be: decoded by the Header
+        # decoder, or given (a lazy replay input decodes its header alone first).
+        assert [leaf.path for leaf in leaves[:3]] == [*_HEADER_PATHS]
+        leaves = leaves[3:]
+        names["_header"] = _decoder(Header)
+        names["_past_header"] = _past_header
+        lines += [
+            "if header is None:",
+            "    header, pos = _header(data)",
+            "else:",
+            "    pos = _past_header(data)",
+        ]
+    else:
+        lines.append("pos = 4")
+    for leaf in leaves:
         if isinstance(leaf, _Fixed):
             run.append(leaf)
             continue
@@ -310,8 +328,10 @@ def _compile_decoder(message: type[Message]) -> Decoder:
         parts = []
         if not layout.fields:
             i += 1
-        for field in layout.fields:
-            if not isinstance(field.type, str) and field.array is None:
+        for k, field in enumerate(layout.fields):
+            if k == 0 and stamped and current is message:
+                code = "header"
+            elif not isinstance(field.type, str) and field.array is None:
                 code, i = build(field.type, i)
             elif isinstance(field.type, str) and field.type != "string" and (field.array or 0) > 0:
                 n = field.array or 0
@@ -336,18 +356,42 @@ def _compile_decoder(message: type[Message]) -> Decoder:
     top, used = build(message, 0)
     assert used == len(values)
     # The reads (in wire order), then the builds (innermost messages first).
-    body = "\n".join("    " + line for line in ["pos = 4", *lines])
-    source = f"def decode_{message.__name__}(data):\n{body}\n    return {top}, pos\n"
+    body = "\n".join("    " + line for line in lines)
+    source = f"def decode_{message.__name__}(data, header=None):\n{body}\n    return {top}, pos\n"
     exec(compile(source, f"<cdr decoder of {message.__name__}>", "exec"), names)
     decoder: Decoder = names[f"decode_{message.__name__}"]  # type: ignore[assignment]
     return decoder
 
 
 _DECODERS: dict[type[Message], Decoder] = {}
+_HEADER_PATHS = ("header.stamp.sec", "header.stamp.nanosec", "header.frame_id")
 
 
-def decode(message: type[M], data: bytes) -> M:
+def _decoder(message: type[Message]) -> Decoder:
+    decoder = _DECODERS.get(message)
+    if decoder is None:
+        decoder = _DECODERS[message] = _compile_decoder(message)
+    return decoder
+
+
+def _stamped(message: type[Message]) -> bool:
+    """Whether ``message``'s first field is a std_msgs Header."""
+    fields = layout_for(message).fields
+    return bool(fields) and fields[0].name == "header" and fields[0].type is Header
+
+
+def _past_header(data: bytes) -> int:
+    """Where the field after a leading Header starts: past its stamp (8 bytes) and its
+    frame_id (a uint32 length, aligned already, then the bytes)."""
+    length: int = _U32.unpack_from(data, 12)[0]
+    return 16 + length
+
+
+def decode(message: type[M], data: bytes, header: Header | None = None) -> M:
     """The ``message`` encoded in ``data`` (CDR with its encapsulation header).
+
+    ``header``: for a message whose first field is a Header, that Header already
+    decoded from ``data`` (``decode(Header, data)``): it is used as is.
 
     Raises ValueError for data that is not little-endian CDR of that type (too short,
     a string past the end, trailing garbage is tolerated as ROS 2 pads to 4 bytes).
@@ -357,11 +401,9 @@ def decode(message: type[M], data: bytes) -> M:
             f"cannot decode {message.ros_type}: not little-endian plain CDR "
             f"(encapsulation {bytes(data[:4]).hex() or 'missing'}, expected {ENCAPSULATION.hex()})"
         )
-    decoder = _DECODERS.get(message)
-    if decoder is None:
-        decoder = _DECODERS[message] = _compile_decoder(message)
+    decoder = _DECODERS.get(message) or _decoder(message)
     try:
-        result, pos = decoder(data)
+        result, pos = decoder(data, header)
     except (struct.error, UnicodeDecodeError) as error:
         raise ValueError(f"cannot decode {message.ros_type}: {error}") from error
     if pos > len(data):

@@ -58,11 +58,8 @@ def materialize(message: M) -> M:
     # No bytes: a copy taken from an already decoded message (pydantic's __copy__ builds
     # the copy with type(self), read before the original decoded itself).
     if data is not None:
-        decoded = _get(decode(real, data), "__dict__")
-        header = fields.get("header")
-        if header is not None:  # read before (see _lazy_class): keep the object handed out
-            decoded["header"] = header
-        _set_dict(message, decoded)
+        # A header read before (see _lazy_class) is the message's own: not decoded again.
+        _set_dict(message, _get(decode(real, data, fields.get("header")), "__dict__"))
     _set_class(message, "__class__", real)
     return message
 

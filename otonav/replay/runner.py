@@ -39,14 +39,12 @@ from otonav.runtime.funnel import Funnel
 from otonav.stack import StackConfig
 from otonav.stack.overrides import apply_overrides
 
-# Modules that load on first use, loaded here with the replay's own code rather than
-# inside the first replay of a process (the window its RTF is measured over): anyio's
-# asyncio backend (the first System to start), numpy's masked arrays (np.unique, which the
-# navigator's map calls, imports them). 12 + 7 ms in a fresh `otonav replay` process, the
-# same either way for the command as a whole (ADR 0036).
-for _module in ("anyio._backends._asyncio", "numpy.ma"):
-    with contextlib.suppress(ImportError):  # a library that reorganised: the replay pays
-        importlib.import_module(_module)
+# anyio loads its asyncio backend when the first System starts: 12 ms in a fresh
+# `otonav replay` process. Loaded here, with the replay's own code, rather than inside the
+# first replay's window (the span its RTF is measured over); the same for the command as
+# a whole (ADR 0036; `otonav run` does the same, ADR 0027).
+with contextlib.suppress(ImportError):  # a library that reorganised: the replay pays
+    importlib.import_module("anyio._backends._asyncio")
 
 
 @dataclass(slots=True)

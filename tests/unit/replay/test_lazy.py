@@ -9,7 +9,19 @@ from typing import Any
 
 import pytest
 
-from otonav.msgs import Header, LaserScan, Odometry, Pose, PoseWithCovariance, Time, Twist, Vector3
+from otonav.msgs import (
+    Header,
+    Imu,
+    LaserScan,
+    Message,
+    Odometry,
+    Pose,
+    PoseStamped,
+    PoseWithCovariance,
+    Time,
+    Twist,
+    Vector3,
+)
 from otonav.record.cdr import encode
 from otonav.record.cdr_decode import decode
 from otonav.replay.lazy import is_lazy, lazy, materialize
@@ -112,3 +124,21 @@ async def test_a_relayed_unread_input_passes_the_publishers_type_check() -> None
     # A wrong type is still refused.
     with pytest.raises(TopicTypeError):
         await publisher.publish(lazy(Vector3, encode(Vector3(x=1.0))))  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("frame", ["", "a", "ab", "abc", "odom", "laser_frame", "激光雷达"])
+@pytest.mark.parametrize("kind", [Odometry, LaserScan, Imu, PoseStamped])
+def test_a_message_decoded_after_its_header_is_the_same(frame: str, kind: type[Message]) -> None:
+    # Frame ids of every length mod 4: what follows the header starts at every alignment.
+    header = Header(stamp=Time(sec=7, nanosec=123), frame_id=frame)
+    fields: dict[str, object] = {"header": header}
+    if kind is LaserScan:
+        fields |= {"ranges": (1.0, 2.5), "intensities": (0.5,), "angle_min": -1.0}
+    message = kind.model_validate(fields)
+    data = encode(message)
+    alone = decode(Header, data)
+    assert alone == header
+    after = decode(kind, data, alone)
+    assert after == decode(kind, data) == message
+    assert after.header is alone  # type: ignore[attr-defined]
+    assert encode(after) == data
