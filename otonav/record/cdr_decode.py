@@ -25,10 +25,11 @@ from typing import Any, Final, TypeVar
 from pydantic import BaseModel
 
 from otonav.msgs import Header, Message
-from otonav.record.cdr import ENCAPSULATION, _Fixed, _leaves, _run_format, _Var
+from otonav.msgs.flat import FlatLayout
+from otonav.record.cdr import ENCAPSULATION, _Fixed, _leaves, _offsets, _run_format, _Var, encode
 from otonav.record.schemas import SEQUENCE, layout_for
 
-__all__ = ("decode",)
+__all__ = ("decode", "flat_values")
 
 M = TypeVar("M", bound=Message)
 
@@ -409,3 +410,55 @@ def decode(message: type[M], data: bytes, header: Header | None = None) -> M:
     if pos > len(data):
         raise ValueError(f"cannot decode {message.ros_type}: the data ends early")
     return result  # type: ignore[no-any-return]
+
+
+def flat_values(layout: FlatLayout[Any]) -> Callable[[bytes], tuple[Any, ...] | None]:
+    """The inverse of a fixed layout's packer (:mod:`otonav.msgs.flat`): from CDR bytes,
+    the values at ``layout.paths`` when everything else is the template's, byte for byte
+    (so ``layout(*values)`` is the message the bytes hold, and encodes to them); None
+    otherwise (another length, a frame id, a covariance, a -0.0 where the template has
+    0.0...). One precompiled ``unpack`` and a comparison per constant stretch: ~0.6 us
+    for an Odometry, against ~5 us to decode it."""
+    template = encode(layout.template)
+    offsets, _end = _offsets(layout.template)
+    places = sorted(
+        (len(ENCAPSULATION) + offsets[path][0], offsets[path][1], i)
+        for i, path in enumerate(layout.paths)
+    )
+    fmt, pos = "<", 0
+    constants: list[tuple[int, bytes]] = []  # (index in the unpacked tuple, bytes)
+    order: dict[int, int] = {}  # path index -> index in the unpacked tuple
+    items = 0
+    for at, code, i in places:
+        if at > pos:
+            constants.append((items, template[pos:at]))
+            fmt += f"{at - pos}s"
+            items += 1
+        fmt += code
+        order[i] = items
+        items += 1
+        pos = at + struct.calcsize(code)
+    if pos < len(template):
+        constants.append((items, template[pos:]))
+        fmt += f"{len(template) - pos}s"
+    unpack = struct.Struct(fmt)
+    names: dict[str, object] = {"_unpack": unpack.unpack, "_size": unpack.size, "_len": len}
+    checks = []
+    for k, (index, chunk) in enumerate(constants):
+        names[f"_c{k}"] = chunk
+        checks.append(f"r[{index}] != _c{k}")
+    picked = ", ".join(f"r[{order[i]}]" for i in range(len(layout.paths)))
+    source = (
+        f"def values_{layout.message_type.__name__}(data):\n"
+        "    if _len(data) != _size:\n"
+        "        return None\n"
+        "    r = _unpack(data)\n"
+        f"    if {' or '.join(checks) or 'False'}:\n"
+        "        return None\n"
+        f"    return ({picked},)\n"
+    )
+    exec(compile(source, f"<flat values of {layout!r}>", "exec"), names)
+    read: Callable[[bytes], tuple[Any, ...] | None] = names[
+        f"values_{layout.message_type.__name__}"
+    ]  # type: ignore[assignment]
+    return read

@@ -39,8 +39,9 @@ from dataclasses import dataclass
 from functools import partial
 from typing import Any, NamedTuple
 
+from otonav.actors.bridge import CLOCK, IMU, ODOM, TF
 from otonav.msgs import Message
-from otonav.replay.lazy import lazy, lazy_maker
+from otonav.replay.lazy import input_maker
 from otonav.replay.recording import RecordedMessage
 from otonav.runtime import Clock, Publisher, VirtualTimeLoop
 from otonav.runtime.timesource import tick_rate
@@ -251,6 +252,11 @@ class ReplayClock(Clock):
             handle.cancel()
 
 
+FLAT_LAYOUTS = (CLOCK, ODOM, TF, IMU)
+"""The bridge's fixed layouts: its /clock, /odom, /tf and /imu are fed as the flat
+messages it published (:func:`~otonav.replay.lazy.input_maker`)."""
+
+
 class _Route(NamedTuple):
     publisher: Publisher[Any]
     make: Callable[[bytes], Message]
@@ -306,7 +312,7 @@ class Feeder:
         subscriptions = publisher._topic.subscriptions
         route = self._routes[topic] = _Route(
             publisher,
-            lazy_maker(publisher.msg_type),
+            input_maker(publisher.msg_type, FLAT_LAYOUTS),
             subscriptions,
             tuple(s for s in subscriptions if s._reliable),
         )
@@ -333,7 +339,7 @@ class Feeder:
 
     async def _instant(self, instant: Instant, start: int) -> None:
         """Publish ``instant``'s steps from ``start`` on, holding actors as planned."""
-        gate, publishers = self._gate, self._publishers
+        gate = self._gate
         gate.holding = instant.holds
         idle = False  # the actors due now are parked (the loop went idle once)
         for step in instant.steps[start:]:
@@ -344,8 +350,8 @@ class Feeder:
                 gate.release(step.actors)
                 await self._idle()
                 continue
-            publisher = publishers[step.topic]
-            await _publish(publisher, lazy(publisher.msg_type, step.data))
+            route = self._route_of(step.topic)
+            await _publish(route.publisher, route.make(step.data))
             self.published += 1
         gate.holding = False
         if not instant.last:

@@ -19,16 +19,17 @@ publisher's slow path asks the object for its ``__class__``, which decodes it.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
 from pydantic import BaseModel
 
 from otonav.msgs import Header, Message
-from otonav.record.cdr_decode import decode
+from otonav.msgs.flat import FlatLayout
+from otonav.record.cdr_decode import decode, flat_values
 from otonav.record.schemas import layout_for
 
-__all__ = ("is_lazy", "lazy", "lazy_maker", "materialize")
+__all__ = ("input_maker", "is_lazy", "lazy", "lazy_maker", "materialize")
 
 M = TypeVar("M", bound=Message)
 
@@ -147,6 +148,32 @@ def lazy_maker(message_type: type[M]) -> Callable[[bytes], M]:
         _set_fields_set(message, fields)
         _set_extra(message, None)
         _set_private(message, None)
+        return message
+
+    return make
+
+
+def input_maker(
+    message_type: type[M], layouts: Sequence[FlatLayout[Any]] = ()
+) -> Callable[[bytes], M]:
+    """How a replay makes its ``message_type`` inputs from their CDR bytes: as a fixed
+    layout's flat message (:mod:`otonav.msgs.flat`) when ``layouts`` has one for the
+    type and the bytes are that layout's template with its values in place (what the
+    bridge publishes: the same kind of object the live stack handed the actors, whose
+    readers take the values without building anything), else lazily. Either is, from
+    its first use, the decoded message (tested on every recorded /odom, /tf, /imu and
+    /clock of the acceptance run)."""
+    make_lazy = lazy_maker(message_type)
+    layout = next((f for f in layouts if f.message_type is message_type), None)
+    if layout is None:
+        return make_lazy
+    values_of = flat_values(layout)
+
+    def make(data: bytes) -> M:
+        values = values_of(data)
+        if values is None:
+            return make_lazy(data)
+        message: M = layout(*values)
         return message
 
     return make

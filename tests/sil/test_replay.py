@@ -16,12 +16,15 @@ import pytest
 
 from otonav.cli import main as cli_main
 from otonav.hal import RobotHardwareInterface
-from otonav.msgs import Message, Odometry, PoseStamped, Twist
+from otonav.msgs import Clock, Imu, Message, Odometry, PoseStamped, TFMessage, Twist
+from otonav.msgs.flat import is_flat
 from otonav.nav import GoalCommand, go_to_goal
 from otonav.record.cdr_decode import decode
 from otonav.record.reader import MAGIC, read_messages, summarize
 from otonav.record.writer import RecordingWriter
 from otonav.replay import nodes, replay_recording
+from otonav.replay.feed import FLAT_LAYOUTS
+from otonav.replay.lazy import input_maker
 from otonav.replay.nodes import stack_actor_names
 from otonav.replay.recording import load_recording
 from otonav.runtime import JumpSource, VirtualTimeLoop
@@ -98,6 +101,22 @@ def test_the_recorded_robot_spares_building_the_world(
     result = replay_recording(older, ["nav", "base"])
     assert result.byte_identical, result.first_divergence
     assert len(built) == 1
+
+
+def test_the_bridges_streams_are_fed_as_the_flat_messages_it_published(acceptance: Path) -> None:
+    recorded = load_recording(acceptance, ["/odom", "/tf", "/imu", "/clock"]).messages
+    kinds: dict[str, type[Message]] = {
+        "/odom": Odometry,
+        "/tf": TFMessage,
+        "/imu": Imu,
+        "/clock": Clock,
+    }
+    assert len(recorded) > 4 * 1000
+    for message in recorded:
+        kind = kinds[message.topic]
+        fed = input_maker(kind, FLAT_LAYOUTS)(message.data)
+        assert is_flat(fed), message.topic
+        assert fed == decode(kind, message.data)
 
 
 def test_the_pytest_helper_and_a_user_actor_by_import_path(acceptance: Path) -> None:

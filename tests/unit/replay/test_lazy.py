@@ -9,12 +9,14 @@ from typing import Any
 
 import pytest
 
+from otonav.actors.bridge import ODOM as ODOM_LAYOUT
 from otonav.msgs import (
     Header,
     Imu,
     LaserScan,
     Message,
     Odometry,
+    Point,
     Pose,
     PoseStamped,
     PoseWithCovariance,
@@ -22,9 +24,11 @@ from otonav.msgs import (
     Twist,
     Vector3,
 )
+from otonav.msgs.flat import flat_state, is_flat
 from otonav.record.cdr import encode
 from otonav.record.cdr_decode import decode
-from otonav.replay.lazy import is_lazy, lazy, materialize
+from otonav.replay.feed import FLAT_LAYOUTS
+from otonav.replay.lazy import input_maker, is_lazy, lazy, materialize
 from otonav.runtime import QoS, Reliability, TopicTypeError
 from otonav.runtime.mailbox import Bus, Endpoint
 
@@ -142,3 +146,43 @@ def test_a_message_decoded_after_its_header_is_the_same(frame: str, kind: type[M
     assert after == decode(kind, data) == message
     assert after.header is alone  # type: ignore[attr-defined]
     assert encode(after) == data
+
+
+def test_inputs_of_a_fixed_layout_are_fed_as_its_flat_messages() -> None:
+    make = input_maker(Odometry, FLAT_LAYOUTS)
+    values = (12, 340_000_000, 1.25, -0.5, 0.2, 0.98, 0.3, -0.1)
+    published = ODOM_LAYOUT(*values)  # what the bridge publishes
+    data = encode(published)
+    fed = make(data)
+    assert is_flat(fed)
+    assert flat_state(fed) == (ODOM_LAYOUT, values)
+    assert fed == decode(Odometry, data)
+    assert encode(fed) == data
+    # Bytes that are not the template's with values in place: decoded, lazily.
+    decoded = decode(Odometry, data)
+    for changed in (
+        decoded.model_copy(update={"child_frame_id": "base_footprint"}),
+        decoded.model_copy(update={"header": Header(stamp=Time(sec=12), frame_id="map")}),
+        decoded.model_copy(
+            update={"pose": PoseWithCovariance(pose=decoded.pose.pose, covariance=(0.0,) * 36)}
+        ),
+    ):
+        other = make(encode(changed))
+        assert not is_flat(other)
+        assert is_lazy(other)
+        assert other == changed
+    # -0.0 where the template has 0.0 (position.z) is another byte: not the layout's.
+    z = decoded.model_copy(
+        update={
+            "pose": decoded.pose.model_copy(
+                update={
+                    "pose": decoded.pose.pose.model_copy(
+                        update={"position": Point(x=1.25, y=-0.5, z=-0.0)}
+                    )
+                }
+            )
+        }
+    )
+    assert is_lazy(make(encode(z)))
+    # A type with no layout is fed lazily.
+    assert is_lazy(input_maker(LaserScan, FLAT_LAYOUTS)(encode(SCAN)))
