@@ -106,6 +106,14 @@ def main() -> None:
             f"  {name:<26} RTF {median:5.0f}x [{min(values):.0f}..{max(values):.0f}]"
             f"  = {sim / median * 1e3:6.1f} ms"
         )
+    if args.baseline is not None:
+        print("this against the baseline, median of the per-repetition ratios:")
+        for nodes in NODES:
+            ratios = [
+                a / b
+                for a, b in zip(rtfs[f"CLI this {nodes}"], rtfs[f"CLI baseline {nodes}"], strict=True)
+            ]
+            print(f"  {nodes:<26} RTF x {statistics.median(ratios):.2f}")
     print("wall times:")
     for name, values in walls.items():
         median = statistics.median(values)
