@@ -109,10 +109,8 @@ def main() -> None:
     if args.baseline is not None:
         print("this against the baseline, median of the per-repetition ratios:")
         for nodes in NODES:
-            ratios = [
-                a / b
-                for a, b in zip(rtfs[f"CLI this {nodes}"], rtfs[f"CLI baseline {nodes}"], strict=True)
-            ]
+            pairs = zip(rtfs[f"CLI this {nodes}"], rtfs[f"CLI baseline {nodes}"], strict=True)
+            ratios = [a / b for a, b in pairs]
             print(f"  {nodes:<26} RTF x {statistics.median(ratios):.2f}")
     print("wall times:")
     for name, values in walls.items():
