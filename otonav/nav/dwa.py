@@ -57,6 +57,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, fields
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -136,9 +137,9 @@ class DwaParams:
             raise ValueError(f"DwaParams.dt ({self.dt} s) must be <= horizon ({self.horizon} s)")
 
 
-@dataclass(frozen=True, slots=True)
-class DwaResult:
-    """Output of :func:`dwa_step`.
+class DwaResult(NamedTuple):
+    """Output of :func:`dwa_step` (a named tuple: immutable, and made in a third of
+    a frozen dataclass's time, once per step).
 
     Attributes:
         v: forward speed command, m/s.

@@ -36,6 +36,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -119,9 +120,9 @@ class NavigationParams:
     kp_ang: float = 2.0
 
 
-@dataclass(frozen=True, slots=True)
-class NavOutput:
-    """One step's command and what explains it."""
+class NavOutput(NamedTuple):
+    """One step's command and what explains it. A named tuple, immutable like a frozen
+    dataclass but made in ~0.7 us instead of ~2.7 us (one per step)."""
 
     v: float
     omega: float
@@ -400,12 +401,12 @@ class Navigation:
         if path is None:
             return self.goal
         d = np.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1])
-        i = int(np.argmin(d))
-        beyond = np.flatnonzero(d[i:] >= self.params.lookahead)
-        if beyond.size == 0:
+        i = int(d.argmin())  # (the array methods: no np.argmin/np.flatnonzero wrappers)
+        beyond = d[i:] >= self.params.lookahead
+        j = i + int(beyond.argmax())  # the first True, or i when there is none
+        if not beyond[j - i]:
             return self.goal
-        p = path[i + int(beyond[0])]
-        return float(p[0]), float(p[1])
+        return float(path[j, 0]), float(path[j, 1])
 
     def _begin(
         self,
