@@ -147,6 +147,12 @@ class CanBusInterface(RobotHardwareInterface):
         self._serviced_at = -1  # the tick of the last bus instant
         self._sent = False  # frames sent since then (the peer must hear them)
         self._tick = sensors.tick
+        # The sensor readings are the source's own: bound here, they skip a delegating
+        # call each (the bridge and the judge read them at every 10 ms instant).
+        self.read_imu = sensors.read_imu  # type: ignore[method-assign]
+        self.read_scan = sensors.read_scan  # type: ignore[method-assign]
+        self.ground_truth = sensors.ground_truth  # type: ignore[method-assign]
+        self._geometry = sensors.geometry  # the robot's shape does not change as it runs
         self._start(sensors.ticks * self._tick)
 
     @property
@@ -353,7 +359,7 @@ class CanBusInterface(RobotHardwareInterface):
 
     @property
     def geometry(self) -> RobotGeometry:
-        return self._sensors.geometry
+        return self._geometry
 
     def obstacles(self) -> tuple[BoxObstacle, ...]:
         return self._sensors.obstacles()

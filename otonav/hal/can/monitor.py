@@ -249,7 +249,14 @@ class DriveMonitor:
 
     def _check_running(self, now: float) -> tuple[Action, ...]:
         limits = self.limits
+        # The earliest instant a timeout could fire next (see check()).
+        quiet = math.inf
         for node in self._nodes.values():
+            quiet = min(
+                quiet,
+                node.heartbeat_at + limits.heartbeat_timeout,
+                node.encoder_at + limits.encoder_timeout,
+            )
             age = now - node.heartbeat_at
             if age > limits.heartbeat_timeout + 1e-9:
                 self._enter_fault(
@@ -290,12 +297,7 @@ class DriveMonitor:
                 return (Action.ZERO_ALL,)
         if now >= self._loss_due:
             self._loss_due = now + limits.loss_window / 10.0
-        nodes = self._nodes.values()
-        self._quiet_until = min(
-            min(n.heartbeat_at for n in nodes) + limits.heartbeat_timeout,
-            min(n.encoder_at for n in nodes) + limits.encoder_timeout,
-            self._loss_due,
-        )
+        self._quiet_until = min(quiet, self._loss_due)
         return ()
 
     def _loss(self, node: _Node, now: float, since: float) -> float | None:
