@@ -11,7 +11,18 @@ import anyio
 from otonav.actors import topics
 from otonav.control import DiffDriveGeometry, limit_twist, twist_to_wheels
 from otonav.msgs import HardwareStatus, Header, Log, Time, Twist, WheelCommand
+from otonav.msgs.flat import FlatLayout
 from otonav.runtime import Actor, Input, Output
+
+WHEEL_COMMAND = FlatLayout(
+    WheelCommand.fast(
+        header=Header.fast(stamp=Time.fast(sec=0, nanosec=0), frame_id="base_link"),
+        left=0.0,
+        right=0.0,
+    ),
+    ("header.stamp.sec", "header.stamp.nanosec", "left", "right"),
+)
+"""/wheel_cmd as a fixed layout (otonav.msgs.flat): sec, nanosec, left, right."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -118,13 +129,10 @@ class BaseController(Actor):
                 max_alpha=limits.max_alpha,
             )
             left, right = twist_to_wheels(v, omega, self.geometry)
-            await self.wheel_cmd.publish(
-                WheelCommand.fast(
-                    header=Header.fast(stamp=Time.from_seconds(now), frame_id="base_link"),
-                    left=left,
-                    right=right,
-                )
-            )
+            sec, nanosec = divmod(round(now * 1e9), 1_000_000_000)  # Time.from_seconds'
+            command = WHEEL_COMMAND(sec, nanosec, left, right)
+            if not self.wheel_cmd.try_publish(command):
+                await self.wheel_cmd.publish(command)
 
     def _reject(self, command: Twist, now: float) -> None:
         self.rejected_commands += 1

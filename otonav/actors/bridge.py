@@ -6,6 +6,9 @@ from __future__ import annotations
 import contextlib
 import logging
 import math
+from collections import deque
+from collections.abc import Awaitable, Callable
+from typing import Any
 
 import anyio
 import numpy as np
@@ -38,10 +41,16 @@ from otonav.msgs import (
     Vector3,
     WheelCommand,
 )
-from otonav.msgs.flat import FlatLayout
-from otonav.runtime import Actor, Input, Output
+from otonav.msgs.flat import FlatLayout, reader
+from otonav.runtime import Actor, Input, Output, Publisher
 
 log = logging.getLogger("otonav.hal")
+
+_read_wheel_command = reader(WheelCommand, "left", "right")
+"""left, right of a /wheel_cmd without building a flat one's header."""
+
+_Now = Callable[[int, int, float], None]
+_Waiting = Callable[[int, int, float], Awaitable[None]]
 
 _LOG_LEVELS = {
     HealthLevel.OK: (Log.INFO, logging.INFO),
@@ -210,6 +219,7 @@ class Bridge(Actor):
         self._last_odom_time = 0.0
         self._imu_sample: ImuSample | None = None
         self._imu_time = -1.0
+        self._pending: deque[tuple[Publisher[Any], Any]] = deque()
 
     async def on_start(self) -> None:
         """/tf_static: base_link -> laser and base_link -> imu_link (latched), so a
@@ -243,22 +253,24 @@ class Bridge(Actor):
 
     async def _apply_commands(self) -> None:
         async for cmd in self.wheel_cmd:
-            self.hal.write(HalWheelCommand(cmd.left, cmd.right))
+            self.hal.write(HalWheelCommand(*_read_wheel_command(cmd)))
 
     async def _publish_loop(self) -> None:
         """One timer for all streams: wake at the earliest due instant, publish every
         stream due then, in a fixed order (clock, odom, imu, scan): deterministic, and
         one wake per instant instead of one per stream."""
         start = self.clock.now()
-        publishers = (
-            (self._periods["clock"], self._publish_clock),
-            (self._periods["odom"], self._publish_odom),
-            (self._periods["imu"], self._publish_imu),
-            (self._periods["scan"], self._publish_scan),
-            (self._periods["diagnostics"], self._publish_diagnostics),
+        # (period, publish now, or publish waiting): the 100 Hz streams publish without a
+        # coroutine each (_send), the scan and diagnostics as coroutines.
+        publishers: tuple[tuple[float, _Now | None, _Waiting | None], ...] = (
+            (self._periods["clock"], self._publish_clock, None),
+            (self._periods["odom"], self._publish_odom, None),
+            (self._periods["imu"], self._publish_imu, None),
+            (self._periods["scan"], None, self._publish_scan),
+            (self._periods["diagnostics"], None, self._publish_diagnostics),
         )
         counts = [1] * len(publishers)
-        due = [start + period for period, _ in publishers]
+        due = [start + period for period, _, _ in publishers]
         self._last_odom_time = start
         wheels = self.hal.read_wheels()  # odometry counts motion from the start
         self._last_wheels = (wheels.left_position, wheels.right_position)
@@ -273,16 +285,34 @@ class Bridge(Actor):
                 await self._check_health(now)
             # Time.from_seconds(now)'s two integers, without the Time object.
             sec, nanosec = divmod(round(now * 1e9), 1_000_000_000)
-            for i, (period, publish) in enumerate(publishers):
+            for i, (period, publish, publish_waiting) in enumerate(publishers):
                 if due[i] <= instant + 1e-12:
                     counts[i] += 1
                     due[i] = start + counts[i] * period  # no drift: k periods from start
-                    await publish(sec, nanosec, now)
+                    if publish is not None:
+                        publish(sec, nanosec, now)
+                    elif publish_waiting is not None:
+                        await self._publish_pending()  # in order
+                        await publish_waiting(sec, nanosec, now)
+            await self._publish_pending()
 
-    async def _publish_clock(self, sec: int, nanosec: int, _now: float) -> None:
-        await self.clock_out.publish(CLOCK(sec, nanosec))
+    async def _publish_pending(self) -> None:
+        """What found a full reliable mailbox (:meth:`_send`), in order, waiting."""
+        pending = self._pending
+        while pending:
+            publisher, message = pending.popleft()
+            await publisher.publish(message)
 
-    async def _publish_odom(self, sec: int, nanosec: int, now: float) -> None:
+    def _send(self, publisher: Publisher[Any], message: Any) -> None:
+        """Publish without a coroutine (:meth:`Publisher.try_publish`); once a mailbox is
+        full, this and every later message of the instant wait in order (in the loop)."""
+        if self._pending or not publisher.try_publish(message):
+            self._pending.append((publisher, message))
+
+    def _publish_clock(self, sec: int, nanosec: int, _now: float) -> None:
+        self._send(self.clock_out, CLOCK(sec, nanosec))
+
+    def _publish_odom(self, sec: int, nanosec: int, now: float) -> None:
         hal = self.hal
         wheels = hal.read_wheels()
         gyro_z = self._imu_at(now).angular_velocity[2]
@@ -302,8 +332,8 @@ class Bridge(Actor):
             self._pose = integrate_odometry(self._pose, v, gyro_z, dt)
         pose = self._pose
         qz, qw = math.sin(pose.yaw / 2), math.cos(pose.yaw / 2)  # Quaternion.from_yaw's
-        await self.odom.publish(ODOM(sec, nanosec, pose.x, pose.y, qz, qw, v, gyro_z))
-        await self.tf.publish(TF(sec, nanosec, pose.x, pose.y, qz, qw))
+        self._send(self.odom, ODOM(sec, nanosec, pose.x, pose.y, qz, qw, v, gyro_z))
+        self._send(self.tf, TF(sec, nanosec, pose.x, pose.y, qz, qw))
 
     def _imu_at(self, now: float) -> ImuSample:
         """One IMU read per instant, shared by odometry and /imu (it was read twice)."""
@@ -312,11 +342,12 @@ class Bridge(Actor):
             self._imu_time = now
         return self._imu_sample
 
-    async def _publish_imu(self, sec: int, nanosec: int, now: float) -> None:
+    def _publish_imu(self, sec: int, nanosec: int, now: float) -> None:
         sample = self._imu_at(now)
         w, x, y, z = sample.orientation
-        await self.imu.publish(
-            IMU(sec, nanosec, x, y, z, w, *sample.angular_velocity, *sample.linear_acceleration)
+        self._send(
+            self.imu,
+            IMU(sec, nanosec, x, y, z, w, *sample.angular_velocity, *sample.linear_acceleration),
         )
 
     async def _publish_scan(self, sec: int, nanosec: int, _now: float) -> None:

@@ -94,12 +94,11 @@ class Recorder(Actor):
     def drain(self) -> None:
         """Write everything still queued (on stop, and before a verdict is appended)."""
         funnel, writer = self.funnel, self.writer
-        deliveries = iter(funnel.try_recv, None)
-        if writer.finished:
-            for _ in deliveries:  # taken, and nowhere to write them
-                pass
-            return
-        writer.write_all(deliveries)
+        # Taken until none is left: writing cannot publish, but a blocked publisher
+        # woken by the room made is served on its own turn, not inside this call.
+        while deliveries := funnel.take_all():
+            if not writer.finished:  # else: taken, and nowhere to write them
+                writer.write_all(deliveries)
 
     async def on_stop(self) -> None:
         self.drain()

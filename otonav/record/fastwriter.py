@@ -98,5 +98,74 @@ class FastWriter(Writer):
             return True
         return False
 
+    def add_batch(self, records: list[tuple[int, int, bytes, int]]) -> int:
+        """:meth:`add_message_and_check` for each ``(channel_id, log_time, data,
+        sequence)`` in order (log time = publish time, as the recorder writes them), with
+        the writer's state in locals and the records joined into one write per chunk:
+        the same bytes, statistics and index (a chunk is finished after the message that
+        takes it past the chunk size, as there). Returns how many chunks were finished.
+        A recorder's drain: 2.5 -> ? us per recorded message, writer included."""
+        if not SUPPORTED:
+            return sum(self.add_message_and_check(c, t, d, t, s) for c, t, d, s in records)
+        stats: Any = self._Writer__statistics  # type: ignore[attr-defined]
+        limit: int = self._Writer__chunk_size  # type: ignore[attr-defined]
+        counts = stats.channel_message_counts
+        pack = _HEADER.pack
+        finished = 0
+        start = 0
+        while start < len(records):
+            chunk: Any = self._Writer__chunk_builder  # type: ignore[attr-defined]
+            buffer = chunk.record_writer._buffer
+            indices = chunk.message_indices
+            pos = buffer.tell()
+            parts: list[bytes] = []
+            first = chunk.num_messages == 0
+            chunk_start, chunk_end = chunk.message_start_time, chunk.message_end_time
+            stats_empty = stats.message_count == 0
+            stats_start, stats_end = stats.message_start_time, stats.message_end_time
+            full = False
+            i = start
+            for i in range(start, len(records)):
+                channel_id, log_time, data, sequence = records[i]
+                if stats_empty or log_time < stats_start:
+                    stats_start, stats_empty = log_time, False
+                if log_time > stats_end:
+                    stats_end = log_time
+                counts[channel_id] += 1
+                if first or log_time < chunk_start:
+                    chunk_start, first = log_time, False
+                if log_time > chunk_end:
+                    chunk_end = log_time
+                index = indices.get(channel_id)
+                if index is None:
+                    index = indices[channel_id] = _MessageIndex(channel_id=channel_id, records=[])
+                index.records.append((log_time, pos))
+                parts.append(
+                    pack(
+                        _MESSAGE_OPCODE,
+                        _FIELDS_LENGTH + len(data),
+                        channel_id,
+                        sequence,
+                        log_time,
+                        log_time,
+                    )
+                )
+                parts.append(data)
+                pos += _HEADER.size + len(data)
+                if pos > limit:
+                    full = True
+                    break
+            taken = i + 1 - start
+            buffer.write(b"".join(parts))
+            chunk.num_messages += taken
+            chunk.message_start_time, chunk.message_end_time = chunk_start, chunk_end
+            stats.message_count += taken
+            stats.message_start_time, stats.message_end_time = stats_start, stats_end
+            start = i + 1
+            if full:
+                self._Writer__finalize_chunk()  # type: ignore[attr-defined]
+                finished += 1
+        return finished
+
     def _chunks_written(self) -> int:
         return int(self._Writer__statistics.chunk_count)  # type: ignore[attr-defined]

@@ -89,27 +89,41 @@ class RecordingWriter:
 
     def write_all(self, deliveries: Iterable[tuple[str, float, Message]]) -> None:
         """:meth:`write` each ``(topic, sim_time, message)`` in order (a recorder's
-        drain): the same records, with the per-message lookups hoisted out of the loop.
-        A subclass that overrides :meth:`write` gets its :meth:`write` called."""
+        drain): the same records, encoded one after another and handed to the MCAP
+        writer as one batch (:meth:`FastWriter.add_batch`), split where a message opens
+        a new channel (its channel record goes into the chunk before that message, as
+        :meth:`write` puts it). A subclass that overrides :meth:`write` gets its
+        :meth:`write` called."""
         if type(self).write is not RecordingWriter.write:
             for topic, sim_time, message in deliveries:
                 self.write(topic, message, sim_time)
             return
         channels, sequences = self._channels, self._sequence
-        add, flush = self._writer.add_message_and_check, self._file.flush
-        written = 0
+        batch: list[tuple[int, int, bytes, int]] = []
+        chunks = 0
         try:
             for topic, sim_time, message in deliveries:
                 channel_id = channels.get(topic)
                 if channel_id is None:
+                    chunks += self._add_batch(batch)
                     channel_id = self._channel(topic, real_type(type(message)))
                 stamp = round(sim_time * 1e9)
                 sequence = sequences[channel_id] = sequences[channel_id] + 1
-                if add(channel_id, stamp, encode(message), stamp, sequence):
-                    flush()
-                written += 1
+                batch.append((channel_id, stamp, encode(message), sequence))
         finally:
-            self.messages += written
+            # What was encoded is written even when a later message fails to encode
+            # (write() would have written each one before the failure, too).
+            chunks += self._add_batch(batch)
+            if chunks:
+                self._file.flush()
+
+    def _add_batch(self, batch: list[tuple[int, int, bytes, int]]) -> int:
+        if not batch:
+            return 0
+        chunks = self._writer.add_batch(batch)
+        self.messages += len(batch)
+        batch.clear()
+        return chunks
 
     def add_metadata(self, name: str, data: dict[str, str]) -> None:
         self._writer.add_metadata(name, data)

@@ -114,8 +114,10 @@ class VirtualClock(Clock):
         handle = loop.call_at(sim_time, _wake, future)
         try:
             await future
-        finally:
-            handle.cancel()
+        except BaseException:
+            handle.cancel()  # woken otherwise (cancelled): the timer must not fire
+            raise
+        # Woken by the timer: it has run, nothing to cancel (a cancel call per wake less).
 
 
 def _wake(future: asyncio.Future[None]) -> None:

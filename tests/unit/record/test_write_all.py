@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from otonav.actors.bridge import CLOCK, ODOM
 from otonav.msgs import Clock, Header, Log, Message, Time
 from otonav.record.writer import RecordingWriter
 
@@ -16,7 +17,7 @@ pytestmark = pytest.mark.unit
 def _deliveries() -> list[tuple[str, float, Message]]:
     out: list[tuple[str, float, Message]] = []
     for n in range(3000):  # several 4 KiB chunks, channels appearing as they come
-        t = n * 0.01
+        t = 1.0 + n * 0.01
         stamp = Time.from_seconds(t)
         out.append(("/clock", t, Clock(clock=stamp)))
         if n % 3 == 0:
@@ -25,6 +26,11 @@ def _deliveries() -> list[tuple[str, float, Message]]:
             )
         if n % 5 == 0:
             out.append((f"/h{n % 2}", t, Header(stamp=stamp, frame_id="f" * (n % 7))))
+        if n % 4 == 1:  # fixed-layout messages, packed rather than encoded field by field
+            out.append(("/flat_clock", t, CLOCK(stamp.sec, stamp.nanosec)))
+            out.append(("/odom", t, ODOM(stamp.sec, stamp.nanosec, t, -t, 0.0, 1.0, 0.5, n)))
+        if n % 97 == 1:  # a publisher that waited for room: stamped earlier
+            out.append(("/late", t - 0.5, Clock(clock=Time.from_seconds(t - 0.5))))
     return out
 
 
@@ -56,3 +62,17 @@ def test_a_subclass_that_overrides_write_sees_every_message(tmp_path: Path) -> N
     with Spy(tmp_path / "s.mcap") as writer:
         writer.write_all(iter(_deliveries()[:50]))
     assert seen == [topic for topic, _, _ in _deliveries()[:50]]
+
+
+def test_what_was_encoded_before_a_bad_message_is_written(tmp_path: Path) -> None:
+    good = _deliveries()[:40]
+    bad = ("/clock", 1.0, Clock.model_construct(clock=Time.model_construct(sec=2**40)))
+    with RecordingWriter(tmp_path / "a.mcap") as writer:
+        with pytest.raises(ValueError, match="cannot encode"):
+            writer.write_all(iter([*good, bad]))
+        assert writer.messages == len(good)
+    with RecordingWriter(tmp_path / "b.mcap") as writer:
+        for topic, t, message in good:
+            writer.write(topic, message, t)
+        writer._sequence[writer._channels["/clock"]] += 1  # the bad one took its number
+    assert (tmp_path / "a.mcap").read_bytes() == (tmp_path / "b.mcap").read_bytes()

@@ -66,3 +66,34 @@ def test_backpressure_keeps_publication_stamps_and_first_come_first_served() -> 
     # /b blocked first, so it goes first, although /a sorts first by name; each keeps
     # the instant it was published at, not the instant room was found.
     assert got == [("/b", 0.0, 0), ("/b", 0.0, 1), ("/a", 0.2, 2)]
+
+
+def test_take_all_is_every_try_recv_at_once_and_counts_what_was_taken() -> None:
+    bus = Bus()
+    pubs = {t: bus.publisher(t, Msg, endpoint=Endpoint("x", t)) for t in ("/b", "/a")}
+
+    async def main() -> tuple[list[tuple[str, float, int]], dict[str, int], int]:
+        funnel = Funnel(bus, "rec", anyio.current_time, depth=3)
+        got: list[tuple[str, float, int]] = []
+        async with anyio.create_task_group() as tg:
+            for n in range(3):
+                await pubs["/b" if n % 2 else "/a"].publish(Msg(n))
+                await anyio.sleep(0.1)
+            tg.start_soon(pubs["/a"].publish, Msg(3))  # the funnel is full: it waits
+            await anyio.sleep(0.1)
+            got += [(t, time, m.n) for t, time, m in funnel.take_all()]
+            await anyio.sleep(0.1)  # the waiting publisher got its room and delivered
+            got += [(t, time, m.n) for t, time, m in funnel.take_all()]
+            assert funnel.take_all() == []
+        taken = {topic: tap.taken for topic, tap in funnel.taps.items()}
+        return got, taken, funnel.statistics().blocked_publishes
+
+    got, taken, blocked = anyio.run(main, backend_options={"loop_factory": virtual_loop_factory()})
+    assert [(t, round(time, 6), n) for t, time, n in got] == [
+        ("/a", 0.0, 0),
+        ("/b", 0.1, 1),
+        ("/a", 0.2, 2),
+        ("/a", 0.3, 3),
+    ]
+    assert taken == {"/a": 3, "/b": 1}
+    assert blocked == 1

@@ -356,3 +356,23 @@ def test_a_late_transient_local_joiner_mid_delivery_gets_the_message_once(late: 
         assert got == [Ping(0), Ping(1)]
 
     _run(main)
+
+
+def test_try_publish_delivers_to_all_or_to_none() -> None:
+    bus = Bus()
+    pub = bus.publisher("/data", Ping, endpoint=Endpoint("p", "out"))
+    loose = bus.subscribe(
+        "/data", Ping, QoS(Reliability.BEST_EFFORT, depth=1), endpoint=Endpoint("a", "in")
+    )
+    strict = bus.subscribe("/data", Ping, QoS(depth=2), endpoint=Endpoint("b", "in"))
+    assert pub.try_publish(Ping(0))
+    assert pub.try_publish(Ping(1))
+    # The reliable mailbox is full: nothing is delivered, to anyone, and nothing counted.
+    assert not pub.try_publish(Ping(2))
+    assert pub.published == 2
+    assert [m.n for m in loose.drain()] == [1]  # best effort kept the newest
+    assert [m.n for m in strict.drain()] == [0, 1]
+    assert pub.try_publish(Ping(3))
+    assert [m.n for m in strict.drain()] == [3]
+    with pytest.raises(TopicTypeError):
+        pub.try_publish("not a ping")  # type: ignore[arg-type]
