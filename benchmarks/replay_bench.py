@@ -8,7 +8,8 @@ The figure issue 15 asks for is the replay RTF the command prints: a user runs
 span over the replay's wall time (from opening the recording to the end of the comparison;
 starting Python and importing otonav are before it, as for every command). So each
 repetition runs the CLI as a user does, in a new process, and reads the figure it
-printed ("CLI"); it also times the whole command, start to exit ("process"). Beside it, a
+printed ("CLI"), and the CPU time it prints beside it (what a busy machine changes
+least); it also times the whole command, start to exit ("process"). Beside it, a
 replay in this process, warm (``replay_recording``: what a test suite replaying a
 directory of recordings pays per file), with its CPU time, which follows the machine's
 load less than wall time.
@@ -37,11 +38,16 @@ from otonav.replay import replay_recording
 from otonav.scenario import ScenarioConfig, run_scenario
 
 NODES = ("nav", "base", "nav,base")
-_PRINTED = re.compile(r"of\s+sim\s+time\s+in\s+([0-9.]+)\s+s\s+\(([0-9]+)x\)")
+_PRINTED = re.compile(
+    r"of\s+sim\s+time\s+in\s+([0-9.]+)\s+s\s+\(([0-9]+)x(?:;\s+CPU\s+([0-9.]+)\s+s)?\)"
+)
 
 
-def run_cli(python: Path, cwd: Path, recording: Path, nodes: str) -> tuple[float, float]:
-    """(the RTF the command printed, the command's wall time s, start to exit)."""
+def run_cli(
+    python: Path, cwd: Path, recording: Path, nodes: str
+) -> tuple[float, float | None, float]:
+    """(the RTF the command printed, the CPU time s it printed (None: a version that
+    does not print it), the command's wall time s, start to exit)."""
     start = time.perf_counter()
     done = subprocess.run(
         [str(python), "-m", "otonav", "replay", str(recording), "--node", nodes],
@@ -54,7 +60,8 @@ def run_cli(python: Path, cwd: Path, recording: Path, nodes: str) -> tuple[float
     found = _PRINTED.search(done.stdout)
     if done.returncode != 0 or found is None:
         sys.exit(f"{python} replay --node {nodes}: exit {done.returncode}\n{done.stdout}")
-    return float(found.group(2)), wall
+    cpu = found.group(3)
+    return float(found.group(2)), None if cpu is None else float(cpu), wall
 
 
 def main() -> None:
@@ -85,9 +92,11 @@ def main() -> None:
                 if rep % 2:
                     order.reverse()
                 for side, (python, cwd) in order:
-                    rtf, wall = run_cli(python, cwd, recording, nodes)
+                    rtf, cli_cpu, wall = run_cli(python, cwd, recording, nodes)
                     if rep:
                         rtfs.setdefault(f"CLI {side} {nodes}", []).append(rtf)
+                        if cli_cpu is not None:
+                            cpus.setdefault(f"CLI {side} {nodes}", []).append(cli_cpu)
                         walls.setdefault(f"process {side} {nodes}", []).append(wall)
                 cpu = time.process_time()
                 result = replay_recording(recording, nodes.split(","))
@@ -106,6 +115,12 @@ def main() -> None:
             f"  {name:<26} RTF {median:5.0f}x [{min(values):.0f}..{max(values):.0f}]"
             f"  = {sim / median * 1e3:6.1f} ms"
         )
+    if args.baseline is not None:
+        print("this against the baseline, median of the per-repetition ratios:")
+        for nodes in NODES:
+            pairs = zip(rtfs[f"CLI this {nodes}"], rtfs[f"CLI baseline {nodes}"], strict=True)
+            ratios = [a / b for a, b in pairs]
+            print(f"  {nodes:<26} RTF x {statistics.median(ratios):.2f}")
     print("wall times:")
     for name, values in walls.items():
         median = statistics.median(values)

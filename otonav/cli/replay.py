@@ -102,7 +102,7 @@ def print_result(result: ReplayResult, console: Console) -> None:
     console.print(
         f"replayed {', '.join(result.nodes)} against {result.recording}: "
         f"{result.sim_time_s:.3f} s of sim time in {result.wall_time_s:.3f} s "
-        f"({result.rtf:.0f}x); fed {fed}"
+        f"({result.rtf:.0f}x; CPU {result.cpu_time_s:.3f} s); fed {fed}"
     )
     for t in result.topics:
         line = (

@@ -18,6 +18,7 @@ else is a ``ValueError`` naming the type.
 
 from __future__ import annotations
 
+import functools
 import struct
 from collections.abc import Callable
 from typing import Any, Final, TypeVar
@@ -412,6 +413,7 @@ def decode(message: type[M], data: bytes, header: Header | None = None) -> M:
     return result  # type: ignore[no-any-return]
 
 
+@functools.cache  # layouts are module constants: compiled once per process
 def flat_values(layout: FlatLayout[Any]) -> Callable[[bytes], tuple[Any, ...] | None]:
     """The inverse of a fixed layout's packer (:mod:`otonav.msgs.flat`): from CDR bytes,
     the values at ``layout.paths`` when everything else is the template's, byte for byte

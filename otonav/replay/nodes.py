@@ -38,9 +38,18 @@ NOT_REPLAYABLE: dict[str, str] = {
 
 def stack_actor_names(stack: StackConfig, geometry: RobotGeometry | None = None) -> list[str]:
     """The names of the actors the stack builds from ``stack`` that replay can run."""
+    return [a.name for a in _stack_actors(stack, geometry) if a.name not in NOT_REPLAYABLE]
+
+
+def _stack_actors(stack: StackConfig, geometry: RobotGeometry | None) -> list[Actor]:
     hal = _robot(stack, geometry)
     try:
-        return [a.name for a in build_actors(stack, hal) if a.name not in NOT_REPLAYABLE]
+        return build_actors(stack, hal)
+    except ImportError as exc:  # a CAN stack's modules without the extra
+        raise ReplayInputError(
+            f"hal.kind: {stack.hal.kind} needs a module that is not installed ({exc.name}): "
+            "pip install 'otonav[can]'"
+        ) from None
     finally:
         hal.close()
 
@@ -78,11 +87,7 @@ def build_nodes(
     for a robot of ``geometry`` (None: the one ``stack``'s world compiles to)."""
     if not specs:
         raise ReplayInputError("--node: name at least one node to replay")
-    hal = _robot(stack, geometry)
-    try:
-        stack_actors = {a.name: a for a in build_actors(stack, hal)}
-    finally:
-        hal.close()
+    stack_actors = {a.name: a for a in _stack_actors(stack, geometry)}
     replayable = [name for name in stack_actors if name not in NOT_REPLAYABLE]
     actors: list[Actor] = []
     for spec in specs:

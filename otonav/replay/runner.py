@@ -64,6 +64,9 @@ class ReplayResult:
     """The crash report of a replayed actor that raised (the replay stopped there)."""
     stack: StackConfig = field(default_factory=StackConfig)
     replayed: list[Replayed] = field(default_factory=list)
+    cpu_time_s: float = 0.0
+    """The process's CPU time over the same span as ``wall_time_s`` (on a busy machine
+    the wall time follows the load, this less)."""
 
     @property
     def passed(self) -> bool:
@@ -208,6 +211,7 @@ def _replay(
     if not tolerance >= 0:
         raise ReplayInputError(f"--tolerance {tolerance}: must be a number >= 0")
     wall_start = time.perf_counter()
+    cpu_start = time.process_time()
     path = Path(recording)
     meta = load_recording(path, topics=())  # metadata and types only
     config = stack or meta.stack or StackConfig()
@@ -322,4 +326,5 @@ def _replay(
         crash,
         config,
         replayed,
+        time.process_time() - cpu_start,
     )

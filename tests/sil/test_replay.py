@@ -7,6 +7,7 @@ from __future__ import annotations
 import asyncio
 import contextvars
 import dataclasses
+import re
 import struct
 from collections.abc import Callable
 from pathlib import Path
@@ -149,7 +150,11 @@ def test_cli_exit_codes_summary_and_out(
     acceptance: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     assert cli_main(["replay", str(acceptance), "--node", "nav,base"]) == 0
-    assert "SAME: every output byte-identical" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "SAME: every output byte-identical" in printed
+    # The speed it prints: sim time, wall time, RTF and CPU time of the replay.
+    speed = r"\d+\.\d{3} s of sim time in \d+\.\d{3} s \(\d+x; CPU \d+\.\d{3} s\)"
+    assert re.search(speed, " ".join(printed.split())), printed  # rich wraps at 80
 
     out = tmp_path / "replayed.mcap"
     code = cli_main(

@@ -4,12 +4,16 @@ doubles, and the world built only when something asks for more than the geometry
 from __future__ import annotations
 
 import json
+import sys
 
 import pytest
 
 from otonav.hal import FakeHardware, RobotGeometry, WheelCommand
 from otonav.hal.mujoco import MujocoInterface
+from otonav.replay import ReplayInputError
+from otonav.replay.nodes import build_nodes, stack_actor_names
 from otonav.replay.world import RecordedRobot
+from otonav.stack import StackConfig
 from otonav.stack.worldmeta import geometry_from_metadata, world_metadata
 
 pytestmark = pytest.mark.unit
@@ -87,3 +91,21 @@ def test_closing_an_unbuilt_robot_builds_nothing() -> None:
     robot = RecordedRobot(ODD, lambda: pytest.fail("built"))
     robot.close()
     assert not robot.built
+
+
+def test_a_can_stack_without_python_can_is_one_line(monkeypatch: pytest.MonkeyPatch) -> None:
+    # The actors of a CAN recording are built for its recorded robot, no bus opened;
+    # without the extra, the stack's CAN modules cannot even be imported.
+    for name in [m for m in sys.modules if m == "can" or m.startswith(("can.", "otonav.hal.can"))]:
+        monkeypatch.delitem(sys.modules, name)
+    monkeypatch.setitem(sys.modules, "can", None)
+    stack = StackConfig.model_validate({"hal": {"kind": "can"}})
+    with pytest.raises(ReplayInputError, match=r"pip install 'otonav\[can\]'"):
+        build_nodes(["nav"], stack, ODD)
+
+
+def test_a_can_stack_replays_its_actors_without_a_bus() -> None:
+    stack = StackConfig.model_validate({"hal": {"kind": "can"}})
+    assert stack_actor_names(stack, ODD) == ["base", "nav", "safety"]
+    with pytest.raises(ReplayInputError, match="can_tap: cannot be replayed"):
+        build_nodes(["can_tap"], stack, ODD)
