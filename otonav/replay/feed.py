@@ -266,7 +266,9 @@ class _Route(NamedTuple):
 
 class Feeder:
     """Publishes the planned instants on ``publishers`` (topic -> publisher), each
-    recorded message as a :func:`~otonav.replay.lazy.lazy` one (decoded on first use).
+    recorded message as :func:`~otonav.replay.lazy.input_maker` makes it: the bridge's
+    flat message for its fixed-layout streams, otherwise a lazy one (decoded on first
+    use).
 
     An instant that needs no holding (no replayed actor ran between two of its inputs)
     is delivered inline: from the time source's ``advance()``, in the loop's select, at

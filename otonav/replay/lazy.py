@@ -15,6 +15,11 @@ decoded one (tests check each operation). Before its first use only ``type(m)`` 
 it apart, and a publisher's strict type check compares ``type(m)``: the feeder delivers
 to the mailboxes itself, and when an actor relays an input it never looked at, the
 publisher's slow path asks the object for its ``__class__``, which decodes it.
+
+Two shortcuts: a stamped message's ``header`` (its first field on the wire) is decoded
+alone, and the message stays lazy until anything else is read; and :func:`input_maker`
+feeds the bridge's fixed-layout streams as the flat messages it published
+(:mod:`otonav.msgs.flat`) when the bytes are exactly that layout's.
 """
 
 from __future__ import annotations
