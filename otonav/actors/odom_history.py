@@ -60,6 +60,14 @@ class OdomHistory:
         v, omega = _read_twist(odom)
         return _stamp(odom), _pose(odom), v, omega
 
+    @property
+    def latest_stamp(self) -> float | None:
+        """The newest message's stamp, s (None with no odometry yet): its freshness,
+        without decoding its pose and twist."""
+        if not self._items:
+            return None
+        return _stamp(self._items[-1])
+
     def pose_at(self, stamp: float) -> Pose | None:
         """The pose with the stamp nearest ``stamp`` (None with no odometry yet)."""
         if not self._items:

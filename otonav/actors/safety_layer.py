@@ -110,9 +110,9 @@ class SafetyLayer(Actor):
         return self._nearest
 
     async def _send(self, now: float, v_in: float, w_in: float) -> None:
-        odom = self._history.latest
+        stamp = self._history.latest_stamp  # the pose and twist only when moving
         clear_moved = 0.0  # the centre's travel since the scan, when a report wants it
-        fresh_odom = odom is not None and now - odom[0] <= self.scan_timeout
+        fresh_odom = stamp is not None and now - stamp <= self.scan_timeout
         if self._points_pose is None or now - self._scan_time > self.scan_timeout or not fresh_odom:
             v, w, scale, nearest, reason = 0.0, 0.0, 0.0, math.inf, "blind"
         elif v_in == 0.0 and w_in == 0.0:
@@ -121,6 +121,7 @@ class SafetyLayer(Actor):
             # only looked at if a report goes out. At rest this is every period.
             v, w, scale, nearest, reason = 0.0, 0.0, 1.0, math.nan, "idle"
         else:
+            odom = self._history.latest
             assert odom is not None
             _, pose, v0, w0 = odom
             p, scan_pose = self.params, self._points_pose
