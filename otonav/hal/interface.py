@@ -73,6 +73,13 @@ class RobotHardwareInterface(abc.ABC):
     def ground_truth(self) -> GroundTruth:
         """True chassis pose and world velocity (for judging only, never for control)."""
 
+    def planar_truth(self) -> tuple[float, float, float, float]:
+        """True ``(x, y, vx_world, vy_world)``: the part of :meth:`ground_truth` a
+        judge samples at every tick, without the attitude (for judging only). This
+        default reads :meth:`ground_truth`; a simulator may answer it more cheaply."""
+        truth = self.ground_truth()
+        return truth.x, truth.y, truth.vx_world, truth.vy_world
+
     @property
     @abc.abstractmethod
     def geometry(self) -> RobotGeometry:

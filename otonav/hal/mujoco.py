@@ -672,6 +672,14 @@ class MujocoInterface(RobotHardwareInterface):
             vy_world=float(qvel[v + 1]),
         )
 
+    def planar_truth(self) -> tuple[float, float, float, float]:
+        # The judge's read at every tick: two slices instead of seven floats and the
+        # attitude's trigonometry (2.9 -> ~0.4 us, ~1.5 % of the acceptance run).
+        p, v = self._base_qpos, self._base_qvel
+        x, y = self._data.qpos[p : p + 2].tolist()
+        vx, vy = self._data.qvel[v : v + 2].tolist()  # free joint: world-frame velocity
+        return x, y, vx, vy
+
     @property
     def geometry(self) -> RobotGeometry:
         return self._geometry

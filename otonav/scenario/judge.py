@@ -134,15 +134,14 @@ class Judge(Actor):
             self.nav_reason = diag.reason
 
     def sample(self, now: float) -> None:
-        truth = self.hal.ground_truth()
-        x, y = truth.x, truth.y
+        x, y, vx, vy = self.hal.planar_truth()
         self.samples += 1
         self.trajectory.append((now, x, y))
         if self._last is not None:
             self.path_length += math.hypot(x - self._last[0], y - self._last[1])
         self._last = (x, y)
         self.distance = math.hypot(self.goal[0] - x, self.goal[1] - y)
-        self.speed = math.hypot(truth.vx_world, truth.vy_world)
+        self.speed = math.hypot(vx, vy)
         if self.time_to_goal is None and self.distance <= self.tolerance:
             self.time_to_goal = now
         if (

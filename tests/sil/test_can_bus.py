@@ -219,6 +219,9 @@ class _SensorsOnly(RobotHardwareInterface):
     def ground_truth(self) -> Any:
         return self.world.ground_truth()
 
+    def planar_truth(self) -> Any:
+        return self.world.planar_truth()
+
     def obstacles(self) -> Any:
         return self.world.obstacles()
 

@@ -357,6 +357,9 @@ class CanBusInterface(RobotHardwareInterface):
     def ground_truth(self) -> GroundTruth:
         return self._sensors.ground_truth()
 
+    def planar_truth(self) -> tuple[float, float, float, float]:
+        return self._sensors.planar_truth()
+
     @property
     def geometry(self) -> RobotGeometry:
         return self._geometry
