@@ -37,9 +37,11 @@ from collections.abc import Callable, Sequence
 from operator import attrgetter
 from typing import Any, ClassVar, Generic, TypeVar
 
-from pydantic import BaseModel
-
 from otonav.msgs._base import Message
+from otonav.msgs.stand_in import become, get, new, operators, set_dict, set_extra
+from otonav.msgs.stand_in import make as _make
+from otonav.msgs.stand_in import set_fields_set as _set_fields_set
+from otonav.msgs.stand_in import set_private as _set_private
 
 __all__ = ("FlatLayout", "flat_state", "is_flat", "reader", "real_type")
 
@@ -49,28 +51,12 @@ _KEY = "\0flat"
 """Where a flat message keeps ``(layout, values)`` in its ``__dict__``: no field can
 have this name, so every field lookup misses and reaches ``__getattribute__``."""
 
-_get = object.__getattribute__
-_set_class = object.__setattr__
-_new = object.__new__
-_set_dict = BaseModel.__dict__["__dict__"].__set__
-_set_fields_set = BaseModel.__dict__["__pydantic_fields_set__"].__set__
-_set_extra = BaseModel.__dict__["__pydantic_extra__"].__set__
-_set_private = BaseModel.__dict__["__pydantic_private__"].__set__
+_get, _new, _set_dict, _set_extra = get, new, set_dict, set_extra
 
 _FLAT: dict[type[Message], type[Message]] = {}
 """message class -> its flat subclass"""
 _REAL: dict[type[Message], type[Message]] = {}
 """flat subclass -> its message class"""
-
-
-def _make(cls: type[Message], fields: dict[str, Any], fields_set: set[str]) -> Message:
-    """A message of ``cls`` with these fields, built as :meth:`Message.fast` does."""
-    message: Message = _new(cls)
-    _set_dict(message, fields)
-    _set_fields_set(message, fields_set)
-    _set_extra(message, None)
-    _set_private(message, None)
-    return message
 
 
 def materialize(message: M) -> M:
@@ -82,10 +68,7 @@ def materialize(message: M) -> M:
     state = _get(message, "__dict__").get(_KEY)
     # No state: a copy of an already built one (pydantic's __copy__ builds the copy with
     # type(self), read before the original built itself): it has its fields already.
-    if state is not None:
-        layout, values = state
-        _set_dict(message, layout._build(values))
-    _set_class(message, "__class__", real)
+    become(message, real, None if state is None else state[0]._build(state[1]))
     return message
 
 
@@ -94,24 +77,9 @@ def _flat_class(real: type[Message]) -> type[Message]:
         materialize(self)
         return _get(self, name)
 
-    def __eq__(self: Message, other: object) -> bool:
-        return materialize(self) == other
-
-    def __hash__(self: Message) -> int:
-        return hash(materialize(self))
-
-    def __repr__(self: Message) -> str:
-        return repr(materialize(self))
-
-    def __str__(self: Message) -> str:
-        return str(materialize(self))
-
     namespace = {
         "__getattribute__": __getattribute__,
-        "__eq__": __eq__,
-        "__hash__": __hash__,
-        "__repr__": __repr__,
-        "__str__": __str__,
+        **operators(materialize),
         "__module__": __name__,
         "__qualname__": f"Flat{real.__name__}",
         "__doc__": f"A {real.__name__} of a fixed layout: built on first use.",

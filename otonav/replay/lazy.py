@@ -27,10 +27,15 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
-from pydantic import BaseModel
-
 from otonav.msgs import Header, Message
 from otonav.msgs.flat import FlatLayout
+from otonav.msgs.stand_in import become, operators
+from otonav.msgs.stand_in import get as _get
+from otonav.msgs.stand_in import new as _new
+from otonav.msgs.stand_in import set_dict as _set_dict
+from otonav.msgs.stand_in import set_extra as _set_extra
+from otonav.msgs.stand_in import set_fields_set as _set_fields_set
+from otonav.msgs.stand_in import set_private as _set_private
 from otonav.record.cdr_decode import decode, flat_values
 from otonav.record.schemas import layout_for
 
@@ -41,14 +46,6 @@ M = TypeVar("M", bound=Message)
 _KEY = "\0cdr"
 """Where a lazy message keeps its bytes in its ``__dict__``: no field can have this name,
 so every field lookup misses and reaches ``__getattribute__``."""
-
-_get = object.__getattribute__
-_new = object.__new__
-_set_class = object.__setattr__
-_set_dict = BaseModel.__dict__["__dict__"].__set__
-_set_fields_set = BaseModel.__dict__["__pydantic_fields_set__"].__set__
-_set_extra = BaseModel.__dict__["__pydantic_extra__"].__set__
-_set_private = BaseModel.__dict__["__pydantic_private__"].__set__
 
 _LAZY: dict[type[Message], type[Message]] = {}
 _REAL: dict[type[Message], type[Message]] = {}
@@ -63,10 +60,9 @@ def materialize(message: M) -> M:
     data = fields.get(_KEY)
     # No bytes: a copy taken from an already decoded message (pydantic's __copy__ builds
     # the copy with type(self), read before the original decoded itself).
-    if data is not None:
-        # A header read before (see _lazy_class) is the message's own: not decoded again.
-        _set_dict(message, _get(decode(real, data, fields.get("header")), "__dict__"))
-    _set_class(message, "__class__", real)
+    # A header read before (see _lazy_class) is the message's own: not decoded again.
+    decoded = None if data is None else decode(real, data, fields.get("header"))
+    become(message, real, None if decoded is None else _get(decoded, "__dict__"))
     return message
 
 
@@ -95,24 +91,9 @@ def _lazy_class(real: type[Message]) -> type[Message]:
         materialize(self)
         return _get(self, name)
 
-    def __eq__(self: Message, other: object) -> bool:
-        return materialize(self) == other
-
-    def __hash__(self: Message) -> int:
-        return hash(materialize(self))
-
-    def __repr__(self: Message) -> str:
-        return repr(materialize(self))
-
-    def __str__(self: Message) -> str:
-        return str(materialize(self))
-
     namespace = {
         "__getattribute__": __getattribute__,
-        "__eq__": __eq__,
-        "__hash__": __hash__,
-        "__repr__": __repr__,
-        "__str__": __str__,
+        **operators(materialize),
         "__module__": __name__,
         "__qualname__": f"Lazy{real.__name__}",
         "__doc__": f"A {real.__name__} still in CDR: decoded on first use.",
