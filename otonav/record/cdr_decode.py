@@ -23,10 +23,9 @@ import struct
 from collections.abc import Callable
 from typing import Any, Final, TypeVar
 
-from pydantic import BaseModel
-
 from otonav.msgs import Header, Message
 from otonav.msgs.flat import FlatLayout
+from otonav.msgs.stand_in import make, new, set_dict, set_extra, set_fields_set, set_private
 from otonav.record.cdr import ENCAPSULATION, _Fixed, _leaves, _offsets, _run_format, _Var, encode
 from otonav.record.schemas import SEQUENCE, layout_for
 
@@ -198,23 +197,11 @@ def _compile_builder(message: type[Message]) -> Builder:
     return build
 
 
-_new = object.__new__
-# BaseModel's slots, set through their descriptors (as Message.fast does): object.__setattr__
-# looks each one up on the type first. Odometry decode 8.4 -> ? us.
-_set_dict = BaseModel.__dict__["__dict__"].__set__
-_set_fields_set = BaseModel.__dict__["__pydantic_fields_set__"].__set__
-_set_extra = BaseModel.__dict__["__pydantic_extra__"].__set__
-_set_private = BaseModel.__dict__["__pydantic_private__"].__set__
-
-
-def _make(cls: type[Message], fields: dict[str, Any], fields_set: set[str]) -> Message:
-    """``cls.fast(**fields)`` without the keyword-argument round trip (the same object)."""
-    message: Message = _new(cls)
-    _set_dict(message, fields)
-    _set_fields_set(message, fields_set)
-    _set_extra(message, None)
-    _set_private(message, None)
-    return message
+# The slot setters of a message built without pydantic's constructor (Message.fast's way),
+# shared with the stand-in messages; the generated decoders call them directly.
+_make = make
+_new, _set_dict, _set_fields_set = new, set_dict, set_fields_set
+_set_extra, _set_private = set_extra, set_private
 
 
 _PLANS: dict[type[Message], tuple[tuple[ReadStep, ...], Builder]] = {}
