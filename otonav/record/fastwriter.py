@@ -58,55 +58,20 @@ class FastWriter(Writer):
         self, channel_id: int, log_time: int, data: bytes, publish_time: int, sequence: int
     ) -> bool:
         """:meth:`add_message`; True when that finished a chunk (it went to the stream)."""
+        return self.add_batch([(channel_id, log_time, data, publish_time, sequence)]) > 0
+
+    def add_batch(self, records: list[tuple[int, int, bytes, int, int]]) -> int:
+        """:meth:`add_message` for each ``(channel_id, log_time, data, publish_time,
+        sequence)`` in order, with the writer's state in locals and the records joined
+        into one write per chunk: the same bytes, statistics and index as the stock
+        writer (a chunk is finished after the message that takes it past the chunk
+        size). Returns how many chunks were finished. The only copy of the fast path:
+        a single message comes here too (:meth:`add_message_and_check`)."""
         if not SUPPORTED:
             before = self._chunks_written()
-            super().add_message(channel_id, log_time, data, publish_time, sequence)
-            return self._chunks_written() != before
-        stats: Any = self._Writer__statistics  # type: ignore[attr-defined]
-        if stats.message_count == 0 or log_time < stats.message_start_time:
-            stats.message_start_time = log_time
-        if log_time > stats.message_end_time:
-            stats.message_end_time = log_time
-        stats.channel_message_counts[channel_id] += 1
-        stats.message_count += 1
-        chunk: Any = self._Writer__chunk_builder  # type: ignore[attr-defined]
-        if chunk.num_messages == 0 or log_time < chunk.message_start_time:
-            chunk.message_start_time = log_time
-        if log_time > chunk.message_end_time:
-            chunk.message_end_time = log_time
-        buffer = chunk.record_writer._buffer  # a BytesIO: its write and tell directly
-        index = chunk.message_indices.get(channel_id)
-        if index is None:
-            index = chunk.message_indices[channel_id] = _MessageIndex(
-                channel_id=channel_id, records=[]
-            )
-        index.records.append((log_time, buffer.tell()))
-        chunk.num_messages += 1
-        buffer.write(
-            _HEADER.pack(
-                _MESSAGE_OPCODE,
-                _FIELDS_LENGTH + len(data),
-                channel_id,
-                sequence,
-                log_time,
-                publish_time,
-            )
-        )
-        buffer.write(data)
-        if buffer.tell() > self._Writer__chunk_size:  # type: ignore[attr-defined]
-            self._Writer__finalize_chunk()  # type: ignore[attr-defined]
-            return True
-        return False
-
-    def add_batch(self, records: list[tuple[int, int, bytes, int]]) -> int:
-        """:meth:`add_message_and_check` for each ``(channel_id, log_time, data,
-        sequence)`` in order (log time = publish time, as the recorder writes them), with
-        the writer's state in locals and the records joined into one write per chunk:
-        the same bytes, statistics and index (a chunk is finished after the message that
-        takes it past the chunk size, as there). Returns how many chunks were finished.
-        A recorder's drain: 2.5 -> ? us per recorded message, writer included."""
-        if not SUPPORTED:
-            return sum(self.add_message_and_check(c, t, d, t, s) for c, t, d, s in records)
+            for channel_id, log_time, data, publish_time, sequence in records:
+                super().add_message(channel_id, log_time, data, publish_time, sequence)
+            return self._chunks_written() - before
         stats: Any = self._Writer__statistics  # type: ignore[attr-defined]
         limit: int = self._Writer__chunk_size  # type: ignore[attr-defined]
         counts = stats.channel_message_counts
@@ -126,7 +91,7 @@ class FastWriter(Writer):
             full = False
             i = start
             for i in range(start, len(records)):
-                channel_id, log_time, data, sequence = records[i]
+                channel_id, log_time, data, publish_time, sequence = records[i]
                 if stats_empty or log_time < stats_start:
                     stats_start, stats_empty = log_time, False
                 if log_time > stats_end:
@@ -147,7 +112,7 @@ class FastWriter(Writer):
                         channel_id,
                         sequence,
                         log_time,
-                        log_time,
+                        publish_time,
                     )
                 )
                 parts.append(data)

@@ -99,7 +99,7 @@ class RecordingWriter:
                 self.write(topic, message, sim_time)
             return
         channels, sequences = self._channels, self._sequence
-        batch: list[tuple[int, int, bytes, int]] = []
+        batch: list[tuple[int, int, bytes, int, int]] = []
         chunks = 0
         try:
             for topic, sim_time, message in deliveries:
@@ -109,7 +109,7 @@ class RecordingWriter:
                     channel_id = self._channel(topic, real_type(type(message)))
                 stamp = round(sim_time * 1e9)
                 sequence = sequences[channel_id] = sequences[channel_id] + 1
-                batch.append((channel_id, stamp, encode(message), sequence))
+                batch.append((channel_id, stamp, encode(message), stamp, sequence))
         finally:
             # What was encoded is written even when a later message fails to encode
             # (write() would have written each one before the failure, too).
@@ -117,7 +117,7 @@ class RecordingWriter:
             if chunks:
                 self._file.flush()
 
-    def _add_batch(self, batch: list[tuple[int, int, bytes, int]]) -> int:
+    def _add_batch(self, batch: list[tuple[int, int, bytes, int, int]]) -> int:
         if not batch:
             return 0
         chunks = self._writer.add_batch(batch)
