@@ -12,6 +12,7 @@ from otonav.actors import topics
 from otonav.control import DiffDriveGeometry, limit_twist, twist_to_wheels
 from otonav.msgs import HardwareStatus, Header, Log, Time, Twist, WheelCommand
 from otonav.msgs.flat import FlatLayout
+from otonav.msgs.std import split_seconds
 from otonav.runtime import Actor, Input, Output
 
 WHEEL_COMMAND = FlatLayout(
@@ -129,7 +130,7 @@ class BaseController(Actor):
                 max_alpha=limits.max_alpha,
             )
             left, right = twist_to_wheels(v, omega, self.geometry)
-            sec, nanosec = divmod(round(now * 1e9), 1_000_000_000)  # Time.from_seconds'
+            sec, nanosec = split_seconds(now)
             command = WHEEL_COMMAND(sec, nanosec, left, right)
             if not self.wheel_cmd.try_publish(command):
                 await self.wheel_cmd.publish(command)

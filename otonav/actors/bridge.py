@@ -42,6 +42,7 @@ from otonav.msgs import (
     WheelCommand,
 )
 from otonav.msgs.flat import FlatLayout, reader
+from otonav.msgs.std import split_seconds
 from otonav.runtime import Actor, Input, Output, Publisher
 
 log = logging.getLogger("otonav.hal")
@@ -283,8 +284,7 @@ class Bridge(Actor):
             now = clock.now()
             if self.hal.health() is not self._health:
                 await self._check_health(now)
-            # Time.from_seconds(now)'s two integers, without the Time object.
-            sec, nanosec = divmod(round(now * 1e9), 1_000_000_000)
+            sec, nanosec = split_seconds(now)  # Time.from_seconds(now)'s, no Time object
             for i, (period, publish, publish_waiting) in enumerate(publishers):
                 if due[i] <= instant + 1e-12:
                     counts[i] += 1

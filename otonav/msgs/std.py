@@ -7,6 +7,13 @@ from typing import ClassVar
 from otonav.msgs._base import Message
 
 
+def split_seconds(seconds: float) -> tuple[int, int]:
+    """``seconds`` as a Time's ``(sec, nanosec)``, rounded to the nanosecond (what
+    :meth:`Time.from_seconds` holds, for a fixed-layout message's stamp)."""
+    sec, nanosec = divmod(round(seconds * 1e9), 1_000_000_000)
+    return sec, nanosec
+
+
 class Time(Message):
     """builtin_interfaces/msg/Time: sim time as whole seconds + nanoseconds."""
 
@@ -18,8 +25,8 @@ class Time(Message):
 
     @classmethod
     def from_seconds(cls, seconds: float) -> Time:
-        total = round(seconds * 1e9)
-        return cls.fast(sec=total // 1_000_000_000, nanosec=total % 1_000_000_000)
+        sec, nanosec = split_seconds(seconds)
+        return cls.fast(sec=sec, nanosec=nanosec)
 
     def to_seconds(self) -> float:
         return self.sec + self.nanosec * 1e-9
