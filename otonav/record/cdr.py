@@ -426,6 +426,9 @@ def _offsets(
                 offset += -offset % size
             if field.array is None:
                 found[path] = (offset, code)
+            else:
+                for i in range(count):
+                    found[f"{path}.{i}"] = (offset + size * i, code)
             offset += size * count
     return found, offset
 

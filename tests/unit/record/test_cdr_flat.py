@@ -13,6 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from otonav.actors.bridge import CLOCK, IMU, ODOM, TF
+from otonav.hal.can.tap import frame_layout
 from otonav.msgs import (
     DiagnosticArray,
     DiagnosticStatus,
@@ -70,6 +71,39 @@ def test_imu_bytes(sec: int, nsec: int, floats: list[float]) -> None:
 @given(SEC, NSEC)
 def test_clock_bytes(sec: int, nsec: int) -> None:
     _check(CLOCK, (sec, nsec))
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.text(max_size=9),  # the channel: a string before the numbers moves their offsets
+    SEC,
+    NSEC,
+    st.integers(0, 2**32 - 1),
+    st.booleans(),
+    st.booleans(),
+    st.integers(0, 255),
+    st.lists(st.integers(0, 255), min_size=8, max_size=8),
+)
+def test_can_frame_bytes(
+    channel: str,
+    sec: int,
+    nsec: int,
+    ident: int,
+    rtr: bool,
+    error: bool,
+    dlc: int,
+    data: list[int],
+) -> None:
+    _check(frame_layout(channel), (sec, nsec, ident, rtr, error, dlc, *data))
+
+
+def test_elements_of_fixed_arrays_and_sequences_can_vary() -> None:
+    # data.0..data.7 of a Frame (uint8[8]) and single ranges of a LaserScan (float32[]).
+    values = (1, 2, 3, True, False, 4, 5, 6, 7, 8, 9, 10, 11, 12)
+    assert encode(frame_layout("can0")(*values)).endswith(bytes([4, 5, 6, 7, 8, 9, 10, 11, 12]))
+    ranges = FlatLayout(SCAN.template, ("ranges.2", "ranges.0"))
+    _check(ranges, (0.5, 7.0))
+    assert materialize(ranges(0.5, 7.0)).ranges == (7.0, 2.0, 0.5)
 
 
 def test_the_sign_of_zero_and_nan_bits_survive() -> None:
