@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from otonav.hal.can.bus import RawFrame
 from otonav.hal.can.tap import frame_layout, frames_of
 from otonav.msgs import Frame, Header, Time
-from otonav.msgs.flat import is_flat
+from otonav.msgs.flat import is_flat, reader
 from otonav.record.cdr import encode
 
 pytestmark = pytest.mark.unit
@@ -123,3 +123,11 @@ def test_one_layout_per_channel() -> None:
     assert frame_layout("can0") is frame_layout("can0")
     assert frame_layout("can0") is not frame_layout("can1")
     assert frame_layout("can1").constant("header.frame_id") == "can1"
+
+
+def test_a_reader_gets_the_bytes_as_the_frame_holds_them_without_building_it() -> None:
+    logged = [(3.5, RawFrame(0x007, bytes([8, 0, 0, 0]), False, False))]
+    flat, eager = frames_of("can0", logged)[0], eager_frames("can0", logged)[0]
+    read = reader(Frame, "data", "dlc", "header.frame_id", "is_extended")
+    assert read(flat) == read(eager) == ((8, 0, 0, 0, 0, 0, 0, 0), 4, "can0", False)
+    assert is_flat(flat)

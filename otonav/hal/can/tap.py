@@ -48,7 +48,7 @@ FRAME_PATHS: Final = (
     "is_rtr",
     "is_error",
     "dlc",
-    *(f"data.{i}" for i in range(8)),
+    "data",  # its 8 bytes as one bytes value (FlatLayout.byte_paths)
 )
 """What varies between the frames of one channel, in the order of a layout's values."""
 
@@ -56,7 +56,8 @@ FRAME_PATHS: Final = (
 @lru_cache(maxsize=8)
 def frame_layout(channel: str) -> FlatLayout[Frame]:
     """Frames of ``channel`` (``header.frame_id``), standard (11-bit) ids, made from
-    :data:`FRAME_PATHS`' values: ``(sec, nanosec, id, is_rtr, is_error, dlc, d0, ..., d7)``."""
+    :data:`FRAME_PATHS`' values: ``(sec, nanosec, id, is_rtr, is_error, dlc, data)``,
+    ``data`` a ``bytes`` of 8."""
     template = Frame.fast(
         header=Header.fast(stamp=Time.fast(sec=0, nanosec=0), frame_id=channel),
         id=0,
@@ -90,7 +91,7 @@ def frames_of(channel: str, logged: Iterable[tuple[float, RawFrame]]) -> list[Fr
                 is_remote,
                 is_error,
                 n,
-                *(data + _PAD[n] if n <= 8 else data[:8]),
+                data + _PAD[n] if n <= 8 else data[:8],
             )
         )
     return out

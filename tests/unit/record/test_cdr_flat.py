@@ -82,7 +82,7 @@ def test_clock_bytes(sec: int, nsec: int) -> None:
     st.booleans(),
     st.booleans(),
     st.integers(0, 255),
-    st.lists(st.integers(0, 255), min_size=8, max_size=8),
+    st.binary(min_size=8, max_size=8),
 )
 def test_can_frame_bytes(
     channel: str,
@@ -92,18 +92,35 @@ def test_can_frame_bytes(
     rtr: bool,
     error: bool,
     dlc: int,
-    data: list[int],
+    data: bytes,
 ) -> None:
-    _check(frame_layout(channel), (sec, nsec, ident, rtr, error, dlc, *data))
+    # The tap's layout: the 8 data bytes are one bytes value (an "8s" item).
+    layout = frame_layout(channel)
+    assert layout.byte_paths == {layout.index("data")}
+    _check(layout, (sec, nsec, ident, rtr, error, dlc, data))
+    assert materialize(layout(sec, nsec, ident, rtr, error, dlc, data)).data == tuple(data)
 
 
-def test_elements_of_fixed_arrays_and_sequences_can_vary() -> None:
-    # data.0..data.7 of a Frame (uint8[8]) and single ranges of a LaserScan (float32[]).
-    values = (1, 2, 3, True, False, 4, 5, 6, 7, 8, 9, 10, 11, 12)
-    assert encode(frame_layout("can0")(*values)).endswith(bytes([4, 5, 6, 7, 8, 9, 10, 11, 12]))
+@settings(max_examples=100, deadline=None)
+@given(st.lists(st.integers(0, 255), min_size=3, max_size=3), st.integers(0, 2**32 - 1))
+def test_elements_of_a_byte_array_as_numbers(elements: list[int], ident: int) -> None:
+    layout = FlatLayout(frame_layout("vcan1").template, ("data.7", "id", "data.0", "data.3"))
+    assert not layout.byte_paths
+    _check(layout, (*elements[:1], ident, *elements[1:]))
+
+
+def test_elements_of_a_sequence_can_vary() -> None:
     ranges = FlatLayout(SCAN.template, ("ranges.2", "ranges.0"))
     _check(ranges, (0.5, 7.0))
     assert materialize(ranges(0.5, 7.0)).ranges == (7.0, 2.0, 0.5)
+
+
+def test_bytes_only_for_an_array_of_bytes() -> None:
+    # Small ints in the template of a float32[]: FlatLayout takes it for bytes, the CDR
+    # packer refuses it, naming the path.
+    odd = FlatLayout(SCAN.template.model_copy(update={"intensities": (1, 2)}), ("intensities",))
+    with pytest.raises(ValueError, match="'intensities' is not a primitive of sensor_msgs"):
+        encode(odd(b"\x01\x02"))
 
 
 def test_the_sign_of_zero_and_nan_bits_survive() -> None:
