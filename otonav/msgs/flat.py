@@ -8,7 +8,7 @@ layer and the navigator want six numbers of an Odometry.
 
 A :class:`FlatLayout` is a *template* message and the *paths* of the scalar fields that
 vary (``header.stamp.sec``, ``pose.pose.position.x``, ``transforms.0.header.stamp.sec``).
-``layout(*values)`` makes a message holding only those values (0.4 us). It is an
+``layout(*values)`` makes a message holding only those values (0.25 us). It is an
 instance of a subclass of the template's class (``FlatOdometry`` for an Odometry), like
 a lazily decoded replay input (:mod:`otonav.replay.lazy`): its first attribute access
 of any kind (a field, a method, ``__dict__``, which every pydantic method goes through,

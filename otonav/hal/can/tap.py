@@ -9,11 +9,12 @@ those last frames while the recorder still records.
 
 The frames are flat messages (:mod:`otonav.msgs.flat`, ADR 0038) of one layout per
 channel (:func:`frame_layout`): a Frame's header names the channel, so only the stamp,
-the id, two flags, the dlc and the eight data bytes vary. A frame is then built in
-~0.5 us instead of ~1.5 us (a Frame, a Header and a Time eagerly) and the recorder
-packs it with one ``struct`` (0.3 us instead of 1.5 us field by field); a subscriber
-that reads one gets the Frame the tap built eagerly before. A flush's frames go into
-the mailboxes as one batch (:meth:`Publisher.try_publish_all`) while they all fit.
+the id, two flags, the dlc and the eight data bytes (one ``bytes`` value) vary. A frame
+is then built in 0.49 us instead of 1.37 us (a Frame, and per instant a Header and a
+Time, eagerly) and the recorder packs it with one ``struct`` (0.31 us instead of 0.95 us
+field by field; measured in batches of 12 frames over 4 instants); a subscriber that
+reads one gets the Frame the tap built eagerly before. A flush's frames go into the
+mailboxes as one batch (:meth:`Publisher.try_publish_all`) while they all fit.
 """
 
 from __future__ import annotations
