@@ -184,10 +184,9 @@ class DriveEmulator:
         """Receive, update the drives and the wheels, send what is due at tick ``now``.
 
         Called again at an instant already exchanged (the host sent commands since),
-        the axes are updated again only if a command changed their state: a
-        Set_Input_Vel alone moves nothing before time passes (the setpoint ramp is
-        ``vel_ramp_rate * dt`` and dt is 0), so that update would be a no-op. Skipping
-        it saved ~10 % of the emulator's cost (one such instant per 20 ms base tick)."""
+        the axes are updated again only if a command changed their state or a setpoint
+        (a Set_Input_Vel in PASSTHROUGH); in VEL_RAMP a Set_Input_Vel alone moves
+        nothing before time passes (the ramp is ``vel_ramp_rate * dt`` and dt is 0)."""
         t = now * self._tick
         changed = False
         incoming = self._endpoint.poll()
@@ -251,8 +250,8 @@ class DriveEmulator:
         self.frames_sent += 1
 
     def _handle(self, frame: RawFrame, t: float) -> bool:
-        """Apply one command frame; True if it may have changed an axis' state (any
-        command but Set_Input_Vel)."""
+        """Apply one command frame; True if it may have changed an axis' state or
+        setpoint (any command but a Set_Input_Vel the ramp will follow later)."""
         if frame.is_error or frame.is_remote:
             return False
         ident = frame.arbitration_id
@@ -263,8 +262,9 @@ class DriveEmulator:
         axis, data = drive.axis, frame.data
         try:
             if cmd == p.CMD_SET_INPUT_VEL:
-                axis.set_input_vel(p.unpack_two_f32(data)[0], t)
-                return False
+                # In PASSTHROUGH the setpoint takes the input now, like a real drive's
+                # next control cycle (8 kHz): the wheels are driven at this instant.
+                return axis.set_input_vel(p.unpack_two_f32(data)[0], t)
             if cmd == p.CMD_SET_AXIS_STATE:
                 axis.request_state(p.decode_set_axis_state(data), t)
             elif cmd == p.CMD_ESTOP:
