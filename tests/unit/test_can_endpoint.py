@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import copy
 import itertools
+from typing import Any
 
 import can
 import pytest
@@ -33,7 +34,7 @@ def _slots(message: can.Message) -> dict[str, object]:
 def test_the_lean_copy_equals_python_cans_own_deep_copy(
     data: bytes, remote: bool, error: bool, channel: str | int | None, fd: bool
 ) -> None:
-    fields = dict(
+    fields: dict[str, Any] = dict(
         timestamp=12.34,
         arbitration_id=0x069,
         is_extended_id=False,
