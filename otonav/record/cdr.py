@@ -400,7 +400,9 @@ def _offsets(
 ) -> tuple[dict[str, tuple[int, str]], int]:
     """Where each scalar primitive of ``message`` lands (payload offset, struct code),
     by path, and the offset after it: the CDR rules of the module docstring walked over
-    one message's values (its strings and sequences have the lengths they have)."""
+    one message's values (its strings and sequences have the lengths they have). The
+    elements of primitive arrays too (``data.3``), and an array of ``uint8`` (or
+    ``byte``, ``char``) of n elements also as a whole (``data``, code ``{n}s``)."""
     found: dict[str, tuple[int, str]] = {}
     layout = layout_for(real_type(type(message)))
     if not layout.fields:
@@ -426,6 +428,11 @@ def _offsets(
                 offset += -offset % size
             if field.array is None:
                 found[path] = (offset, code)
+            else:  # each element; an array of bytes also whole, as one bytes item
+                for i in range(count):
+                    found[f"{path}.{i}"] = (offset + size * i, code)
+                if code == "B":
+                    found[path] = (offset, f"{count}s")
             offset += size * count
     return found, offset
 
@@ -442,6 +449,12 @@ def _flat_packer(layout: FlatLayout[Any]) -> Callable[..., bytes]:
         raise AssertionError(
             f"{layout}: walked {end} payload bytes, the encoder wrote {len(template) - 4}"
         )
+    for path in layout.paths:
+        if path not in offsets:  # a tuple of small ints whose ROS type is not bytes
+            raise ValueError(
+                f"{layout}: '{path}' is not a primitive of {layout.message_type.ros_type}; "
+                "an array given as bytes must be a uint8 (byte, char) array"
+            )
     places = sorted(
         (len(ENCAPSULATION) + offsets[path][0], offsets[path][1], i)
         for i, path in enumerate(layout.paths)
@@ -480,6 +493,8 @@ def _flat_packer(layout: FlatLayout[Any]) -> Callable[..., bytes]:
 def _probe(code: str, i: int) -> object:
     """A value for a field of struct ``code``, distinct for each ``i`` (the check of
     :func:`_flat_packer`)."""
+    if code.endswith("s"):  # an array of bytes: distinct values in each element
+        return bytes((i + 1 + k) % 256 for k in range(struct.calcsize(code)))
     if code in "fd":
         return 1.0 + 0.25 * i
     if code == "?":

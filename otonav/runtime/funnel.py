@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import logging
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any, NamedTuple
 
 from otonav.runtime.mailbox import Bus, Endpoint, Subscription, Topic
@@ -83,6 +83,24 @@ class _Tap(Subscription[Any]):
 
     def _full(self) -> bool:
         return len(self._funnel._queue) >= self._funnel.depth
+
+    def _has_room(self, n: int) -> bool:
+        return len(self._funnel._queue) + n <= self._funnel.depth
+
+    def _offer_all(self, messages: Sequence[Any]) -> None:
+        """:meth:`_offer` each of ``messages`` (they fit: :meth:`_has_room`): one
+        ``extend``, all stamped with this instant, the reader woken once if the queue
+        reached its high-water mark (waking it is a request to drain, never a drain)."""
+        if self._blocked_at is not None and messages:  # a publisher gave up waiting
+            self._offer(messages[0])
+            messages = messages[1:]
+        funnel = self._funnel
+        queue = funnel._queue
+        topic, now = self.topic, funnel._now()
+        queue.extend([(topic, now, message) for message in messages])
+        self.received += len(messages)
+        if len(queue) >= funnel.high_water and funnel._on_high_water is not None:
+            funnel._wake_reader()
 
 
 class Funnel:

@@ -6,11 +6,22 @@ nothing while the robot runs. The stack builder adds it when ``hal.kind`` is ``c
 before the bridge: it stops after every actor that commands the wheels, and its
 ``on_stop`` sets the drives IDLE (:meth:`CanBusInterface.stop_drives`) and publishes
 those last frames while the recorder still records.
+
+The frames are flat messages (:mod:`otonav.msgs.flat`, ADR 0038) of one layout per
+channel (:func:`frame_layout`): a Frame's header names the channel, so only the stamp,
+the id, two flags, the dlc and the eight data bytes (one ``bytes`` value) vary. A frame
+is then built in 0.49 us instead of 1.37 us (a Frame, and per instant a Header and a
+Time, eagerly) and the recorder packs it with one ``struct`` (0.31 us instead of 0.95 us
+field by field; measured in batches of 12 frames over 4 instants); a subscriber that
+reads one gets the Frame the tap built eagerly before. A flush's frames go into the
+mailboxes as one batch (:meth:`Publisher.try_publish_all`) while they all fit.
 """
 
 from __future__ import annotations
 
 import contextlib
+from collections.abc import Iterable
+from functools import lru_cache
 from typing import Final
 
 import anyio
@@ -18,16 +29,73 @@ import anyio
 from otonav.hal.can.bus import RawFrame
 from otonav.hal.can.interface import CanBusInterface
 from otonav.msgs import Frame, Header, Time
+from otonav.msgs.flat import FlatLayout
+from otonav.msgs.std import split_seconds
 from otonav.runtime import Actor, Bus, Output, QoS
 from otonav.runtime.mailbox import Topic
 
-__all__ = ["FRAMES_QOS", "FRAMES_TOPIC", "CanFrameTap"]
+__all__ = ["FRAMES_QOS", "FRAMES_TOPIC", "CanFrameTap", "frame_layout"]
 
 FRAMES_TOPIC: Final = "/can/frames"
 FRAMES_QOS: Final = QoS(depth=200)
 """Reliable: a recording must hold every frame (~330 per simulated second)."""
 
 _PAD: Final = tuple(bytes(8 - n) for n in range(9))
+
+FRAME_PATHS: Final = (
+    "header.stamp.sec",
+    "header.stamp.nanosec",
+    "id",
+    "is_rtr",
+    "is_error",
+    "dlc",
+    "data",  # its 8 bytes as one bytes value (FlatLayout.byte_paths)
+)
+"""What varies between the frames of one channel, in the order of a layout's values."""
+
+
+@lru_cache(maxsize=8)
+def frame_layout(channel: str) -> FlatLayout[Frame]:
+    """Frames of ``channel`` (``header.frame_id``), standard (11-bit) ids, made from
+    :data:`FRAME_PATHS`' values: ``(sec, nanosec, id, is_rtr, is_error, dlc, data)``,
+    ``data`` a ``bytes`` of 8."""
+    template = Frame.fast(
+        header=Header.fast(stamp=Time.fast(sec=0, nanosec=0), frame_id=channel),
+        id=0,
+        is_rtr=False,
+        is_extended=False,
+        is_error=False,
+        dlc=0,
+        data=(0,) * 8,
+    )
+    return FlatLayout(template, FRAME_PATHS)
+
+
+def frames_of(channel: str, logged: Iterable[tuple[float, RawFrame]]) -> list[Frame]:
+    """The Frame of each ``(sim time, frame)`` of the interface's log, stamped with that
+    time: ``data`` zero-padded (or cut) to 8 bytes, ``dlc`` the payload's length."""
+    layout = frame_layout(channel)
+    out: list[Frame] = []
+    append = out.append
+    last: float | None = None
+    sec = nanosec = 0
+    for t, (ident, data, is_error, is_remote) in logged:
+        if t != last:  # frames of one instant share a stamp
+            sec, nanosec = split_seconds(t)
+            last = t
+        n = len(data)
+        append(
+            layout(
+                sec,
+                nanosec,
+                ident,
+                is_remote,
+                is_error,
+                n,
+                data + _PAD[n] if n <= 8 else data[:8],
+            )
+        )
+    return out
 
 
 class CanFrameTap(Actor):
@@ -70,10 +138,9 @@ class CanFrameTap(Actor):
         if self._topic is not None and not self._topic.subscriptions:
             self.hal.take_frames()
             return
-        for t, raw in self.hal.take_frames():
+        for frame in frames_of(self.hal.channel, self.hal.take_frames()):
             with contextlib.suppress(anyio.WouldBlock):
-                header = Header.fast(stamp=Time.from_seconds(t), frame_id=self.hal.channel)
-                self.frames.publish_nowait(_frame(header, raw))
+                self.frames.publish_nowait(frame)
 
     async def flush(self) -> None:
         if self._topic is not None and not self._topic.subscriptions:
@@ -81,31 +148,16 @@ class CanFrameTap(Actor):
             # simulated second for nobody was ~3 % of a CAN run's CPU time.
             self.hal.take_frames()
             return
-        channel = self.hal.channel
-        publish, publish_nowait = self.frames.publish, self.frames.publish_nowait
-        header: Header | None = None
-        last = -1.0
-        for t, raw in self.hal.take_frames():
-            if header is None or t != last:  # frames of one instant share a header
-                header, last = Header.fast(stamp=Time.from_seconds(t), frame_id=channel), t
-            frame = _frame(header, raw)
-            # No coroutine per frame while the mailboxes have room (the usual case:
-            # ~15 frames per wake, a depth of 200); wait for room only when one is full.
+        frames = frames_of(self.hal.channel, self.hal.take_frames())
+        publisher = self.frames
+        # The usual case (~15 frames per wake, a depth of 200): the flush goes into
+        # every mailbox at once, no call and no coroutine per frame. Else frame by frame,
+        # waiting for room only when a reliable mailbox is full: none is lost, the
+        # order holds.
+        if publisher.try_publish_all(frames):
+            return
+        for frame in frames:
             try:
-                publish_nowait(frame)
+                publisher.publish_nowait(frame)
             except anyio.WouldBlock:
-                await publish(frame)
-
-
-def _frame(header: Header, raw: RawFrame) -> Frame:
-    data = raw.data
-    n = len(data)
-    return Frame.fast(
-        header=header,
-        id=raw.arbitration_id,
-        is_rtr=raw.is_remote,
-        is_extended=False,
-        is_error=raw.is_error,
-        dlc=n,
-        data=tuple(data + _PAD[n]) if n <= 8 else tuple(data[:8]),
-    )
+                await publisher.publish(frame)

@@ -13,6 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from otonav.actors.bridge import CLOCK, IMU, ODOM, TF
+from otonav.hal.can.tap import frame_layout
 from otonav.msgs import (
     DiagnosticArray,
     DiagnosticStatus,
@@ -70,6 +71,56 @@ def test_imu_bytes(sec: int, nsec: int, floats: list[float]) -> None:
 @given(SEC, NSEC)
 def test_clock_bytes(sec: int, nsec: int) -> None:
     _check(CLOCK, (sec, nsec))
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.text(max_size=9),  # the channel: a string before the numbers moves their offsets
+    SEC,
+    NSEC,
+    st.integers(0, 2**32 - 1),
+    st.booleans(),
+    st.booleans(),
+    st.integers(0, 255),
+    st.binary(min_size=8, max_size=8),
+)
+def test_can_frame_bytes(
+    channel: str,
+    sec: int,
+    nsec: int,
+    ident: int,
+    rtr: bool,
+    error: bool,
+    dlc: int,
+    data: bytes,
+) -> None:
+    # The tap's layout: the 8 data bytes are one bytes value (an "8s" item).
+    layout = frame_layout(channel)
+    assert layout.byte_paths == {layout.index("data")}
+    _check(layout, (sec, nsec, ident, rtr, error, dlc, data))
+    assert materialize(layout(sec, nsec, ident, rtr, error, dlc, data)).data == tuple(data)
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.lists(st.integers(0, 255), min_size=3, max_size=3), st.integers(0, 2**32 - 1))
+def test_elements_of_a_byte_array_as_numbers(elements: list[int], ident: int) -> None:
+    layout = FlatLayout(frame_layout("vcan1").template, ("data.7", "id", "data.0", "data.3"))
+    assert not layout.byte_paths
+    _check(layout, (*elements[:1], ident, *elements[1:]))
+
+
+def test_elements_of_a_sequence_can_vary() -> None:
+    ranges = FlatLayout(SCAN.template, ("ranges.2", "ranges.0"))
+    _check(ranges, (0.5, 7.0))
+    assert materialize(ranges(0.5, 7.0)).ranges == (7.0, 2.0, 0.5)
+
+
+def test_bytes_only_for_an_array_of_bytes() -> None:
+    # Small ints in the template of a float32[]: FlatLayout takes it for bytes, the CDR
+    # packer refuses it, naming the path.
+    odd = FlatLayout(SCAN.template.model_copy(update={"intensities": (1, 2)}), ("intensities",))
+    with pytest.raises(ValueError, match="'intensities' is not a primitive of sensor_msgs"):
+        encode(odd(b"\x01\x02"))
 
 
 def test_the_sign_of_zero_and_nan_bits_survive() -> None:
