@@ -34,7 +34,7 @@ from otonav.msgs.std import split_seconds
 from otonav.runtime import Actor, Bus, Output, QoS
 from otonav.runtime.mailbox import Topic
 
-__all__ = ["FRAMES_QOS", "FRAMES_TOPIC", "CanFrameTap", "frame_layout"]
+__all__ = ["FRAMES_QOS", "FRAMES_TOPIC", "FRAME_PATHS", "CanFrameTap", "frame_layout", "frames_of"]
 
 FRAMES_TOPIC: Final = "/can/frames"
 FRAMES_QOS: Final = QoS(depth=200)
