@@ -73,6 +73,14 @@ class RobotHardwareInterface(abc.ABC):
     def ground_truth(self) -> GroundTruth:
         """True chassis pose and world velocity (for judging only, never for control)."""
 
+    def wheel_values(self) -> tuple[float, float, float, float]:
+        """:meth:`read_wheels` as a plain tuple ``(left_position, right_position,
+        left_velocity, right_velocity)`` (what a drive emulator reads from a simulated
+        world at every 10 ms instant). This default reads :meth:`read_wheels`; a
+        simulator may answer it more cheaply."""
+        w = self.read_wheels()
+        return w.left_position, w.right_position, w.left_velocity, w.right_velocity
+
     def planar_truth(self) -> tuple[float, float, float, float]:
         """True ``(x, y, vx_world, vy_world)``: the part of :meth:`ground_truth` a
         judge samples at every tick, without the attitude (for judging only). This

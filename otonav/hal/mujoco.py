@@ -586,6 +586,13 @@ class MujocoInterface(RobotHardwareInterface):
             right_velocity=float(qvel[self._wheel_qvel[1]]),
         )
 
+    def wheel_values(self) -> tuple[float, float, float, float]:
+        # The drive emulator's read at every 10 ms instant: the same four doubles as
+        # read_wheels, without building a WheelState (1.1 -> ~0.35 us).
+        qpos, qvel = self._data.qpos, self._data.qvel
+        (pl, pr), (vl, vr) = self._wheel_qpos, self._wheel_qvel
+        return qpos.item(pl), qpos.item(pr), qvel.item(vl), qvel.item(vr)
+
     def read_imu(self) -> ImuSample:
         self._sync()
         s = self._data.sensordata

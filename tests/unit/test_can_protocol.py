@@ -84,12 +84,31 @@ def test_axis_arms_after_arm_time_then_follows_the_clamped_setpoint() -> None:
     assert axis.update(0.02, 0.0) == 5.0  # clamped to vel_limit
 
 
-def test_axis_ramp_limits_the_setpoint_slew() -> None:
+def test_axis_ramp_limits_the_setpoint_slew_in_vel_ramp_mode() -> None:
     axis = AxisModel(AxisParams(0, vel_ramp_rate=10.0, arm_time=0.0))
+    axis.set_controller_mode(p.ControlMode.VELOCITY_CONTROL, p.InputMode.VEL_RAMP)
     axis.request_state(p.AxisState.CLOSED_LOOP_CONTROL, 0.0)
     axis.update(0.0, 0.0)
-    axis.set_input_vel(4.0, 0.0)
+    assert axis.set_input_vel(4.0, 0.0) is False  # the ramp follows as time passes
+    assert axis.update(0.0, 0.0) == 0.0  # no time passed: no slew yet
     assert axis.update(0.1, 0.0) == pytest.approx(1.0)  # 10 turns/s^2 * 0.1 s
+    assert axis.update(0.2, 0.0) == pytest.approx(2.0)
+
+
+def test_passthrough_takes_the_input_at_once_and_inactive_ignores_it() -> None:
+    # An ODrive's input modes: PASSTHROUGH (what the CAN interface selects) has no
+    # ramp, whatever vel_ramp_rate says; INACTIVE ignores new input.
+    axis = AxisModel(AxisParams(0, vel_limit=5.0, vel_ramp_rate=10.0, arm_time=0.0))
+    axis.set_controller_mode(p.ControlMode.VELOCITY_CONTROL, p.InputMode.PASSTHROUGH)
+    axis.request_state(p.AxisState.CLOSED_LOOP_CONTROL, 0.0)
+    axis.update(0.0, 0.0)
+    assert axis.set_input_vel(4.0, 0.0) is True  # the caller updates now
+    assert axis.update(0.0, 0.0) == 4.0
+    axis.set_input_vel(-9.0, 0.01)
+    assert axis.update(0.01, 0.0) == -5.0  # still clamped to vel_limit
+    axis.set_controller_mode(p.ControlMode.VELOCITY_CONTROL, p.InputMode.INACTIVE)
+    axis.set_input_vel(2.0, 0.02)
+    assert axis.update(0.03, 0.0) == -5.0
 
 
 def test_watchdog_expires_without_commands_and_disarms() -> None:

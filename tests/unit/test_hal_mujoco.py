@@ -155,6 +155,22 @@ def test_planar_truth_is_ground_truth_without_the_attitude() -> None:
     assert abs(gt.vy_world) > 0.01
 
 
+def test_wheel_values_are_read_wheels_as_a_tuple() -> None:
+    """The drive emulator's per-instant read gives exactly read_wheels' four values, in
+    its field order (and the interface's default, which reads read_wheels, agrees),
+    with the wheels turning at different speeds."""
+    hw = MujocoInterface("empty")
+    hw.write(WheelCommand(SPEED, -0.5 * SPEED))
+    for _ in range(30):
+        hw.advance(10)
+        w = hw.read_wheels()
+        expected = (w.left_position, w.right_position, w.left_velocity, w.right_velocity)
+        assert hw.wheel_values() == expected
+        assert RobotHardwareInterface.wheel_values(hw) == expected
+        assert all(type(v) is float for v in hw.wheel_values())
+    assert w.left_velocity > 0.1 > -0.1 > w.right_velocity  # all four differ
+
+
 def test_shipped_model_stays_flat_and_never_scans_the_floor() -> None:
     hw = MujocoInterface("obstacles")
     pitches, floor_hits, _ = drive_and_brake(hw)

@@ -46,6 +46,43 @@ class RawFrame(NamedTuple):
     is_remote: bool = False
 
 
+class _Outgoing(can.Message):
+    """The message an endpoint refills for its data frames: a :class:`can.Message` whose
+    deep copy is made directly instead of through the constructor.
+
+    ``VirtualBus.send`` deep-copies the sent message once per receiver; python-can's
+    ``Message.__deepcopy__`` calls ``Message(...)`` with twelve keyword arguments and
+    deep-copies the payload and channel (three ``copy.deepcopy`` calls): 2.8 of the 5.6
+    us a frame costs on a virtual bus (measured). This copy sets the same slots to the
+    same values and types -- a plain ``can.Message``, ``data`` a new ``bytearray`` -- so
+    what a receiver gets is what python-can's own copy would give (a unit test compares
+    every slot of both). The bus code is python-can's, unchanged."""
+
+    __slots__ = ()
+
+    def __deepcopy__(self, memo: dict[int, Any] | None) -> can.Message:
+        channel = self.channel
+        if not (channel is None or isinstance(channel, str | int)):
+            return super().__deepcopy__(memo)  # a channel object: python-can's deep copy
+        copy: can.Message = _new_message(can.Message)
+        copy.timestamp = self.timestamp
+        copy.arbitration_id = self.arbitration_id
+        copy.is_extended_id = self.is_extended_id
+        copy.is_remote_frame = self.is_remote_frame
+        copy.is_error_frame = self.is_error_frame
+        copy.channel = channel
+        copy.is_fd = self.is_fd
+        copy.is_rx = self.is_rx
+        copy.bitrate_switch = self.bitrate_switch
+        copy.error_state_indicator = self.error_state_indicator
+        copy.data = bytearray() if self.is_remote_frame else bytearray(self.data)
+        copy.dlc = self.dlc
+        return copy
+
+
+_new_message = object.__new__
+
+
 class BusError(RuntimeError):
     """The bus refused a frame or could not be opened (bus-off, link down, no driver)."""
 
@@ -69,7 +106,7 @@ class CanEndpoint:
         self._template: can.Message | None = None
         if isinstance(bus, VirtualBus):
             self._rx_queue = bus.queue
-            self._template = can.Message(is_extended_id=False, check=False)
+            self._template = _Outgoing(is_extended_id=False, check=False)
 
     def send_data(self, arbitration_id: int, data: bytes, timestamp: float = 0.0) -> None:
         """Put a classic data frame on the bus (the hot path: no :class:`RawFrame`).

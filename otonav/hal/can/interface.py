@@ -51,6 +51,7 @@ from otonav.hal.types import (
 __all__ = ["BusPeer", "CanBusInterface", "WheelAxis"]
 
 _TWO_PI = 2.0 * math.pi
+_unpack_two_f32 = p.unpack_two_f32
 
 
 @dataclass(frozen=True, slots=True)
@@ -121,10 +122,15 @@ class CanBusInterface(RobotHardwareInterface):
             p.arbitration_id(left.node_id, p.CMD_SET_INPUT_VEL),
             p.arbitration_id(right.node_id, p.CMD_SET_INPUT_VEL),
         )
-        # The receive path's dispatch: an expected drive's encoder id -> its axis.
-        # Everything else (heartbeats, other nodes, error frames) takes the slow path.
+        # The receive path's dispatch: an expected drive's encoder id -> its axis index,
+        # node id and turns per rad. Everything else (heartbeats, other nodes, error
+        # frames) takes the slow path.
         self._encoder_axis = {
-            p.arbitration_id(axis.node_id, p.CMD_GET_ENCODER_ESTIMATES): i
+            p.arbitration_id(axis.node_id, p.CMD_GET_ENCODER_ESTIMATES): (
+                i,
+                axis.node_id,
+                self._scale[i],
+            )
             for i, axis in enumerate((left, right))
         }
         self.monitor = DriveMonitor(
@@ -152,6 +158,7 @@ class CanBusInterface(RobotHardwareInterface):
         self.read_imu = sensors.read_imu  # type: ignore[method-assign]
         self.read_scan = sensors.read_scan  # type: ignore[method-assign]
         self.ground_truth = sensors.ground_truth  # type: ignore[method-assign]
+        self.planar_truth = sensors.planar_truth  # type: ignore[method-assign]
         self._geometry = sensors.geometry  # the robot's shape does not change as it runs
         self._start(sensors.ticks * self._tick)
 
@@ -227,21 +234,26 @@ class CanBusInterface(RobotHardwareInterface):
             self.frames_dropped_from_log += min(over, len(frames))
         append = log.append
         encoder_axis = self._encoder_axis
+        encoder = self.monitor.encoder
+        pos, vel = self._pos, self._vel
+        fresh = False
         for frame in frames:
             append((t, frame))
             ident, data, is_error, is_remote = frame
-            i = None if is_error or is_remote else encoder_axis.get(ident)
-            if i is None:
+            axis = None if is_error or is_remote else encoder_axis.get(ident)
+            if axis is None:
                 self._receive_other(frame, t)
                 continue
-            self.monitor.encoder(self._node_ids[i], t)
+            i, node_id, scale = axis
+            encoder(node_id, t)
             try:
-                position, velocity = p.unpack_two_f32(data)
+                position, velocity = _unpack_two_f32(data)
             except struct.error:  # a short payload: ignored, like a bad frame on the wire
                 continue
-            scale = self._scale[i]
-            self._pos[i] = position / scale
-            self._vel[i] = velocity / scale
+            pos[i] = position / scale
+            vel[i] = velocity / scale
+            fresh = True
+        if fresh:
             self._wheels = None
 
     def _receive_other(self, frame: RawFrame, t: float) -> None:

@@ -33,11 +33,12 @@ from otonav.hal.can import protocol as p
 from otonav.hal.can.bus import CAN_ERR_BUSOFF, CAN_ERR_RESTARTED, CanEndpoint, RawFrame
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.sim.odrive import AxisModel, AxisParams
-from otonav.hal.types import WheelCommand, WheelState
+from otonav.hal.types import WheelCommand
 
 __all__ = ["BusFaults", "DriveEmulator", "DriveMount"]
 
 _TWO_PI = 2.0 * math.pi
+_pack_two_f32 = p.pack_two_f32
 
 
 @dataclass(frozen=True, slots=True)
@@ -70,11 +71,22 @@ class BusFaults:
 
 
 class _Drive:
-    __slots__ = ("axis", "encoder_id", "heartbeat_id", "heartbeat_silent", "k", "mount", "node_id")
+    __slots__ = (
+        "axis",
+        "encoder_id",
+        "gear",
+        "heartbeat_id",
+        "heartbeat_silent",
+        "k",
+        "mount",
+        "node_id",
+        "sign",
+    )
 
     def __init__(self, params: AxisParams, mount: DriveMount) -> None:
         self.axis = AxisModel(params)
         self.mount = mount
+        self.sign, self.gear = mount.sign, mount.gear_ratio
         self.node_id = params.node_id
         self.heartbeat_silent = False
         # Precomputed for the 10 ms encoder frames: the id, and wheel rad -> motor turns.
@@ -172,10 +184,9 @@ class DriveEmulator:
         """Receive, update the drives and the wheels, send what is due at tick ``now``.
 
         Called again at an instant already exchanged (the host sent commands since),
-        the axes are updated again only if a command changed their state: a
-        Set_Input_Vel alone moves nothing before time passes (the setpoint ramp is
-        ``vel_ramp_rate * dt`` and dt is 0), so that update would be a no-op. Skipping
-        it saved ~10 % of the emulator's cost (one such instant per 20 ms base tick)."""
+        the axes are updated again only if a command changed their state or a setpoint
+        (a Set_Input_Vel in PASSTHROUGH); in VEL_RAMP a Set_Input_Vel alone moves
+        nothing before time passes (the ramp is ``vel_ramp_rate * dt`` and dt is 0)."""
         t = now * self._tick
         changed = False
         incoming = self._endpoint.poll()
@@ -200,8 +211,8 @@ class DriveEmulator:
         if now == self._updated_at and not changed:
             return
         self._updated_at = now
-        wheels = self._world.read_wheels()
-        self._drive_wheels(t, wheels)
+        wheels = self._world.wheel_values()
+        self._drive_wheels(t, wheels[2], wheels[3])
         if now != self._sent_at and not self._bus_off:
             self._sent_at = now
             if now % self._enc_ticks == 0:
@@ -239,8 +250,8 @@ class DriveEmulator:
         self.frames_sent += 1
 
     def _handle(self, frame: RawFrame, t: float) -> bool:
-        """Apply one command frame; True if it may have changed an axis' state (any
-        command but Set_Input_Vel)."""
+        """Apply one command frame; True if it may have changed an axis' state or
+        setpoint (any command but a Set_Input_Vel the ramp will follow later)."""
         if frame.is_error or frame.is_remote:
             return False
         ident = frame.arbitration_id
@@ -251,8 +262,9 @@ class DriveEmulator:
         axis, data = drive.axis, frame.data
         try:
             if cmd == p.CMD_SET_INPUT_VEL:
-                axis.set_input_vel(p.unpack_two_f32(data)[0], t)
-                return False
+                # In PASSTHROUGH the setpoint takes the input now, like a real drive's
+                # next control cycle (8 kHz): the wheels are driven at this instant.
+                return axis.set_input_vel(p.unpack_two_f32(data)[0], t)
             if cmd == p.CMD_SET_AXIS_STATE:
                 axis.request_state(p.decode_set_axis_state(data), t)
             elif cmd == p.CMD_ESTOP:
@@ -267,26 +279,25 @@ class DriveEmulator:
             return False
         return True
 
-    def _drive_wheels(self, t: float, wheels: WheelState) -> None:
+    def _drive_wheels(self, t: float, left_velocity: float, right_velocity: float) -> None:
         left, right = self.drives
-        ml, mr = left.mount, right.mount
         # wheel rad/s -> motor turns/s and back (the arithmetic is the recording's bytes)
-        turns_l = left.axis.update(t, ml.sign * wheels.left_velocity * ml.gear_ratio / _TWO_PI)
-        turns_r = right.axis.update(t, mr.sign * wheels.right_velocity * mr.gear_ratio / _TWO_PI)
+        turns_l = left.axis.update(t, left.sign * left_velocity * left.gear / _TWO_PI)
+        turns_r = right.axis.update(t, right.sign * right_velocity * right.gear / _TWO_PI)
         cmd = (
-            ml.sign * turns_l * _TWO_PI / ml.gear_ratio,
-            mr.sign * turns_r * _TWO_PI / mr.gear_ratio,
+            left.sign * turns_l * _TWO_PI / left.gear,
+            right.sign * turns_r * _TWO_PI / right.gear,
         )
         if cmd != self._last_cmd:
             self._last_cmd = cmd
             self._world.write(WheelCommand(cmd[0], cmd[1]))
 
-    def _send_encoders(self, now: int, t: float, wheels: WheelState) -> None:
+    def _send_encoders(self, now: int, t: float, wheels: tuple[float, float, float, float]) -> None:
         left, right = self.drives
-        pack = p.pack_two_f32
+        position_l, position_r, velocity_l, velocity_r = wheels
         kl, kr = left.k, right.k
-        data_l = pack(wheels.left_position * kl, wheels.left_velocity * kl)
-        data_r = pack(wheels.right_position * kr, wheels.right_velocity * kr)
+        data_l = _pack_two_f32(position_l * kl, velocity_l * kl)
+        data_r = _pack_two_f32(position_r * kr, velocity_r * kr)
         faults = self.faults
         if faults.drop_rate > 0.0 or faults.delay > 0.0 or faults.jitter > 0.0:
             self._transmit(RawFrame(left.encoder_id, data_l), now, t)

@@ -5,9 +5,11 @@ time, and asks for the velocity setpoint (turns/s, motor side) to put on the whe
 
 * States IDLE and CLOSED_LOOP_CONTROL. Closed loop is entered ``arm_time`` s after it
   was requested, and only with no error active (a real ODrive refuses too).
-* Velocity control, input passthrough: the setpoint follows ``Set_Input_Vel`` clamped to
-  ``vel_limit`` and slewed at ``vel_ramp_rate`` (turns/s²). The torque loop under it is
-  MuJoCo's velocity actuator with its force limit.
+* Velocity control: the setpoint follows ``Set_Input_Vel`` clamped to ``vel_limit``. In
+  input mode PASSTHROUGH (what the CAN interface selects) it takes the input at once; in
+  VEL_RAMP it slews towards it at ``vel_ramp_rate`` (turns/s²); INACTIVE ignores the input
+  (the setpoint holds), like an ODrive's ``controller.config.input_mode``. The torque loop
+  under it is MuJoCo's velocity actuator with its force limit.
 * The watchdog: in closed loop, no ``Set_Input_Vel`` for ``watchdog_timeout`` s raises
   WATCHDOG_TIMER_EXPIRED and drops to IDLE (0 disables it). Entering closed loop feeds it.
 * Errors latch until ``Clear_Errors``; any error disarms (IDLE, setpoint 0). Estop
@@ -26,6 +28,8 @@ __all__ = ["AxisModel", "AxisParams"]
 
 _CLOSED_LOOP = AxisState.CLOSED_LOOP_CONTROL
 _VELOCITY_CONTROL = ControlMode.VELOCITY_CONTROL
+_PASSTHROUGH = InputMode.PASSTHROUGH
+_VEL_RAMP = InputMode.VEL_RAMP
 
 
 @dataclass(frozen=True, slots=True)
@@ -85,10 +89,13 @@ class AxisModel:
         if inp in InputMode._value2member_map_:
             self.input_mode = InputMode(inp)
 
-    def set_input_vel(self, vel: float, now: float) -> None:
+    def set_input_vel(self, vel: float, now: float) -> bool:
+        """Take a Set_Input_Vel (it feeds the watchdog). True if the setpoint follows it
+        at once (input mode PASSTHROUGH): the caller should :meth:`update` now."""
         if math.isfinite(vel):
             self.input_vel = vel
         self._fed_at = now
+        return self.input_mode == _PASSTHROUGH
 
     def estop(self) -> None:
         self.raise_error(AxisError.ESTOP_REQUESTED)
@@ -132,14 +139,20 @@ class AxisModel:
         if abs(measured_vel) > self._overspeed:
             self.raise_error(AxisError.VELOCITY_LIMIT_VIOLATION)
             return 0.0
+        mode = self.input_mode
         if self.control_mode != _VELOCITY_CONTROL:
             target = 0.0
-        else:
+        elif mode in (_PASSTHROUGH, _VEL_RAMP):
             limit, wanted = p.vel_limit, self.input_vel
             target = wanted if wanted < limit else limit
             target = target if target > -limit else -limit
-        step = p.vel_ramp_rate * dt
-        change = target - self.setpoint
-        change = change if change < step else step
-        self.setpoint += change if change > -step else -step
+        else:  # INACTIVE: the input is ignored, the setpoint holds
+            return self.setpoint
+        if mode == _VEL_RAMP:
+            step = p.vel_ramp_rate * dt
+            change = target - self.setpoint
+            change = change if change < step else step
+            self.setpoint += change if change > -step else -step
+        else:
+            self.setpoint = target
         return self.setpoint
