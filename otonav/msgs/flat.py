@@ -195,7 +195,9 @@ def real_type(cls: type[M]) -> type[M]:
 def reader(message_type: type[M], *paths: str) -> Callable[[M], tuple[Any, ...]]:
     """A function giving the values at ``paths`` of a ``message_type`` message, as a
     tuple: from a flat message's values and its template (nothing built), from any
-    other message through its attributes. The same values either way."""
+    other message through its attributes. The same values either way: a path that
+    holds varying values (``header.stamp`` of a layout that varies its ``sec``) or lies
+    inside one is read from the built message."""
     if not paths:
         raise ValueError("reader: name at least one path")
     get = attrgetter(*paths)
@@ -203,12 +205,20 @@ def reader(message_type: type[M], *paths: str) -> Callable[[M], tuple[Any, ...]]
     def through_attributes(m: Any) -> tuple[Any, ...]:
         return (get(m),) if len(paths) == 1 else get(m)
 
-    picks: dict[FlatLayout[Any], Callable[[tuple[Any, ...]], tuple[Any, ...]]] = {}
+    picks: dict[FlatLayout[Any], Callable[[tuple[Any, ...]], tuple[Any, ...] | None]] = {}
 
-    def pick_for(layout: FlatLayout[Any]) -> Callable[[tuple[Any, ...]], tuple[Any, ...]]:
+    def pick_for(
+        layout: FlatLayout[Any],
+    ) -> Callable[[tuple[Any, ...]], tuple[Any, ...] | None]:
         names: dict[str, object] = {}
         parts = []
         for path in paths:
+            if path not in layout.paths and any(
+                varying.startswith(f"{path}.") or path.startswith(f"{varying}.")
+                for varying in layout.paths
+            ):
+                picks[layout] = _no_pick
+                return _no_pick
             if path in layout.paths:
                 i = layout.paths.index(path)
                 parts.append(f"tuple(v[{i}])" if i in layout.byte_paths else f"v[{i}]")
@@ -227,11 +237,19 @@ def reader(message_type: type[M], *paths: str) -> Callable[[M], tuple[Any, ...]]
             state = _get(message, "__dict__").get(_KEY)
             if state is not None:
                 layout, values = state
-                return (picks.get(layout) or pick_for(layout))(values)
+                picked = (picks.get(layout) or pick_for(layout))(values)
+                if picked is not None:
+                    return picked
         result: tuple[Any, ...] = through_attributes(message)
         return result
 
     return read
+
+
+def _no_pick(values: tuple[Any, ...]) -> None:
+    """A reader's pick for a layout whose values it cannot take apart: read the built
+    message instead."""
+    return None
 
 
 # -- building ----------------------------------------------------------------------------
