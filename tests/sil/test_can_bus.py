@@ -187,6 +187,29 @@ async def test_a_full_frame_mailbox_holds_the_tap_back_and_loses_no_frame() -> N
     assert [round(b - a, 6) for a, b in itertools.pairwise(stamps)] == [0.01] * (len(stamps) - 1)
 
 
+@pytest.mark.sim(wall_ceiling=60)
+async def test_frames_are_kept_only_while_somebody_listens() -> None:
+    # No recorder, no subscriber: from the tap's first wake (20 Hz) the interface keeps
+    # no frame. A subscriber that joins gets every frame from the tap's next wake on, in
+    # bus order, with no gap: the left drive's encoder estimates 10 ms apart.
+    async with running_stack(CAN) as stack:
+        system, hal = stack.system, stack.hal
+        assert isinstance(hal, CanBusInterface)
+        await system.clock.sleep(0.5)
+        assert not hal.log_frames
+        assert hal.take_frames() == []
+        joined = system.clock.now()
+        late = system.subscribe(FRAMES_TOPIC, Frame, WATCH)
+        await system.clock.sleep(0.5)
+        assert hal.log_frames
+        frames = drain(late)
+    left = p.arbitration_id(CAN.hal.sim.left_node_id, p.CMD_GET_ENCODER_ESTIMATES)
+    stamps = [_secs(f.header.stamp) for f in frames if f.id == left]
+    assert joined <= stamps[0] <= joined + 0.05 + 0.011  # from the tap's next wake on
+    assert stamps[-1] > joined + 0.4
+    assert [round(b - a, 6) for a, b in itertools.pairwise(stamps)] == [0.01] * (len(stamps) - 1)
+
+
 # -- the interface alone: startup, shutdown, encoders only from frames -------------------
 
 

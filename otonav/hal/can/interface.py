@@ -88,7 +88,9 @@ class CanBusInterface(RobotHardwareInterface):
     """Wheels on ODrive CAN Simple drives, sensors and time from ``sensors``.
 
     ``frame_log`` bounds the frames kept for :meth:`take_frames` (the recording tap);
-    older ones are dropped and counted in :attr:`frames_dropped_from_log`.
+    older ones are dropped and counted in :attr:`frames_dropped_from_log`. While
+    :attr:`log_frames` is False no frame is kept (the tap turns it off while nobody
+    subscribes to /can/frames).
 
     ``command_keepalive`` (s): a wheel setpoint equal to the one last sent to that drive
     is sent again only once this much sim time has passed since (0: every write is
@@ -144,6 +146,8 @@ class CanBusInterface(RobotHardwareInterface):
         self._log_limit = frame_log
         self._logged = 0
         self.frames_dropped_from_log = 0
+        self.log_frames = True
+        """Keep the frames sent and received for :meth:`take_frames`."""
         self._closed = False
         self._stopped = False  # the drives were set IDLE (stop_drives)
         self._keepalive_ticks = round(command_keepalive / sensors.tick)
@@ -228,17 +232,17 @@ class CanBusInterface(RobotHardwareInterface):
     def _receive(self, frames: list[RawFrame], t: float) -> None:
         """Log and decode the frames of one bus instant (the hot path: two encoder
         frames every 10 ms, found by arbitration id in one dict lookup)."""
-        log = self._log
-        over = len(log) + len(frames) - self._log_limit
-        if over > 0:  # the oldest frames leave the bounded log
-            self.frames_dropped_from_log += min(over, len(frames))
-        append = log.append
+        if self.log_frames:
+            log = self._log
+            over = len(log) + len(frames) - self._log_limit
+            if over > 0:  # the oldest frames leave the bounded log
+                self.frames_dropped_from_log += min(over, len(frames))
+            log.extend([(t, frame) for frame in frames])
         encoder_axis = self._encoder_axis
         encoder = self.monitor.encoder
         pos, vel = self._pos, self._vel
         fresh = False
         for frame in frames:
-            append((t, frame))
             ident, data, is_error, is_remote = frame
             axis = None if is_error or is_remote else encoder_axis.get(ident)
             if axis is None:
@@ -311,10 +315,11 @@ class CanBusInterface(RobotHardwareInterface):
             self.monitor.bus_off(t, str(exc))
             return False
         self._sent = True
-        log = self._log
-        if len(log) == log.maxlen:
-            self.frames_dropped_from_log += 1
-        log.append((t, RawFrame(ident, data)))
+        if self.log_frames:
+            log = self._log
+            if len(log) == log.maxlen:
+                self.frames_dropped_from_log += 1
+            log.append((t, RawFrame(ident, data)))
         return True
 
     def take_frames(self) -> list[tuple[float, RawFrame]]:
