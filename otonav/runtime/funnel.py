@@ -210,12 +210,10 @@ class Funnel:
             return []
         taken = list(queue)
         queue.clear()
-        counts: dict[str, int] = {}
-        for topic, _time, _message in taken:
-            counts[topic] = counts.get(topic, 0) + 1
-        taps = self.taps
-        for topic, n in counts.items():
-            taps[topic].taken += n
+        # A tap's received minus its taken is what it has queued: none now. One update
+        # per topic instead of a count per message (~10,000 a run).
+        for tap in self.taps.values():
+            tap.taken = tap.received
         if self._blocked:
             self._took()
         return taken

@@ -8,6 +8,8 @@ from pathlib import Path
 import pytest
 
 from otonav.actors.bridge import CLOCK, ODOM
+from otonav.hal.can.bus import RawFrame
+from otonav.hal.can.tap import frames_of
 from otonav.msgs import Clock, Header, Log, Message, Time
 from otonav.record.writer import RecordingWriter
 
@@ -29,6 +31,11 @@ def _deliveries() -> list[tuple[str, float, Message]]:
         if n % 4 == 1:  # fixed-layout messages, packed rather than encoded field by field
             out.append(("/flat_clock", t, CLOCK(stamp.sec, stamp.nanosec)))
             out.append(("/odom", t, ODOM(stamp.sec, stamp.nanosec, t, -t, 0.0, 1.0, 0.5, n)))
+        if n % 7 == 0:  # a batch (the CAN tap's flush): a run of one topic and instant
+            raw = [(t - 0.01 * k, RawFrame(0x29 + k, bytes(k), k == 3, False)) for k in range(5)]
+            out.extend(("/can/frames", t, frame) for frame in frames_of("can0", raw))
+        if n % 11 == 0:  # a topic name equal to an earlier one, not the same object
+            out.append(("".join(["/clo", "ck"]), t, Clock(clock=stamp)))
         if n % 97 == 1:  # a publisher that waited for room: stamped earlier
             out.append(("/late", t - 0.5, Clock(clock=Time.from_seconds(t - 0.5))))
     return out
