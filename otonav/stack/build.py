@@ -73,6 +73,7 @@ def _can_world(config: StackConfig, world: MujocoInterface) -> CanBusInterface:
             WheelAxis,
             open_endpoint,
         )
+        from otonav.hal.can.protocol import InputMode
         from otonav.hal.sim import AxisParams, DriveEmulator, DriveMount
     except ImportError as exc:  # python-can is an extra
         raise ConfigFileError(
@@ -124,6 +125,7 @@ def _can_world(config: StackConfig, world: MujocoInterface) -> CanBusInterface:
             limits,
             peer=peer,
             command_keepalive=can.command_keepalive,
+            input_mode=InputMode[can.input_mode.upper()],
         )
     except BaseException:
         host.close()

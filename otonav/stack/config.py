@@ -264,6 +264,11 @@ class CanConfig(_Section):
     command_keepalive: _CanDelay = 0.1
     """s: an unchanged wheel setpoint is sent again only this often (0: at every base
     tick). Keep it well under the drives' watchdog timeout."""
+    input_mode: Literal["passthrough", "vel_ramp"] = "passthrough"
+    """The ODrive input mode the interface selects at startup (Set_Controller_Mode,
+    velocity control): ``passthrough``, the setpoint follows each Set_Input_Vel at once
+    (the base controller already limits acceleration), or ``vel_ramp``, the drive slews
+    it at its own ``vel_ramp_rate`` (``hal.sim.vel_ramp_rate`` for emulated drives)."""
     record_frames: bool = True
     """Publish every frame on /can/frames (and so into the recording)."""
 
@@ -284,7 +289,7 @@ class DriveSimConfig(_Section):
     vel_ramp_rate: Annotated[
         float, _within(0.0, limits.MAX_DRIVE_RAMP_TURNS_S2, " turns/s^2", open_low=True)
     ] = 200.0
-    """turns/s^2."""
+    """turns/s^2: the setpoint's slew in input mode VEL_RAMP (``hal.can.input_mode``)."""
     watchdog_timeout: _CanDelay = 0.2
     """s without Set_Input_Vel before the axis stops (0: off)."""
     arm_time: _CanDelay = 0.01

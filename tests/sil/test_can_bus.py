@@ -280,6 +280,37 @@ def _bench(
     return hal, emulator, world
 
 
+@pytest.mark.parametrize("mode", ["passthrough", "vel_ramp"])
+def test_the_configured_input_mode_reaches_the_drives(mode: str) -> None:
+    # hal.can.input_mode is what Set_Controller_Mode selects: in passthrough a drive's
+    # setpoint takes a new Set_Input_Vel at the instant it arrives; in vel_ramp it slews
+    # at the drive's vel_ramp_rate (100 turns/s^2 here: 1 turn/s per 10 ms).
+    config = apply_overrides(
+        StackConfig(), ["hal.kind=can", f"hal.can.input_mode={mode}", "hal.sim.vel_ramp_rate=100"]
+    )
+    hal = build_world(config)
+    with hal:
+        emulator = emulator_of(hal)
+        ten_ms = round(0.01 / hal.tick)
+        for _ in range(20):  # 0.2 s at rest, feeding the drives' watchdog: closed loop
+            hal.write(WheelCommand(0.0, 0.0))
+            hal.advance(ten_ms)
+        assert hal.health().drivable
+        axis = emulator.drive(config.hal.sim.right_node_id)
+        assert axis.input_mode == p.InputMode[mode.upper()]
+        target = 5.0  # turns/s of the right motor (sign +1, gear 1)
+        hal.write(WheelCommand(-target * 2 * math.pi, target * 2 * math.pi))
+        hal.advance(0)  # the frames cross the bus at this instant
+        setpoints = [axis.setpoint]
+        for _ in range(3):
+            hal.advance(ten_ms)
+            setpoints.append(axis.setpoint)
+    if mode == "passthrough":
+        assert setpoints == pytest.approx([target] * 4)
+    else:
+        assert setpoints == pytest.approx([0.0, 1.0, 2.0, 3.0])
+
+
 def test_startup_waits_for_closed_loop_in_sim_time_and_shutdown_sets_idle() -> None:
     hal, emulator, world = _bench("test-startup")
     with hal:

@@ -16,7 +16,7 @@ bus with ``recv(timeout=0)``, and the :class:`~otonav.hal.can.monitor.DriveMonit
 checks the drives. No thread and no wall clock: the same run gives the same frames.
 With no peer (real drives) the bus is drained at every ``advance``.
 
-Startup: construction sends Clear_Errors, Set_Controller_Mode (velocity, passthrough)
+Startup: construction sends Clear_Errors, Set_Controller_Mode (velocity, ``input_mode``)
 and Set_Axis_State(CLOSED_LOOP_CONTROL) to both drives; :meth:`health` is "starting"
 (not ready: the base holds zero) until a later heartbeat of each shows closed loop,
 or a fault naming the silent node id after ``startup_timeout`` s of sim time.
@@ -96,6 +96,10 @@ class CanBusInterface(RobotHardwareInterface):
     is sent again only once this much sim time has passed since (0: every write is
     sent). The drive holds its last setpoint; the resend feeds its watchdog, so keep
     it well under the drives' ``watchdog_timeout``. A changed setpoint always goes out.
+
+    ``input_mode``: what Set_Controller_Mode selects (velocity control) at startup and
+    recovery: PASSTHROUGH (the drive takes each setpoint at once) or VEL_RAMP (it slews
+    towards it at its own ``vel_ramp_rate``).
     """
 
     def __init__(
@@ -109,11 +113,15 @@ class CanBusInterface(RobotHardwareInterface):
         peer: BusPeer | None = None,
         frame_log: int = 50_000,
         command_keepalive: float = 0.1,
+        input_mode: p.InputMode = p.InputMode.PASSTHROUGH,
     ) -> None:
         if not 0.0 <= command_keepalive < math.inf:
             raise ValueError(f"command_keepalive must be >= 0 s, got {command_keepalive}")
         if left.node_id == right.node_id:
             raise ValueError(f"left and right wheel share node id {left.node_id}")
+        if input_mode not in (p.InputMode.PASSTHROUGH, p.InputMode.VEL_RAMP):
+            raise ValueError(f"input_mode must be PASSTHROUGH or VEL_RAMP, got {input_mode!r}")
+        self._input_mode = input_mode
         self._endpoint = endpoint
         self._sensors = sensors
         self._peer = peer
@@ -299,7 +307,7 @@ class CanBusInterface(RobotHardwareInterface):
             self._send(*p.clear_errors(axis.node_id), t)
             self._send(
                 *p.set_controller_mode(
-                    axis.node_id, p.ControlMode.VELOCITY_CONTROL, p.InputMode.PASSTHROUGH
+                    axis.node_id, p.ControlMode.VELOCITY_CONTROL, self._input_mode
                 ),
                 t,
             )
