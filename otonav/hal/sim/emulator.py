@@ -211,14 +211,27 @@ class DriveEmulator:
         if now == self._updated_at and not changed:
             return
         self._updated_at = now
+        # The drives' update and the wheels' setpoints, inline: this runs at every 10 ms
+        # instant. Wheel rad/s -> motor turns/s and back (the arithmetic is the
+        # recording's bytes).
         wheels = self._world.wheel_values()
-        self._drive_wheels(t, wheels[2], wheels[3])
-        if now != self._sent_at and not self._bus_off:
-            self._sent_at = now
-            if now % self._enc_ticks == 0:
-                self._send_encoders(now, t, wheels)
-            if now % self._hb_ticks == 0:
-                self._send_heartbeats(now, t)
+        left, right = self.drives
+        turns_l = left.axis.update(t, left.sign * wheels[2] * left.gear / _TWO_PI)
+        turns_r = right.axis.update(t, right.sign * wheels[3] * right.gear / _TWO_PI)
+        cmd = (
+            left.sign * turns_l * _TWO_PI / left.gear,
+            right.sign * turns_r * _TWO_PI / right.gear,
+        )
+        if cmd != self._last_cmd:
+            self._last_cmd = cmd
+            self._world.write(WheelCommand(cmd[0], cmd[1]))
+        if now == self._sent_at or self._bus_off:
+            return
+        self._sent_at = now
+        if now % self._enc_ticks == 0:
+            self._send_encoders(now, t, wheels)
+        if now % self._hb_ticks == 0:
+            self._send_heartbeats(now, t)
 
     # -- internals -----------------------------------------------------------------------
 
@@ -278,19 +291,6 @@ class DriveEmulator:
         except (ValueError, struct.error):  # a short payload: ignored
             return False
         return True
-
-    def _drive_wheels(self, t: float, left_velocity: float, right_velocity: float) -> None:
-        left, right = self.drives
-        # wheel rad/s -> motor turns/s and back (the arithmetic is the recording's bytes)
-        turns_l = left.axis.update(t, left.sign * left_velocity * left.gear / _TWO_PI)
-        turns_r = right.axis.update(t, right.sign * right_velocity * right.gear / _TWO_PI)
-        cmd = (
-            left.sign * turns_l * _TWO_PI / left.gear,
-            right.sign * turns_r * _TWO_PI / right.gear,
-        )
-        if cmd != self._last_cmd:
-            self._last_cmd = cmd
-            self._world.write(WheelCommand(cmd[0], cmd[1]))
 
     def _send_encoders(self, now: int, t: float, wheels: tuple[float, float, float, float]) -> None:
         left, right = self.drives
