@@ -112,6 +112,10 @@ class CanFrameTap(Actor):
             raise ValueError(f"can tap rate must be > 0 Hz, got {rate_hz}")
         self.hal = hal
         self.rate_hz = rate_hz
+        # The channel's frame layout is made now, while the stack is built, like the
+        # bridge's layouts: not at the first flush inside the run (~2 ms once per process,
+        # most of it pydantic making the flat Frame class).
+        frame_layout(hal.channel)
         self._topic: Topic[Frame] | None = None
         self._stopping = False
 
