@@ -38,10 +38,10 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from operator import attrgetter
-from typing import Any, ClassVar, Generic, TypeVar
+from typing import Any, Generic, TypeVar
 
 from otonav.msgs._base import Message
-from otonav.msgs.stand_in import become, get, new, operators, set_dict, set_extra
+from otonav.msgs.stand_in import become, get, new, set_dict, set_extra, stand_in_class
 from otonav.msgs.stand_in import make as _make
 from otonav.msgs.stand_in import set_fields_set as _set_fields_set
 from otonav.msgs.stand_in import set_private as _set_private
@@ -90,17 +90,15 @@ def _flat_class(real: type[Message]) -> type[Message]:
         materialize(self)
         return _get(self, name)
 
-    namespace = {
-        "__getattribute__": __getattribute__,
-        **operators(materialize),
-        "__module__": __name__,
-        "__qualname__": f"Flat{real.__name__}",
-        "__doc__": f"A {real.__name__} of a fixed layout: built on first use.",
-        "stands_for": real,
-        "__annotations__": {"stands_for": ClassVar[type[Message]]},
-    }
-    metaclass: Any = type(real)  # pydantic's: the subclass is a model like its base
-    cls: type[Message] = metaclass(f"Flat{real.__name__}", (real,), namespace)
+    cls = stand_in_class(
+        real,
+        f"Flat{real.__name__}",
+        module=__name__,
+        doc=f"A {real.__name__} of a fixed layout: built on first use.",
+        getattribute=__getattribute__,
+        materialize=materialize,
+        stands_for=real,
+    )
     _FLAT[real] = cls
     _REAL[cls] = real
     return cls

@@ -29,7 +29,7 @@ from typing import Any, TypeVar
 
 from otonav.msgs import Header, Message
 from otonav.msgs.flat import FlatLayout
-from otonav.msgs.stand_in import become, operators
+from otonav.msgs.stand_in import become, stand_in_class
 from otonav.msgs.stand_in import get as _get
 from otonav.msgs.stand_in import new as _new
 from otonav.msgs.stand_in import set_dict as _set_dict
@@ -91,20 +91,14 @@ def _lazy_class(real: type[Message]) -> type[Message]:
         materialize(self)
         return _get(self, name)
 
-    namespace = {
-        "__getattribute__": __getattribute__,
-        **operators(materialize),
-        "__module__": __name__,
-        "__qualname__": f"Lazy{real.__name__}",
-        "__doc__": f"A {real.__name__} still in CDR: decoded on first use.",
-    }
-    namespace["__slots__"] = ()  # the base's layout exactly, so __class__ can switch
-    # type.__new__ with pydantic's metaclass, not the metaclass's own __new__: the
-    # subclass is a model class like its base (type(cls) is the same), without pydantic
-    # collecting its fields and building its validator again (~0.5 ms per message type,
-    # paid by the first replay of a process; the class only exists until first use).
-    metaclass: Any = type(real)
-    cls: type[Message] = type.__new__(metaclass, f"Lazy{real.__name__}", (real,), namespace)
+    cls = stand_in_class(
+        real,
+        f"Lazy{real.__name__}",
+        module=__name__,
+        doc=f"A {real.__name__} still in CDR: decoded on first use.",
+        getattribute=__getattribute__,
+        materialize=materialize,
+    )
     _LAZY[real] = cls
     _REAL[cls] = real
     return cls
