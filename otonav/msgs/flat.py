@@ -306,33 +306,22 @@ def _compile_builder(
         names[name] = value
         return name
 
+    def code(value: Any, sub: int | _Tree | None) -> str:
+        """The value unchanged (the template's), a leaf's value, or a subtree rebuilt."""
+        if sub is None:
+            return const(value)
+        return leaf(sub) if isinstance(sub, int) else expr(value, sub)
+
     def fields(message: Message, node: _Tree) -> str:
-        parts = []
-        for name, value in _get(message, "__dict__").items():
-            sub = node.get(name)
-            code = (
-                const(value)
-                if sub is None
-                else leaf(sub)
-                if isinstance(sub, int)
-                else expr(value, sub)
-            )
-            parts.append(f"{name!r}: {code}")
+        parts = [
+            f"{name!r}: {code(value, node.get(name))}"
+            for name, value in _get(message, "__dict__").items()
+        ]
         return "{" + ", ".join(parts) + "}"
 
     def expr(value: Any, node: _Tree) -> str:
         if isinstance(value, tuple):
-            items = []
-            for i, item in enumerate(value):
-                sub = node.get(str(i))
-                code = (
-                    const(item)
-                    if sub is None
-                    else leaf(sub)
-                    if isinstance(sub, int)
-                    else expr(item, sub)
-                )
-                items.append(code)
+            items = [code(item, node.get(str(i))) for i, item in enumerate(value)]
             return "(" + "".join(f"{item}, " for item in items) + ")"
         cls = const(type(value))
         fields_set = const(_get(value, "__pydantic_fields_set__"))
