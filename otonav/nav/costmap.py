@@ -209,18 +209,8 @@ class ClearanceMap:
         them: 9 points cost ~10 us instead of ~21 us with ``np.clip`` and 2-D fancy
         indexing (measured; the DWA asks ~600 points per sampled step)."""
         inv, pad, hi = 1.0 / self.resolution, self._pad, self._width - 1
-        col = x - self.origin_x
-        col *= inv
-        np.floor(col, out=col)
-        col += pad
-        np.maximum(col, 0.0, out=col)
-        np.minimum(col, hi, out=col)
-        row = y - self.origin_y
-        row *= inv
-        np.floor(row, out=row)
-        row += pad
-        np.maximum(row, 0.0, out=row)
-        np.minimum(row, hi, out=row)
+        col = _cell_index(x - self.origin_x, inv, pad, hi)
+        row = _cell_index(y - self.origin_y, inv, pad, hi)
         row *= self._width
         row += col
         return self._flat.take(row.astype(np.intp))
@@ -232,3 +222,14 @@ class ClearanceMap:
         col = min(max(math.floor((x - self.origin_x) * inv) + pad, 0), hi)
         row = min(max(math.floor((y - self.origin_y) * inv) + pad, 0), hi)
         return self._cells[row * self._width + col]
+
+
+def _cell_index(offset: NDArray[np.float64], inv: float, pad: int, hi: int) -> NDArray[np.float64]:
+    """Padded cell indices along one axis, clamped to the grid, as floats, computed in
+    place in ``offset`` (metres from the origin; a fresh array the caller gives away)."""
+    offset *= inv
+    np.floor(offset, out=offset)
+    offset += pad
+    np.maximum(offset, 0.0, out=offset)
+    np.minimum(offset, hi, out=offset)
+    return offset
