@@ -4,13 +4,16 @@ a config file, ``--set`` overrides. Each problem is a ``ConfigFileError`` naming
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 from otonav.scenario.builtin import BUILTIN
 from otonav.scenario.config import ScenarioConfig
 from otonav.stack.config import StackConfig
 from otonav.stack.files import ConfigFileError, load_model
+from otonav.stack.launch import add_actors, check_actors
 from otonav.stack.overrides import apply_overrides
+from otonav.stack.robot import resolve_paths
 
 
 def load_scenario(spec: str, *, source: str = "--scenario") -> ScenarioConfig:
@@ -25,7 +28,18 @@ def load_scenario(spec: str, *, source: str = "--scenario") -> ScenarioConfig:
     )
 
 
-def load_stack(config: Path | None, overrides: list[str]) -> StackConfig:
-    """The built-in stack config, or ``config`` (YAML), with ``--set`` overrides."""
-    stack = load_model(config, StackConfig) if config is not None else StackConfig()
-    return apply_overrides(stack, overrides) if overrides else stack
+def load_stack(
+    config: Path | None, overrides: list[str], actors: Sequence[str] = ()
+) -> StackConfig:
+    """The built-in stack config, or ``config`` (YAML; its relative paths resolved
+    against its folder), with ``--actor`` nodes added and ``--set`` overrides applied;
+    every launched actor's class imported and its parameters validated."""
+    stack = StackConfig()
+    if config is not None:
+        stack = resolve_paths(load_model(config, StackConfig), config.parent)
+    if actors:
+        stack = add_actors(stack, actors)
+    if overrides:
+        stack = apply_overrides(stack, overrides)
+    check_actors(stack.actors)
+    return stack

@@ -50,6 +50,15 @@ def add_parser(commands: Any) -> None:
         metavar="KEY.PATH=VALUE",
         help="override a stack config key, e.g. --set nav.kp_lin=0 (repeatable)",
     )
+    p.add_argument(
+        "--actor",
+        dest="actors",
+        action="append",
+        default=[],
+        metavar="MODULE:CLASS",
+        help="launch your node too, e.g. --actor my_nodes:Wander (repeatable; named by the "
+        "class in snake_case, its parameters set with --set actors.wander.KEY=VALUE)",
+    )
     p.add_argument("--seed", type=int, help="override the scenario's seed")
     p.add_argument(
         "--out", type=Path, default=DEFAULT_OUT, help="artifact directory (default: out)"
@@ -171,7 +180,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
             scenario = ScenarioConfig.model_validate({**scenario.model_dump(), "seed": args.seed})
         except ValidationError as exc:
             raise ConfigFileError(describe_validation_error("--seed", exc)) from None
-    stack = load_stack(args.config, args.overrides)
+    stack = load_stack(args.config, args.overrides, args.actors)
     out: Path = args.out
     source = args.scenario if args.scenario not in BUILTIN else f"scenario '{args.scenario}'"
     progress = ProgressLine() if sys.stderr.isatty() else None

@@ -40,6 +40,15 @@ def add_parser(commands: Any) -> None:
     p.add_argument(
         "--retry-errors", action="store_true", help="with --resume: rerun runs that errored"
     )
+    p.add_argument(
+        "--actor",
+        dest="actors",
+        action="append",
+        default=[],
+        metavar="MODULE:CLASS",
+        help="launch your node in every run, e.g. --actor my_nodes:Wander (repeatable); "
+        "vary its parameters as actors.wander.KEY in the overrides",
+    )
     quick = p.add_argument_group("quick form (no sweep file)")
     quick.add_argument("--generate", type=int, metavar="N", help="N generated worlds")
     quick.add_argument("--density", help="generator parameter: obstacle density")
@@ -260,10 +269,10 @@ def main(args: argparse.Namespace) -> int:
         raise ConfigFileError("--retry-errors: only with --resume")
     if args.sweep is not None:
         spec = load_sweep(args.sweep)
-        tasks = plan_runs(spec, base=args.sweep.parent, where=str(args.sweep))
+        tasks = plan_runs(spec, base=args.sweep.parent, where=str(args.sweep), actors=args.actors)
     else:
         spec = quick_spec(args)
-        tasks = plan_runs(spec, where="otonav sweep")
+        tasks = plan_runs(spec, where="otonav sweep", actors=args.actors)
     backend = runner.make_backend(args.backend, workers=args.workers, ray_address=args.ray_address)
     prepared = runner.prepare(
         args.out,

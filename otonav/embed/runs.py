@@ -83,7 +83,7 @@ def check_run(
     an unknown or broken scene (:class:`~otonav.hal.mujoco.SceneError`), a goal outside
     the arena or on an obstacle (:class:`~otonav.stack.files.ConfigFileError`). Builds
     the world once (milliseconds): call it from a worker thread on a busy loop."""
-    _stack, hal = scenario_world(scenario, stack, source=source)
+    _scenario, _stack, hal = scenario_world(scenario, stack, source=source)
     hal.close()
 
 

@@ -93,6 +93,11 @@ class RobotHardwareInterface(abc.ABC):
     def geometry(self) -> RobotGeometry:
         """Wheel radius and separation (m) and laser mounting offset (m)."""
 
+    def geometry_sources(self) -> dict[str, str]:
+        """Where each value of :attr:`geometry` (and each robot part) came from: derived
+        from the model, or given in the robot description. Empty when not known."""
+        return {}
+
     @abc.abstractmethod
     def obstacles(self) -> tuple[BoxObstacle, ...]:
         """The world's obstacle boxes (m), for ground-truth clearance. Excludes walls."""

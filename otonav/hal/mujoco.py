@@ -34,6 +34,7 @@ import threading
 import time
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
+from dataclasses import dataclass
 from importlib import resources
 from importlib.resources.abc import Traversable
 from pathlib import Path
@@ -42,6 +43,7 @@ from typing import Any, Final, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from otonav.hal.description import BUILTIN_ROBOTS, Mount, RobotDescription, builtin_robot
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.types import (
     BoxObstacle,
@@ -213,6 +215,564 @@ def _apply_bug_variant(spec: Any, label: str) -> None:
         act.biasprm[2] = -BUG_VARIANT_KV
 
 
+# -- the robot: a description put into a scene ------------------------------------------
+
+ROBOT_PREFIX: Final = "robot/"
+"""Names of an attached robot's elements in the compiled world (the scene's own names
+never clash with the robot's)."""
+_SERVO_SLIP: Final = 0.1
+"""rad/s of speed error at which a velocity loop otonav makes reaches its torque limit."""
+_DEFAULT_TORQUE_G: Final = 0.2
+"""A wheel with no stated torque limit gets 0.2 m g r: both wheels can then accelerate
+the robot at 0.4 g (ample for any base limit) without lifting a caster off the floor."""
+_MOUNT_ABOVE: Final = 0.02  # m: a default lidar sits this far above the robot's top
+_REST_TOLERANCE: Final = 1e-3  # m: a model resting within this of the floor is not moved
+
+
+def _names(elements: Sequence[Any]) -> str:
+    shown = [e.name for e in elements if e.name]
+    return ", ".join(shown) if shown else "none named"
+
+
+class _RobotSpec:
+    """The robot's part of an ``MjSpec`` made ready for otonav: wheel actuators driven
+    as velocity loops, a free base, the lidar and IMU sites and sensors, robot geoms out
+    of the lidar's groups. Records where each choice came from (``sources``)."""
+
+    def __init__(self, spec: Any, robot: RobotDescription, file_label: str) -> None:
+        self.spec = spec
+        self.robot = robot
+        self.file = file_label
+        self.sources: dict[str, str] = {}
+        self.wheel_acts: dict[str, Any] = {}
+        self.ctrl_scale: dict[str, float] = {}
+        self.lidar_site = ""
+        self.imu_site = ""
+        self.base = self._body(robot.base, "base")
+        self.joints = {
+            "left_wheel": self._wheel(robot.left_wheel, "left_wheel"),
+            "right_wheel": self._wheel(robot.right_wheel, "right_wheel"),
+        }
+
+    def fail(self, key: str, message: str) -> SceneError:
+        return SceneError(f"{self.robot.key}{key}: {message}")
+
+    def _body(self, name: str, key: str) -> Any:
+        body = self.spec.body(name)
+        if body is None or name == "world":
+            raise self.fail(
+                key, f"no body {name!r} in {self.file} (bodies: {_names(self.spec.bodies[1:])})"
+            )
+        return body
+
+    def _wheel(self, name: str, key: str) -> Any:
+        hinges = [j for j in self.spec.joints if j.type == mujoco.mjtJoint.mjJNT_HINGE]
+        joint = self.spec.joint(name)
+        if joint is None or joint.type != mujoco.mjtJoint.mjJNT_HINGE:
+            what = "no hinge joint" if joint is not None else "no joint"
+            raise self.fail(key, f"{what} {name!r} in {self.file} (hinge joints: {_names(hinges)})")
+        if not self._under_base(joint.parent):
+            raise self.fail(key, f"joint {name!r} is not part of the base {self.robot.base!r}")
+        return joint
+
+    def _under_base(self, body: Any) -> bool:
+        while body is not None and body.name != "world":
+            if body.name == self.base.name:
+                return True
+            body = body.parent
+        return False
+
+    def prepare(self, mass: float, wheel_radius: float) -> None:
+        """Free base, wheel actuators, sensor sites, geom groups (after :meth:`probe`)."""
+        joints = self.base.joints
+        if not joints:
+            self.base.add_freejoint()
+            self.sources["base"] = f"body {self.base.name!r}, free joint added by otonav"
+        elif joints[0].type != mujoco.mjtJoint.mjJNT_FREE:
+            kind = joints[0].type.name.removeprefix("mjJNT_").lower()
+            raise self.fail(
+                "base",
+                f"body {self.base.name!r} has a {kind} joint; otonav's base is a floating "
+                "body (a free joint, or none)",
+            )
+        else:
+            self.sources["base"] = f"body {self.base.name!r} (its own free joint)"
+        for key, joint in self.joints.items():
+            self._actuate(key, joint, mass * 9.81 * _DEFAULT_TORQUE_G * wheel_radius)
+        for geom in self.base.find_all(mujoco.mjtObj.mjOBJ_GEOM):
+            if int(geom.group) in (0, 2):  # the lidar's groups: it must not see the robot
+                geom.group = _ROBOT_GROUP
+
+    def _actuate(self, key: str, joint: Any, default_torque: float) -> None:
+        acts = [
+            a
+            for a in self.spec.actuators
+            if a.trntype == mujoco.mjtTrn.mjTRN_JOINT and a.target == joint.name
+        ]
+        if len(acts) > 1:
+            raise self.fail(
+                key, f"joint {joint.name!r} has {len(acts)} actuators ({_names(acts)}); give it one"
+            )
+        if not acts:
+            act = self.spec.add_actuator(name=f"otonav_{key}", target=joint.name)
+            act.trntype = mujoco.mjtTrn.mjTRN_JOINT
+            self._servo(act, default_torque)
+            self.sources[f"{key}_actuator"] = (
+                f"none in the model: otonav's velocity loop, kv {act.gainprm[0]:.4g}, "
+                f"+-{default_torque:.3g} N m"
+            )
+        elif _is_velocity(acts[0]):
+            act = acts[0]
+            self.sources[f"{key}_actuator"] = (
+                f"velocity actuator {act.name or '(unnamed)'!r}, kv {act.gainprm[0]:.4g}"
+            )
+        else:
+            act = acts[0]
+            kind = "motor" if act.biastype == mujoco.mjtBias.mjBIAS_NONE else "position"
+            torque = _torque_limit(act) or default_torque
+            self._servo(act, torque)
+            self.sources[f"{key}_actuator"] = (
+                f"{kind} actuator {act.name or '(unnamed)'!r} driven as a velocity loop, "
+                f"kv {act.gainprm[0]:.4g}, +-{torque:.3g} N m"
+            )
+        self.wheel_acts[key] = act
+        self.ctrl_scale[key] = float(act.gear[0])
+
+    @staticmethod
+    def _servo(act: Any, torque: float) -> None:
+        kv = torque / _SERVO_SLIP
+        act.gaintype = mujoco.mjtGain.mjGAIN_FIXED
+        act.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+        act.gainprm[:3] = [kv, 0.0, 0.0]
+        act.biasprm[:3] = [0.0, 0.0, -kv]
+        act.gear[:] = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+        act.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
+        act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+        act.forcerange[:] = [-torque, torque]
+
+    def mount(self, key: str, mount: Mount | None, default_pos: Sequence[float]) -> str:
+        """The name of the site the sensor ``key`` (lidar, imu) reads from."""
+        if mount is not None and mount.site is not None:
+            site = self.spec.site(mount.site)
+            if site is None:
+                raise self.fail(
+                    key, f"no site {mount.site!r} in {self.file} (sites: {_names(self.spec.sites)})"
+                )
+            if not self._under_base(site.parent):
+                raise self.fail(key, f"site {mount.site!r} is not on the robot {self.base.name!r}")
+            self.sources[key] = f"site {mount.site!r} of the model"
+            return str(site.name)
+        if mount is None:
+            own = self._own_site(key)
+            if own is not None:
+                return own
+        body = self.base if mount is None or mount.body is None else self._body(mount.body, key)
+        if not self._under_base(body):
+            raise self.fail(key, f"body {body.name!r} is not part of the robot {self.base.name!r}")
+        pos = list(default_pos) if mount is None or mount.pos is None else list(mount.pos)
+        name = f"otonav_{key}"
+        body.add_site(name=name, pos=pos, size=[0.01, 0.01, 0.01], group=4)
+        where = "otonav's default" if mount is None else "the config's mount"
+        self.sources[key] = (
+            f"mounted by otonav on body {body.name!r} at ({', '.join(f'{v:.4g}' for v in pos)})"
+            f" ({where})"
+        )
+        return name
+
+    def _own_site(self, key: str) -> str | None:
+        """A sensor the model already has: a rangefinder for the lidar, a gyro for the IMU."""
+        kinds = {
+            "lidar": mujoco.mjtSensor.mjSENS_RANGEFINDER,
+            "imu": mujoco.mjtSensor.mjSENS_GYRO,
+        }
+        for sensor in self.spec.sensors:
+            if sensor.type == kinds[key] and sensor.objtype == mujoco.mjtObj.mjOBJ_SITE:
+                site = self.spec.site(sensor.objname)
+                if site is not None and self._under_base(site.parent):
+                    self.sources[key] = (
+                        f"site {site.name!r} of the model's {sensor.type.name[9:].lower()} "
+                        f"{sensor.name or '(unnamed)'!r}"
+                    )
+                    return str(site.name)
+        return None
+
+    def imu_sensors(self, site: str) -> None:
+        """Gyro, accelerometer and orientation on the IMU site (the model's, or added)."""
+        have = {
+            s.type
+            for s in self.spec.sensors
+            if s.objtype == mujoco.mjtObj.mjOBJ_SITE and s.objname == site
+        }
+        kinds = mujoco.mjtSensor
+        for kind, suffix in (
+            (kinds.mjSENS_GYRO, "gyro"),
+            (kinds.mjSENS_ACCELEROMETER, "accel"),
+            (kinds.mjSENS_FRAMEQUAT, "quat"),
+        ):
+            if kind not in have:
+                sensor = self.spec.add_sensor(
+                    name=f"otonav_imu_{suffix}", type=kind, objtype=mujoco.mjtObj.mjOBJ_SITE
+                )
+                sensor.objname = site
+
+
+def _is_velocity(act: Any) -> bool:
+    kv = float(act.gainprm[0])
+    return (
+        act.gaintype == mujoco.mjtGain.mjGAIN_FIXED
+        and act.biastype == mujoco.mjtBias.mjBIAS_AFFINE
+        and kv > 0.0
+        and float(act.biasprm[0]) == 0.0
+        and float(act.biasprm[1]) == 0.0
+        and float(act.biasprm[2]) == -kv
+    )
+
+
+def _limited(flag: Any, lo: float, hi: float) -> bool:
+    return bool(
+        flag == mujoco.mjtLimited.mjLIMITED_TRUE
+        or (flag == mujoco.mjtLimited.mjLIMITED_AUTO and lo < hi)
+    )
+
+
+def _torque_limit(act: Any) -> float | None:
+    """The joint torque an actuator can give at most, from its force or control range."""
+    gear = abs(float(act.gear[0]))
+    lo, hi = (float(v) for v in act.forcerange)
+    if _limited(act.forcelimited, lo, hi):
+        return gear * max(abs(lo), abs(hi))
+    lo, hi = (float(v) for v in act.ctrlrange)
+    if act.biastype == mujoco.mjtBias.mjBIAS_NONE and _limited(act.ctrllimited, lo, hi):
+        return gear * abs(float(act.gainprm[0])) * max(abs(lo), abs(hi))
+    return None
+
+
+def _merge_options(scene: Any, robot: Any) -> None:
+    """One set of physics options for the attached world: the scene's, except where the
+    scene leaves one at MuJoCo's default and the robot's model sets it (its integrator,
+    its timestep). Written into both specs, so attaching has no conflict to report."""
+    default = mujoco.MjSpec().option
+    for name in dir(default):
+        if name.startswith("_") or callable(getattr(default, name)):
+            continue
+        ours, theirs, fresh = (getattr(o, name) for o in (scene.option, robot.option, default))
+        if np.array_equal(np.asarray(ours), np.asarray(fresh)):
+            setattr(scene.option, name, theirs)
+        else:
+            setattr(robot.option, name, ours)
+
+
+def _absolute_assets(spec: Any, path: Path) -> None:
+    """Mesh and texture files relative to the model's own directory (and its
+    ``meshdir``/``texturedir``), so the model can be attached to a scene elsewhere."""
+    folder = path.resolve().parent
+    for items, subdir in ((spec.meshes, spec.meshdir), (spec.textures, spec.texturedir)):
+        for item in items:
+            if item.file and not Path(item.file).is_absolute():
+                item.file = str(folder / (subdir or "") / item.file)
+    spec.meshdir = ""
+    spec.texturedir = ""
+
+
+def _load_robot(robot: RobotDescription) -> tuple[Any, str]:
+    path = Path(robot.model)
+    label = robot.label
+    if not path.is_file():
+        raise SceneError(
+            f"{robot.key}model: {label!r} is neither a built-in robot "
+            f"({', '.join(BUILTIN_ROBOTS)}) nor an existing MJCF or URDF file"
+        )
+    try:
+        spec = mujoco.MjSpec.from_file(str(path))
+    except ValueError as exc:
+        raise SceneError(f"{robot.key}model: {label} does not parse: {_one_line(exc)}") from None
+    _absolute_assets(spec, path)
+    return spec, label
+
+
+@dataclass(frozen=True, slots=True)
+class _Probe:
+    mass: float  # kg, the robot's
+    wheel_radius: float  # m, rough (bounding sphere of the left wheel's geoms)
+    top: float  # m, the highest point of the robot above its base's origin
+    bottom: float  # m, the lowest point of its collision geoms above the floor
+
+
+def _probe(parts: _RobotSpec) -> _Probe:
+    """Mass and extent of the robot as modelled, before otonav changes anything."""
+    model = _compile(parts.spec.copy(), parts.file)
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    base = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, parts.base.name))
+    joint = int(
+        mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, parts.joints["left_wheel"].name)
+    )
+    wheel = int(model.jnt_bodyid[joint])
+    geoms = _subtree_geoms(model, base)
+    radius = max(
+        (float(model.geom_rbound[g]) for g in geoms if model.geom_bodyid[g] == wheel), default=0.0
+    )
+    lows, highs = [], []
+    for g in geoms:
+        corners = _geom_corners(model, data, g)[:, 2]
+        highs.append(float(corners.max()))
+        if _collides(model, g):
+            lows.append(float(corners.min()))
+    return _Probe(
+        mass=float(model.body_subtreemass[base]),
+        wheel_radius=radius,
+        top=max(highs, default=0.0) - float(data.xpos[base][2]),
+        bottom=min(lows, default=0.0),
+    )
+
+
+def _subtree_geoms(model: Any, body: int) -> list[int]:
+    """The geoms of ``body`` and of every body under it."""
+    under = {body}
+    for b in range(body + 1, model.nbody):
+        if int(model.body_parentid[b]) in under:
+            under.add(b)
+    return [g for g in range(model.ngeom) if int(model.geom_bodyid[g]) in under]
+
+
+def _collides(model: Any, geom: int) -> bool:
+    return int(model.geom_contype[geom]) != 0 or int(model.geom_conaffinity[geom]) != 0
+
+
+_SIGNS: Final = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+
+
+def _geom_half(model: Any, geom: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Centre and half sizes of a box about ``geom`` in its own frame."""
+    size = model.geom_size[geom]
+    kind = int(model.geom_type[geom])
+    centre = np.zeros(3)
+    if kind == mujoco.mjtGeom.mjGEOM_SPHERE:
+        half = np.array([size[0], size[0], size[0]])
+    elif kind in (mujoco.mjtGeom.mjGEOM_CYLINDER, mujoco.mjtGeom.mjGEOM_CAPSULE):
+        extra = size[0] if kind == mujoco.mjtGeom.mjGEOM_CAPSULE else 0.0
+        half = np.array([size[0], size[0], size[1] + extra])
+    elif kind in (mujoco.mjtGeom.mjGEOM_BOX, mujoco.mjtGeom.mjGEOM_ELLIPSOID):
+        half = np.array(size[:3], dtype=np.float64)
+    else:  # mesh, hull, sdf...: MuJoCo's own bounding box in the geom frame
+        aabb = model.geom_aabb[geom]
+        centre, half = np.array(aabb[:3], dtype=np.float64), np.array(aabb[3:], dtype=np.float64)
+    return centre, half
+
+
+def _geom_corners(model: Any, data: Any, geom: int) -> NDArray[np.float64]:
+    """The 8 corners of ``geom``'s bounding box, world frame."""
+    centre, half = _geom_half(model, geom)
+    local = _SIGNS * half + centre
+    corners: NDArray[np.float64] = (
+        local @ data.geom_xmat[geom].reshape(3, 3).T + data.geom_xpos[geom]
+    )
+    return corners
+
+
+def _shown_name(model: Any, kind: Any, ident: int) -> str:
+    """An element's name as the user wrote it (without the attached robot's prefix)."""
+    name = mujoco.mj_id2name(model, kind, ident) or f"#{ident}"
+    return str(name).removeprefix(ROBOT_PREFIX)
+
+
+def _actuator_of(model: Any, joint: int) -> int:
+    for a in range(model.nu):
+        if (
+            int(model.actuator_trntype[a]) == mujoco.mjtTrn.mjTRN_JOINT
+            and int(model.actuator_trnid[a][0]) == joint
+        ):
+            return a
+    raise SceneError(f"no actuator on joint #{joint} after compiling")  # prepared: a bug
+
+
+def _site_sensor(model: Any, kind: Any, site: int) -> slice:
+    for i in range(model.nsensor):
+        if (
+            int(model.sensor_type[i]) == kind
+            and int(model.sensor_objid[i]) == site
+            and int(model.sensor_objtype[i]) == mujoco.mjtObj.mjOBJ_SITE
+        ):
+            adr = int(model.sensor_adr[i])
+            return slice(adr, adr + int(model.sensor_dim[i]))
+    raise SceneError(f"no {kind.name} sensor on site #{site} after compiling")  # a bug
+
+
+_CENTRED: Final = 0.005
+"""m: how far off base_link (the axle's midpoint, the laser on the centre line) a model
+may put them before otonav refuses it (its frames have no room for the offset)."""
+
+
+class _Derivation:
+    """The robot's geometry read from the compiled world at its rest pose (qpos0), each
+    value's source recorded; a value in the description overrides the derived one."""
+
+    def __init__(self, model: Any, base: int, parts: _RobotSpec) -> None:
+        self.model = model
+        self.base = base
+        self.parts = parts
+        self.robot = parts.robot
+        self.sources: dict[str, str] = {}
+        self.data = mujoco.MjData(model)
+        mujoco.mj_kinematics(model, self.data)
+        self.origin = self.data.xpos[base].copy()
+        self.to_base = self.data.xmat[base].reshape(3, 3).T.copy()
+
+    def in_base(self, world: NDArray[np.float64]) -> NDArray[np.float64]:
+        result: NDArray[np.float64] = (world - self.origin) @ self.to_base.T
+        return result
+
+    def geometry(
+        self, joints: tuple[int, int], lidar: int, imu: int, base_qpos: int
+    ) -> RobotGeometry:
+        m = self.model
+        radius = self.wheel_radius(joints[0])
+        separation = self.separation(*joints)
+        laser = self.site_offset(lidar, "lidar")
+        imu_pos = self.site_offset(imu, "imu")
+        footprint = self.footprint()
+        self.check_lidar_outside(lidar)
+        return RobotGeometry(
+            wheel_radius=radius,
+            wheel_separation=separation,
+            laser_offset_x=float(laser[0]),
+            laser_offset_z=float(laser[2]),
+            base_height=float(m.qpos0[base_qpos + 2]),
+            imu_offset=(float(imu_pos[0]), float(imu_pos[1]), float(imu_pos[2])),
+            footprint=footprint,
+        )
+
+    def _given(self, key: str, value: object) -> bool:
+        if value is None:
+            return False
+        self.sources[key] = f"{self.robot.key}{key} (given)"
+        return True
+
+    def wheel_radius(self, joint: int) -> float:
+        m = self.model
+        body = int(m.jnt_bodyid[joint])
+        geoms = [g for g in range(m.ngeom) if int(m.geom_bodyid[g]) == body and _collides(m, g)]
+        if not geoms:
+            raise self.parts.fail(
+                "left_wheel",
+                f"joint {self.robot.left_wheel!r} moves body "
+                f"{_shown_name(m, mujoco.mjtObj.mjOBJ_BODY, body)!r}, which has no "
+                "collision geom: a wheel needs one to roll on",
+            )
+        if self._given("wheel_radius", self.robot.wheel_radius):
+            return float(self.robot.wheel_radius or 0.0)
+        geom = geoms[0]
+        name = _shown_name(m, mujoco.mjtObj.mjOBJ_GEOM, geom)
+        kind = int(m.geom_type[geom])
+        size = m.geom_size[geom]
+        # The axle in the geom's frame: the wheel is round about it.
+        axis = self.data.geom_xmat[geom].reshape(3, 3).T @ self.data.xaxis[joint]
+        k = int(np.argmax(np.abs(axis)))
+        aligned = abs(float(axis[k])) > 0.999
+        round_about_z = kind in (mujoco.mjtGeom.mjGEOM_CYLINDER, mujoco.mjtGeom.mjGEOM_CAPSULE)
+        if kind == mujoco.mjtGeom.mjGEOM_SPHERE or (round_about_z and aligned and k == 2):
+            radius = float(size[0])
+        elif kind == mujoco.mjtGeom.mjGEOM_ELLIPSOID and aligned:
+            radius = float(max(size[i] for i in range(3) if i != k))
+        elif kind == mujoco.mjtGeom.mjGEOM_MESH:
+            mesh = int(m.geom_dataid[geom])
+            start, count = int(m.mesh_vertadr[mesh]), int(m.mesh_vertnum[mesh])
+            verts = np.asarray(m.mesh_vert[start : start + count], dtype=np.float64)
+            unit = axis / np.linalg.norm(axis)
+            off_axle = verts - np.outer(verts @ unit, unit)
+            radius = float(np.max(np.linalg.norm(off_axle, axis=1)))
+        else:
+            radius = float(m.geom_rbound[geom])
+        kind_name = mujoco.mjtGeom(kind).name.removeprefix("mjGEOM_").lower()
+        self.sources["wheel_radius"] = f"derived from the {kind_name} geom {name!r}"
+        return radius
+
+    def separation(self, left: int, right: int) -> float:
+        if self._given("wheel_separation", self.robot.wheel_separation):
+            return float(self.robot.wheel_separation or 0.0)
+        m = self.model
+        lb, rb = int(m.jnt_bodyid[left]), int(m.jnt_bodyid[right])
+        anchors = self.in_base(np.array([self.data.xanchor[left], self.data.xanchor[right]]))
+        middle = anchors.mean(axis=0)
+        if abs(float(middle[0])) > _CENTRED or abs(float(middle[1])) > _CENTRED:
+            raise self.parts.fail(
+                "base",
+                f"body {self.robot.base!r} is ({middle[0]:.3f}, {middle[1]:.3f}) m from the "
+                "wheel axle's midpoint; otonav's base_link is that midpoint: name a body there "
+                "as the base",
+            )
+        if int(m.body_parentid[lb]) == self.base and int(m.body_parentid[rb]) == self.base:
+            separation = float(np.linalg.norm(m.body_pos[lb] - m.body_pos[rb]))
+        else:
+            separation = abs(float(anchors[0][1] - anchors[1][1]))
+        self.sources["wheel_separation"] = (
+            f"derived from the joints {self.robot.left_wheel!r} and {self.robot.right_wheel!r}"
+        )
+        return separation
+
+    def site_offset(self, site: int, key: str) -> NDArray[np.float64]:
+        """The site's position in base_link; its axes must be the base's."""
+        m = self.model
+        if int(m.site_bodyid[site]) == self.base:
+            pos: NDArray[np.float64] = np.array(m.site_pos[site], dtype=np.float64)
+        else:
+            pos = self.in_base(self.data.site_xpos[site])
+        turn = self.to_base @ self.data.site_xmat[site].reshape(3, 3)
+        if not np.allclose(turn, np.eye(3), atol=1e-6):
+            raise self.parts.fail(
+                key,
+                f"site {_shown_name(m, mujoco.mjtObj.mjOBJ_SITE, site)!r} is turned "
+                "against the base; otonav's sensor frames have the base's axes: mount it with "
+                f"{self.robot.key}{key}: {{body: ..., pos: [x, y, z]}}",
+            )
+        if key == "lidar" and abs(float(pos[1])) > _CENTRED:
+            raise self.parts.fail(
+                key,
+                f"the lidar is {pos[1]:.3f} m off the robot's centre line; otonav's laser frame "
+                "is on it (y = 0): mount it there",
+            )
+        self.sources[f"{key}_offset"] = (
+            f"({', '.join(f'{v:.4g}' for v in pos)}) m in base_link, from the site"
+        )
+        return pos
+
+    def footprint(self) -> tuple[tuple[float, float], ...]:
+        """The rectangle in base_link (CCW corners, m) that bounds every collision geom
+        of the robot projected on the floor, at the rest pose (qpos0)."""
+        if self._given("footprint", self.robot.footprint):
+            return tuple(self.robot.footprint or ())
+        m = self.model
+        geoms = [g for g in _subtree_geoms(m, self.base) if _collides(m, g)]
+        if not geoms:
+            raise self.parts.fail("model", f"the robot {self.robot.base!r} has no collision geom")
+        points = np.concatenate(
+            [self.in_base(_geom_corners(m, self.data, g))[:, :2] for g in geoms]
+        )
+        x0, y0 = (float(v) for v in points.min(axis=0))
+        x1, y1 = (float(v) for v in points.max(axis=0))
+        self.sources["footprint"] = (
+            f"derived: the rectangle bounding {len(geoms)} collision geoms on the floor"
+        )
+        return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
+
+    def check_lidar_outside(self, site: int) -> None:
+        """A lidar inside the robot's own collision geometry would cast from inside it."""
+        m = self.model
+        point = self.data.site_xpos[site]
+        for g in _subtree_geoms(m, self.base):
+            if not _collides(m, g):
+                continue
+            centre, half = _geom_half(m, g)
+            local = self.data.geom_xmat[g].reshape(3, 3).T @ (point - self.data.geom_xpos[g])
+            if np.all(np.abs(local - centre) < half):
+                name = _shown_name(m, mujoco.mjtObj.mjOBJ_GEOM, g)
+                raise self.parts.fail(
+                    "lidar",
+                    f"the lidar's origin is inside the robot's collision geom {name!r}: mount it "
+                    "above the robot (a pos whose z clears the geom)",
+                )
+
+
 _VIEWER_THREAD: Final = "_launch_internal"  # target of launch_passive's thread
 
 
@@ -294,6 +854,7 @@ class MujocoInterface(RobotHardwareInterface):
         extra_obstacles: Sequence[BoxObstacle] = (),
         variant: Variant = "shipped",
         start: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        robot: RobotDescription | None = None,
     ) -> None:
         if lidar_beams < 1:
             raise ValueError(f"lidar_beams must be >= 1, got {lidar_beams}")
@@ -309,64 +870,65 @@ class MujocoInterface(RobotHardwareInterface):
 
         spec, label = _load_spec(scene)
         self._label = label
+        robot = robot if robot is not None else builtin_robot("otonav")
+        self._robot = robot
         if timestep is not None:
             spec.option.timestep = timestep
         for i, box in enumerate(extra_obstacles):
             _add_box(spec, f"obstacle_extra_{i}", box)
+        if spec.body(robot.base) is not None:
+            # The scene has the robot in it already (a scene that includes robot.xml).
+            robot_spec, robot_file, prefix = spec, label, ""
+        else:
+            robot_spec, robot_file = _load_robot(robot)
+            prefix = ROBOT_PREFIX
         if variant == "no_caster_unlimited_torque":
-            _apply_bug_variant(spec, label)
+            _apply_bug_variant(robot_spec, robot_file)
         self._variant: Variant = variant
-        self._model: Any = _compile(spec, label)
+        parts = _RobotSpec(robot_spec, robot, robot_file)
+        probe = _probe(parts)
+        parts.prepare(probe.mass, probe.wheel_radius)
+        lidar_site = parts.mount("lidar", robot.lidar, (0.0, 0.0, probe.top + _MOUNT_ABOVE))
+        imu_site = parts.mount("imu", robot.imu, (0.0, 0.0, 0.0))
+        parts.imu_sensors(imu_site)
+        self._ctrl_scale = (parts.ctrl_scale["left_wheel"], parts.ctrl_scale["right_wheel"])
+        if prefix:
+            if abs(probe.bottom) > _REST_TOLERANCE:
+                parts.base.pos[2] -= probe.bottom  # rest on the floor, not in or above it
+            _merge_options(spec, robot_spec)
+            spec.worldbody.add_frame().attach_body(parts.base, prefix, "")
+        self._model: Any = _compile(spec, label if not prefix else f"{label} with {robot_file}")
         self._data: Any = mujoco.MjData(self._model)
         m = self._model
-
-        def need(obj: Any, name: str) -> int:
-            ident = int(mujoco.mj_name2id(m, obj, name))
-            if ident < 0:
-                kind = str(obj).rsplit(".", 1)[-1].removeprefix("mjOBJ_").lower()
-                raise SceneError(f"MJCF file {label}: no {kind} named {name!r}")
-            return ident
-
         obj = mujoco.mjtObj
-        self._chassis = need(obj.mjOBJ_BODY, "chassis")
+
+        def ident(kind: Any, name: str) -> int:
+            found = int(mujoco.mj_name2id(m, kind, prefix + name))
+            if found < 0:  # prepared above: a bug, not a user's mistake
+                raise SceneError(f"{robot_file}: {name!r} missing after compiling")
+            return found
+
+        self._chassis = ident(obj.mjOBJ_BODY, robot.base)
         base_joint = int(m.body_jntadr[self._chassis])
-        if base_joint < 0 or m.jnt_type[base_joint] != mujoco.mjtJoint.mjJNT_FREE:
-            raise SceneError(f"MJCF file {label}: body 'chassis' needs a free joint")
         self._base_qpos = int(m.jnt_qposadr[base_joint])
         self._base_qvel = int(m.jnt_dofadr[base_joint])
-        left_joint = need(obj.mjOBJ_JOINT, "left_wheel")
-        right_joint = need(obj.mjOBJ_JOINT, "right_wheel")
+        left_joint = ident(obj.mjOBJ_JOINT, robot.left_wheel)
+        right_joint = ident(obj.mjOBJ_JOINT, robot.right_wheel)
         self._wheel_qpos = (int(m.jnt_qposadr[left_joint]), int(m.jnt_qposadr[right_joint]))
         self._wheel_qvel = (int(m.jnt_dofadr[left_joint]), int(m.jnt_dofadr[right_joint]))
-        self._left_act = need(obj.mjOBJ_ACTUATOR, "left_motor")
-        self._right_act = need(obj.mjOBJ_ACTUATOR, "right_motor")
-        self._lidar_site = need(obj.mjOBJ_SITE, "lidar")
-        self._imu_site = need(obj.mjOBJ_SITE, "imu")
+        self._left_act = _actuator_of(m, left_joint)
+        self._right_act = _actuator_of(m, right_joint)
+        self._lidar_site = ident(obj.mjOBJ_SITE, lidar_site)
+        self._imu_site = ident(obj.mjOBJ_SITE, imu_site)
+        self._gyro = _site_sensor(m, mujoco.mjtSensor.mjSENS_GYRO, self._imu_site)
+        self._accel = _site_sensor(m, mujoco.mjtSensor.mjSENS_ACCELEROMETER, self._imu_site)
+        self._quat = _site_sensor(m, mujoco.mjtSensor.mjSENS_FRAMEQUAT, self._imu_site)
 
-        def sensor_slice(name: str) -> slice:
-            ident = need(obj.mjOBJ_SENSOR, name)
-            adr = int(m.sensor_adr[ident])
-            return slice(adr, adr + int(m.sensor_dim[ident]))
-
-        self._gyro = sensor_slice("imu_gyro")
-        self._accel = sensor_slice("imu_accel")
-        self._quat = sensor_slice("imu_quat")
-
-        # The lidar must not see the robot: every geom of the robot's tree in group 1.
-        robot_root = int(m.body_rootid[self._chassis])
-        visible = [
-            mujoco.mj_id2name(m, obj.mjOBJ_GEOM, g) or f"#{g}"
-            for g in range(m.ngeom)
-            if int(m.body_rootid[m.geom_bodyid[g]]) == robot_root
-            and int(m.geom_group[g]) != _ROBOT_GROUP
-        ]
-        if visible:
-            raise SceneError(
-                f"MJCF file {label}: robot geoms {visible} must be in geom group "
-                f"{_ROBOT_GROUP}, or the lidar sees the robot itself"
-            )
-
-        self._geometry = self._read_geometry(left_joint, right_joint)
+        derived = _Derivation(m, self._chassis, parts)
+        self._geometry = derived.geometry(
+            (left_joint, right_joint), self._lidar_site, self._imu_site, self._base_qpos
+        )
+        self._sources = {**parts.sources, **derived.sources}
         self._obstacles = self._static_boxes("obstacle")
         self._walls = self._static_boxes("wall")
         self._is_floor = np.asarray(m.geom_type == mujoco.mjtGeom.mjGEOM_PLANE, dtype=np.bool_)
@@ -403,64 +965,6 @@ class MujocoInterface(RobotHardwareInterface):
         self._sync()
 
     # -- model facts ----------------------------------------------------------------------
-
-    def _read_geometry(self, left_joint: int, right_joint: int) -> RobotGeometry:
-        m = self._model
-        left_body = int(m.jnt_bodyid[left_joint])
-        right_body = int(m.jnt_bodyid[right_joint])
-        left_geoms = [g for g in range(m.ngeom) if int(m.geom_bodyid[g]) == left_body]
-        if not left_geoms:
-            raise SceneError(f"MJCF file {self._label}: wheel 'left_wheel' has no geom")
-        radius = float(m.geom_size[left_geoms[0]][0])
-        separation = float(np.linalg.norm(m.body_pos[left_body] - m.body_pos[right_body]))
-        if int(m.site_bodyid[self._lidar_site]) != self._chassis:
-            raise SceneError(f"MJCF file {self._label}: site 'lidar' must be on 'chassis'")
-        lidar = m.site_pos[self._lidar_site]
-        if int(m.site_bodyid[self._imu_site]) != self._chassis:
-            raise SceneError(f"MJCF file {self._label}: site 'imu' must be on 'chassis'")
-        imu = m.site_pos[self._imu_site]
-        return RobotGeometry(
-            wheel_radius=radius,
-            wheel_separation=separation,
-            laser_offset_x=float(lidar[0]),
-            laser_offset_z=float(lidar[2]),
-            base_height=float(m.qpos0[self._base_qpos + 2]),
-            imu_offset=(float(imu[0]), float(imu[1]), float(imu[2])),
-            footprint=self._read_footprint(),
-        )
-
-    def _read_footprint(self) -> tuple[tuple[float, float], ...]:
-        """The rectangle in base_link (CCW corners, m) that bounds every collision geom
-        of the robot projected on the floor, at the model's rest pose (qpos0)."""
-        m = self._model
-        d = mujoco.MjData(m)
-        mujoco.mj_kinematics(m, d)
-        root = int(m.body_rootid[self._chassis])
-        origin = d.xpos[self._chassis].copy()
-        to_base = d.xmat[self._chassis].reshape(3, 3).T
-        signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-        xy: list[NDArray[np.float64]] = []
-        for g in range(m.ngeom):
-            collides = int(m.geom_contype[g]) != 0 or int(m.geom_conaffinity[g]) != 0
-            if int(m.body_rootid[m.geom_bodyid[g]]) != root or not collides:
-                continue
-            size = m.geom_size[g]
-            kind = int(m.geom_type[g])
-            if kind in (mujoco.mjtGeom.mjGEOM_SPHERE,):
-                half = np.array([size[0], size[0], size[0]])
-            elif kind in (mujoco.mjtGeom.mjGEOM_CYLINDER, mujoco.mjtGeom.mjGEOM_CAPSULE):
-                extra = size[0] if kind == mujoco.mjtGeom.mjGEOM_CAPSULE else 0.0
-                half = np.array([size[0], size[0], size[1] + extra])
-            else:  # box, ellipsoid: half sizes along the geom's axes
-                half = np.array(size[:3], dtype=np.float64)
-            corners = (signs * half) @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g]
-            xy.append(((corners - origin) @ to_base.T)[:, :2])
-        if not xy:
-            raise SceneError(f"MJCF file {self._label}: the robot has no collision geom")
-        points = np.concatenate(xy)
-        x0, y0 = (float(v) for v in points.min(axis=0))
-        x1, y1 = (float(v) for v in points.max(axis=0))
-        return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
 
     def _static_boxes(self, prefix: str) -> tuple[BoxObstacle, ...]:
         m = self._model
@@ -574,8 +1078,12 @@ class MujocoInterface(RobotHardwareInterface):
         self._check_open()
         if not (math.isfinite(cmd.left) and math.isfinite(cmd.right)):
             raise ValueError(f"wheel command must be finite, got {cmd}")
-        self._data.ctrl[self._left_act] = cmd.left
-        self._data.ctrl[self._right_act] = cmd.right
+        left_scale, right_scale = self._ctrl_scale
+        # A velocity actuator with a gear takes actuator speed: gear x wheel speed.
+        self._data.ctrl[self._left_act] = cmd.left if left_scale == 1.0 else cmd.left * left_scale
+        self._data.ctrl[self._right_act] = (
+            cmd.right if right_scale == 1.0 else cmd.right * right_scale
+        )
 
     def read_wheels(self) -> WheelState:
         qpos, qvel = self._data.qpos, self._data.qvel
@@ -690,6 +1198,14 @@ class MujocoInterface(RobotHardwareInterface):
     @property
     def geometry(self) -> RobotGeometry:
         return self._geometry
+
+    def geometry_sources(self) -> dict[str, str]:
+        return dict(self._sources)
+
+    @property
+    def robot(self) -> RobotDescription:
+        """The description this world's robot was built from."""
+        return self._robot
 
     def obstacles(self) -> tuple[BoxObstacle, ...]:
         return self._obstacles

@@ -120,7 +120,7 @@ def run_scenario_realtime(
         raise ValueError(problem)
     if gui:
         check_display()
-    stack, hal = scenario_world(scenario, stack)
+    scenario, stack, hal = scenario_world(scenario, stack)
     judge = Judge(hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance)
     session = scenario_session(
         scenario,

@@ -17,6 +17,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
+from otonav import limits
 from otonav.actors import topics
 from otonav.hal import RobotHardwareInterface
 from otonav.msgs import Header, Point, Pose, PoseStamped, ScenarioVerdict, Time
@@ -36,6 +37,7 @@ from otonav.scenario.judge import Judge
 from otonav.scenario.plot import plot_trajectory
 from otonav.scenario.validate import check_cost, check_goal
 from otonav.stack import StackConfig, build_actors, build_world
+from otonav.stack.robot import describe_robot
 from otonav.stack.session import RealTime, StackSession
 
 VERDICT_TOPIC = "/scenario/verdict"
@@ -86,13 +88,32 @@ def otonav_version() -> str:
         return "unknown"
 
 
+BUDGET_SPEED = 0.4
+"""m/s: scenario budgets are written for a robot that drives this fast (otonav's robot
+under the default ``nav.max_v``). A robot whose description states a lower top speed
+(``robot.max_v``; the ``burger``'s 0.22 m/s) gets every budget scaled by BUDGET_SPEED /
+its top speed, so the same courses judge it fairly (ADR 0041)."""
+
+
+def for_robot(scenario: ScenarioConfig, stack: StackConfig) -> ScenarioConfig:
+    """``scenario`` as run with ``stack``'s robot: its sim budget scaled to the robot's
+    stated top speed when that is below :data:`BUDGET_SPEED`."""
+    top = describe_robot(stack.robot).max_v
+    if top is None or top >= BUDGET_SPEED:
+        return scenario
+    budget = min(scenario.sim_budget * BUDGET_SPEED / top, limits.MAX_SIM_BUDGET_S)
+    return scenario.model_copy(update={"sim_budget": round(budget, 3)})
+
+
 def scenario_world(
     scenario: ScenarioConfig, stack: StackConfig, *, source: str = "scenario"
-) -> tuple[StackConfig, RobotHardwareInterface]:
-    """The stack config with the scenario's scene, and its world with the scenario's
-    obstacles and start pose, checked: a goal or start outside the arena or on an
-    obstacle raises ``ConfigFileError`` naming ``source`` (the world is then closed)."""
+) -> tuple[ScenarioConfig, StackConfig, RobotHardwareInterface]:
+    """The scenario as run with the stack's robot (:func:`for_robot`), the stack config
+    with the scenario's scene, and its world with the scenario's obstacles and start
+    pose, checked: a goal or start outside the arena or on an obstacle raises
+    ``ConfigFileError`` naming ``source`` (the world is then closed)."""
     stack = effective_stack(scenario, stack)
+    scenario = for_robot(scenario, stack)
     hal = build_world(
         stack,
         extra_obstacles=[b.to_obstacle() for b in scenario.obstacles],
@@ -104,7 +125,7 @@ def scenario_world(
     except BaseException:
         hal.close()
         raise
-    return stack, hal
+    return scenario, stack, hal
 
 
 def finite_figures(figures: dict[str, Any]) -> dict[str, Any]:
@@ -265,7 +286,7 @@ def run_scenario(
     task)`` is called on the run's loop as it starts: a host running this in a worker
     thread cancels the run with ``loop.call_soon_threadsafe(task.cancel)``. A goal
     outside the arena or on an obstacle raises ``ConfigFileError`` naming ``source``."""
-    stack, hal = scenario_world(scenario, stack, source=source)
+    scenario, stack, hal = scenario_world(scenario, stack, source=source)
     judge = Judge(
         hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance, progress=progress
     )

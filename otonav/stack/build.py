@@ -7,10 +7,12 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from otonav.actors import (
+    EXTERNAL_COMMAND_WAIT,
     AvoidingNavigator,
     BaseController,
     BaseLimits,
     Bridge,
+    CommandWatch,
     Navigator,
     SafetyLayer,
     topics,
@@ -26,6 +28,8 @@ from otonav.nav.safety import SafetyParams
 from otonav.runtime import Actor
 from otonav.stack.config import StackConfig
 from otonav.stack.files import ConfigFileError
+from otonav.stack.launch import launch
+from otonav.stack.robot import describe_robot, robot_base
 
 if TYPE_CHECKING:
     from otonav.hal.can import CanBusInterface
@@ -44,6 +48,7 @@ def build_world(
     """The robot for ``config``, placed at ``start``: the MuJoCo world, or with
     ``hal.kind: can`` the wheels over a CAN bus with the world as sensor source."""
     world = config.world
+    robot = describe_robot(config.robot)
     sim = MujocoInterface(
         world.scene,
         lidar_beams=world.lidar_beams,
@@ -53,6 +58,7 @@ def build_world(
         extra_obstacles=extra_obstacles,
         variant=variant,
         start=start,
+        robot=robot,
     )
     if config.hal.kind == "mujoco":
         return sim
@@ -145,7 +151,7 @@ def build_actors(
     """bridge + base controller (+ navigator) for ``hal``. ``initial_pose`` is where
     odometry starts (the known start pose: odom is then the world frame)."""
     geometry = hal.geometry
-    rates, base, nav, guard = config.rates, config.base, config.nav, config.guard
+    rates, base, nav, guard = config.rates, robot_base(config), config.nav, config.guard
     actors: list[Actor] = [
         Bridge(
             hal,
@@ -178,8 +184,8 @@ def build_actors(
                     GoToGoalParams(
                         kp_lin=nav.kp_lin,
                         kp_ang=nav.kp_ang,
-                        max_v=nav.max_v,
-                        max_omega=nav.max_omega,
+                        max_v=min(nav.max_v, base.max_v),
+                        max_omega=min(nav.max_omega, base.max_omega),
                         tolerance=nav.tolerance,
                         turn_in_place_threshold=nav.turn_in_place_threshold,
                     ),
@@ -210,12 +216,16 @@ def build_actors(
                     scan_timeout=config.safety.scan_timeout,
                 )
             )
-    return actors
+        if nav.planner == "external":
+            # Nobody may be publishing the planner's commands: say so early.
+            topic = topics.CMD_VEL_NAV if config.safety.enabled else topics.CMD_VEL
+            actors.append(CommandWatch(topic, within=EXTERNAL_COMMAND_WAIT))
+    return launch(actors, config.actors)
 
 
 def navigation_params(config: StackConfig, geometry: RobotGeometry) -> NavigationParams:
     """The avoiding navigator's settings from ``nav.*`` and the base's limits."""
-    nav, base = config.nav, config.base
+    nav, base = config.nav, robot_base(config)
     dwa, grid, rec = nav.dwa, nav.map, nav.recovery
     radius = centre_clearance(nav.clearance, geometry.footprint_radius, nav.footprint_padding)
     return NavigationParams(
@@ -267,7 +277,7 @@ def navigation_params(config: StackConfig, geometry: RobotGeometry) -> Navigatio
 
 def safety_params(config: StackConfig, geometry: RobotGeometry) -> SafetyParams:
     """The safety layer's settings from ``safety.*``, the base's limits and rates."""
-    safety, base = config.safety, config.base
+    safety, base = config.safety, robot_base(config)
     return SafetyParams(
         radius=centre_clearance(
             safety.clearance, geometry.footprint_radius, safety.footprint_padding

@@ -4,7 +4,7 @@ installed wheel runs with no checkout); YAML files in ``config/`` override them.
 from __future__ import annotations
 
 import math
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import (
     AfterValidator,
@@ -306,6 +306,83 @@ class HalConfig(_Section):
     sim: DriveSimConfig = DriveSimConfig()
 
 
+_Name = Annotated[str, Field(min_length=1, max_length=limits.MAX_NAME_CHARS)]
+"""A name in the robot model (a body, joint or site) or of an actor."""
+_Vec3 = tuple[float, float, float]
+
+
+class MountConfig(_Section):
+    """Where a sensor sits: a site the model already has, or a point on a body (metres,
+    in the body's frame; the sensor's axes are the robot base's)."""
+
+    site: _Name | None = None
+    """A site of the model (e.g. a URDF's ``base_scan`` link becomes a body: use body)."""
+    body: _Name | None = None
+    """The body the sensor is mounted on (default: the robot's base)."""
+    pos: _Vec3 | None = None
+    """m, in the body's frame."""
+
+    @model_validator(mode="after")
+    def _one_way(self) -> MountConfig:
+        if self.site is not None and (self.body is not None or self.pos is not None):
+            raise ValueError("give either site, or body and pos, not both")
+        if self.site is None and self.pos is None:
+            raise ValueError("give a site, or a pos (and optionally a body)")
+        return self
+
+
+class RobotConfig(_Section):
+    """The robot description (``otonav.hal.description``): a built-in robot or the
+    user's MJCF/URDF, the names of its base and wheels, where its sensors sit. Wheel
+    radius and separation, footprint and sensor offsets are derived from the model; a
+    value given here overrides the derived one."""
+
+    model: str = Field("otonav", min_length=1, max_length=limits.MAX_PATH_CHARS)
+    """A built-in robot (``otonav``, ``burger``) or an MJCF/URDF file (a path relative
+    to the config file it is written in)."""
+    base: _Name | None = None
+    """The robot's base body (base_link); it gets a free joint if it has none."""
+    left_wheel: _Name | None = None
+    """The left wheel's hinge joint (its actuator is found through it)."""
+    right_wheel: _Name | None = None
+    lidar: MountConfig | None = None
+    """Where otonav's lidar casts from (default: the model's own, else on top)."""
+    imu: MountConfig | None = None
+    wheel_radius: float | None = Field(None, gt=0.0, le=5.0)
+    """m: overrides the radius derived from the wheel's collision geom, in (0, 5]."""
+    wheel_separation: float | None = Field(None, gt=0.0, le=20.0)
+    """m: overrides the separation derived from the wheel joints, in (0, 20]."""
+    footprint: tuple[tuple[float, float], ...] | None = Field(None, min_length=3)
+    """(x, y) points in base_link, m: overrides the derived outline."""
+    max_v: float | None = Field(None, gt=0.0, le=limits.MAX_BASE_V)
+    """m/s, the robot's top speed: caps ``base.max_v`` and scales scenario budgets."""
+    max_omega: float | None = Field(None, gt=0.0, le=limits.MAX_BASE_OMEGA)
+    """rad/s, the robot's top yaw rate: caps ``base.max_omega``."""
+
+
+class ActorConfig(_Section):
+    """One node of the launch: a class (``package.module:Class`` on ``sys.path``, or
+    ``path/to/file.py:Class`` relative to the config file) with its parameters and
+    topic remaps. An entry named like a built-in actor (``nav``, ``safety``, ``base``)
+    replaces it."""
+
+    name: _Name
+    class_: str = Field(alias="class", min_length=3, max_length=limits.MAX_PATH_CHARS)
+    params: dict[str, Any] = Field(default_factory=dict)
+    """Validated at start-up against the class's ``Params`` model."""
+    remap: dict[str, str] = Field(default_factory=dict)
+    """Topic renames, from -> to (as ROS 2 remappings)."""
+
+    model_config = ConfigDict(
+        extra="forbid",
+        frozen=True,
+        strict=True,
+        allow_inf_nan=False,
+        populate_by_name=True,
+        serialize_by_alias=True,
+    )
+
+
 class StackConfig(_Section):
     """Everything needed to bring the robot stack up."""
 
@@ -316,9 +393,16 @@ class StackConfig(_Section):
     guard: GuardConfig = GuardConfig()
     safety: SafetyConfig = SafetyConfig()
     hal: HalConfig = HalConfig()
+    robot: RobotConfig = RobotConfig()
+    actors: tuple[ActorConfig, ...] = ()
+    """Extra nodes, or replacements of built-in ones, in launch order."""
 
     @model_validator(mode="after")
     def _consistent(self) -> StackConfig:
+        names = [entry.name for entry in self.actors]
+        twice = sorted({name for name in names if names.count(name) > 1})
+        if twice:
+            raise ValueError(f"actors: each name once (given more than once: {twice})")
         if self.world.lidar_range_min >= self.world.lidar_range_max:
             raise ValueError(
                 "world.lidar_range_min must be < world.lidar_range_max "

@@ -27,7 +27,7 @@ SHOWN_PROBLEMS = 5
 """How many problems an error line lists before "and N more"."""
 
 
-def _shown(value: object) -> str:
+def shown(value: object) -> str:
     text = repr(value)
     if len(text) <= SHOWN_CHARS:
         return text
@@ -49,10 +49,10 @@ def describe_validation_error(source: str, error: ValidationError) -> str:
         if item["type"] in ("extra_forbidden", "missing") or (
             item["type"] == "value_error" and not path
         ):
-            shown = ""  # a whole-model check quotes what it needs itself
+            quoted = ""  # a whole-model check quotes what it needs itself
         else:
-            shown = f" (got {_shown(got)})"
-        problems.append(f"{path}: {message}{shown}" if path else message)
+            quoted = f" (got {shown(got)})"
+        problems.append(f"{path}: {message}{quoted}" if path else message)
     if len(errors) > SHOWN_PROBLEMS:
         problems.append(f"and {len(errors) - SHOWN_PROBLEMS} more")
     return f"{source}: " + "; ".join(problems)

@@ -14,6 +14,29 @@ from otonav.stack.files import ConfigFileError, describe_validation_error, to_js
 _M = TypeVar("_M", bound=BaseModel)
 
 
+def _actor_path(data: dict[str, Any], parts: list[str], source: str, key: str) -> list[str]:
+    """``actors.NAME.KEY`` (a parameter of the launched actor NAME) as a path into the
+    dumped config: the ``actors`` list becomes a mapping by name for the walk below."""
+    if parts[0] != "actors" or "actors" not in data:
+        return parts
+    entries = data["actors"]
+    names = [entry["name"] for entry in entries]
+    if len(parts) < 3 or parts[1] not in names:
+        raise ConfigFileError(
+            f"{source} {key}: expected actors.NAME.PARAM with NAME one of the launched "
+            f"actors ({', '.join(names) or 'none: add one with --actor or the actors list'})"
+        )
+    if isinstance(entries, list):
+        data["actors"] = {entry["name"]: entry for entry in entries}
+    entry = data["actors"][parts[1]]
+    if parts[2] in ("params", "remap", "class", "name") and len(parts) > 3:
+        return parts
+    if parts[2] in ("class", "name"):
+        return parts
+    entry.setdefault("params", {}).setdefault(parts[2], None)  # validated by the Params model
+    return ["actors", parts[1], "params", *parts[2:]]
+
+
 def apply_overrides(model: _M, assignments: Sequence[str], *, source: str = "--set") -> _M:
     """Return ``model`` with each ``a.b.c=value`` applied (values parsed as YAML scalars)."""
     data: dict[str, Any] = model.model_dump(mode="json")
@@ -31,6 +54,7 @@ def apply_overrides(model: _M, assignments: Sequence[str], *, source: str = "--s
             value = raw
         node = data
         parts = key.strip().split(".")
+        parts = _actor_path(data, parts, source, key)
         for i, part in enumerate(parts[:-1]):
             child = node.get(part)
             if not isinstance(child, dict):
@@ -50,6 +74,8 @@ def apply_overrides(model: _M, assignments: Sequence[str], *, source: str = "--s
                 f"{key}.{next(iter(node[parts[-1]]), 'key')}=VALUE"
             )
         node[parts[-1]] = value
+    if isinstance(data.get("actors"), dict):
+        data["actors"] = list(data["actors"].values())
     try:
         return type(model).model_validate_json(to_json(data, source))
     except ValidationError as exc:

@@ -34,11 +34,15 @@ def world_metadata(hal: RobotHardwareInterface) -> dict[str, str]:
         "imu_offset": list(g.imu_offset),
         "footprint": [list(corner) for corner in g.footprint],
     }
-    return {
+    record = {
         "obstacles": _boxes(hal.obstacles()),
         "walls": _boxes(hal.walls()),
         "robot": json.dumps(robot),
     }
+    sources = hal.geometry_sources()
+    if sources:  # where each value came from: derived from the model, or given
+        record["robot_sources"] = json.dumps(sources, sort_keys=True)
+    return record
 
 
 def geometry_from_metadata(record: Mapping[str, str]) -> RobotGeometry | None:

@@ -19,7 +19,9 @@ from otonav.scenario import ScenarioConfig
 from otonav.scenario.builtin import BUILTIN
 from otonav.stack import StackConfig
 from otonav.stack.files import ConfigFileError, describe_validation_error, load_model
+from otonav.stack.launch import add_actors, check_actors
 from otonav.stack.overrides import apply_overrides
+from otonav.stack.robot import resolve_paths
 from otonav.sweep.spec import GenerateSource, Keep, Scalar, SweepSpec
 from otonav.sweep.worlds import world_name, world_params_json
 
@@ -172,25 +174,34 @@ def plan_runs(
     *,
     base: Path = Path("."),
     where: str = "sweep",
+    actors: Sequence[str] = (),
 ) -> list[RunTask]:
     """Every run of ``spec``, in order, each once. ``base``: where relative paths in the
-    spec start (the sweep file's directory); ``where`` names the file in errors."""
-    return list(_iter_runs(spec, base, where))
+    spec start (the sweep file's directory); ``where`` names the file in errors.
+    ``actors``: ``module:Class`` nodes launched in every run (``--actor``)."""
+    return list(_iter_runs(spec, base, where, actors))
 
 
-def _iter_runs(spec: SweepSpec, base: Path, where: str) -> Iterator[RunTask]:
+def _iter_runs(spec: SweepSpec, base: Path, where: str, actors: Sequence[str]) -> Iterator[RunTask]:
     config_path = str(base / spec.config) if spec.config is not None else None
-    stack = load_model(Path(config_path), StackConfig) if config_path else StackConfig()
+    stack = StackConfig()
+    if config_path:
+        stack = resolve_paths(load_model(Path(config_path), StackConfig), Path(config_path).parent)
+    if actors:
+        stack = add_actors(stack, actors)
     scenarios = _resolve_scenarios(spec, base, where)
     combos = override_combinations(spec)
-    stacks = [
+    overridden = [
         apply_overrides(
             stack,
             [f"{k}={format_value(v)}" for k, v in combo],
             source=f"{where}: overrides",
-        ).model_dump_json()
+        )
         for combo in combos
     ]
+    for each in overridden:  # every launched node importable, its parameters valid
+        check_actors(each.actors)
+    stacks = [each.model_dump_json() for each in overridden]
     seeds = spec.seed_list()
     seen: set[str] = set()
     index = 0

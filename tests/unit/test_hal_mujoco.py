@@ -68,14 +68,17 @@ def test_bad_mjcf_error_names_the_file(tmp_path: Path) -> None:
         compile_scene(tmp_path / "missing.xml")
 
 
-def test_scene_without_robot_is_rejected(tmp_path: Path) -> None:
+def test_a_scene_without_a_robot_gets_the_configured_one(tmp_path: Path) -> None:
     bare = tmp_path / "bare.xml"
     bare.write_text(
         "<mujoco><worldbody><geom name='floor' type='plane' size='1 1 .1'/></worldbody></mujoco>"
     )
     compile_scene(bare)
-    with pytest.raises(SceneError, match=r"bare\.xml: no body named 'chassis'"):
-        MujocoInterface(bare)
+    world = MujocoInterface(bare)
+    # the robot's own physics options fill what the scene leaves at MuJoCo's defaults
+    assert world.tick == 0.002
+    assert world.geometry.wheel_radius == 0.05
+    assert abs(world.ground_truth().pitch) < 0.02  # rests on wheels and caster
 
 
 def test_advance_counts_ticks() -> None:

@@ -389,6 +389,9 @@ class CanBusInterface(RobotHardwareInterface):
     def geometry(self) -> RobotGeometry:
         return self._geometry
 
+    def geometry_sources(self) -> dict[str, str]:
+        return self._sensors.geometry_sources()
+
     def obstacles(self) -> tuple[BoxObstacle, ...]:
         return self._sensors.obstacles()
 

@@ -1,0 +1,87 @@
+"""The stack config's ``robot`` section as a :class:`~otonav.hal.description.RobotDescription`:
+a built-in robot's names and mounts, the user's keys over them, a model path resolved
+against the config file it was written in."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from otonav.hal.description import BUILTIN_ROBOTS, Mount, RobotDescription, builtin_robot
+from otonav.stack.config import BaseConfig, MountConfig, RobotConfig, StackConfig
+from otonav.stack.files import ConfigFileError
+
+__all__ = ["describe_robot", "resolve_paths"]
+
+
+def _mount(config: MountConfig | None) -> Mount | None:
+    if config is None:
+        return None
+    return Mount(site=config.site, body=config.body, pos=config.pos)
+
+
+def describe_robot(config: RobotConfig) -> RobotDescription:
+    """The robot the HAL builds for ``config`` (``ConfigFileError`` naming the key when
+    a model file needs names the config does not give)."""
+    if config.model in BUILTIN_ROBOTS:
+        base = builtin_robot(config.model)
+    else:
+        missing = [k for k in ("base", "left_wheel", "right_wheel") if getattr(config, k) is None]
+        if missing:
+            raise ConfigFileError(
+                f"robot.{missing[0]}: required with robot.model: {config.model} "
+                "(name the model's base body and its two wheel joints: robot.base, "
+                "robot.left_wheel, robot.right_wheel)"
+            )
+        base = RobotDescription(
+            model=config.model, label=config.model, base="", left_wheel="", right_wheel=""
+        )
+    return RobotDescription(
+        model=base.model,
+        label=base.label,
+        base=config.base or base.base,
+        left_wheel=config.left_wheel or base.left_wheel,
+        right_wheel=config.right_wheel or base.right_wheel,
+        lidar=_mount(config.lidar) or base.lidar,
+        imu=_mount(config.imu) or base.imu,
+        wheel_radius=config.wheel_radius,
+        wheel_separation=config.wheel_separation,
+        footprint=config.footprint,
+        max_v=config.max_v if config.max_v is not None else base.max_v,
+        max_omega=config.max_omega if config.max_omega is not None else base.max_omega,
+    )
+
+
+def resolve_paths(stack: StackConfig, folder: Path) -> StackConfig:
+    """``stack`` with its relative file paths (``robot.model``, an actor's
+    ``path/file.py:Class``) made relative to ``folder`` (the config file's)."""
+    updates: dict[str, object] = {}
+    model = stack.robot.model
+    if model not in BUILTIN_ROBOTS and not Path(model).is_absolute():
+        updates["robot"] = stack.robot.model_copy(update={"model": str(folder / model)})
+    actors = []
+    for entry in stack.actors:
+        where, sep, name = entry.class_.rpartition(":")
+        if sep and where.endswith(".py") and not Path(where).is_absolute():
+            entry = entry.model_copy(update={"class_": f"{folder / where}:{name}"})
+        actors.append(entry)
+    if tuple(actors) != stack.actors:
+        updates["actors"] = tuple(actors)
+    return stack.model_copy(update=updates) if updates else stack
+
+
+def robot_base(stack: StackConfig) -> BaseConfig:
+    """``stack.base`` with its speed limits capped at the robot's top speeds (a robot
+    description may state them: ``robot.max_v`` / ``robot.max_omega``)."""
+    robot = describe_robot(stack.robot)
+    base = stack.base
+    updates: dict[str, float] = {}
+    if robot.max_v is not None and robot.max_v < base.max_v:
+        updates["max_v"] = robot.max_v
+    if robot.max_omega is not None and robot.max_omega < base.max_omega:
+        updates["max_omega"] = robot.max_omega
+    return base.model_copy(update=updates) if updates else base
+
+
+def top_speed(stack: StackConfig) -> float:
+    """m/s: the fastest the robot may drive (the base's limit, capped by the robot's)."""
+    return robot_base(stack).max_v
