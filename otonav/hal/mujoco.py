@@ -227,6 +227,7 @@ _DEFAULT_TORQUE_G: Final = 0.2
 the robot at 0.4 g (ample for any base limit) without lifting a caster off the floor."""
 _MOUNT_ABOVE: Final = 0.02  # m: a default lidar sits this far above the robot's top
 _REST_TOLERANCE: Final = 1e-3  # m: a model resting within this of the floor is not moved
+_CASTER_GAP: Final = 3e-3  # m: a base sphere this close to the floor is a caster
 
 
 def _names(elements: Sequence[Any]) -> str:
@@ -281,6 +282,21 @@ class _RobotSpec:
                 return True
             body = body.parent
         return False
+
+    def casters(self, floor: float) -> None:
+        """Spheres of the base that rest on the floor with the wheels are casters: made
+        frictionless (condim 1, priority 1), as a URDF cannot say (its friction tags are
+        Gazebo's); otherwise they drag like brakes."""
+        made = []
+        for geom in self.base.geoms:
+            if geom.type != mujoco.mjtGeom.mjGEOM_SPHERE or int(geom.condim) == 1:
+                continue
+            if float(geom.pos[2]) - float(geom.size[0]) - floor < _CASTER_GAP:
+                geom.condim = 1
+                geom.priority = 1
+                made.append(geom.name or f"sphere at x = {float(geom.pos[0]):.3g} m")
+        if made:
+            self.sources["casters"] = f"made frictionless by otonav: {', '.join(made)}"
 
     def prepare(self, mass: float, wheel_radius: float) -> None:
         """Free base, wheel actuators, sensor sites, geom groups (after :meth:`probe`)."""
@@ -468,13 +484,18 @@ def _absolute_assets(spec: Any, path: Path) -> None:
     folder = path.resolve().parent
     for items, subdir in ((spec.meshes, spec.meshdir), (spec.textures, spec.texturedir)):
         for item in items:
-            if item.file and not Path(item.file).is_absolute():
-                item.file = str(folder / (subdir or "") / item.file)
+            file = str(item.file)
+            if spec.strippath or "://" in file:  # URDF: package://pkg/meshes/x.stl
+                file = file.rsplit("/", 1)[-1]
+            if file and not Path(file).is_absolute():
+                item.file = str(folder / (subdir or "") / file)
+    spec.strippath = False
     spec.meshdir = ""
     spec.texturedir = ""
 
 
 def _load_robot(robot: RobotDescription) -> tuple[Any, str]:
+    """The robot's model as a spec, its asset files found where the model says."""
     path = Path(robot.model)
     label = robot.label
     if not path.is_file():
@@ -487,6 +508,7 @@ def _load_robot(robot: RobotDescription) -> tuple[Any, str]:
     except ValueError as exc:
         raise SceneError(f"{robot.key}model: {label} does not parse: {_one_line(exc)}") from None
     _absolute_assets(spec, path)
+    spec.compiler.fusestatic = False  # URDF's default: it would fuse the base into the world
     return spec, label
 
 
@@ -496,6 +518,7 @@ class _Probe:
     wheel_radius: float  # m, rough (bounding sphere of the left wheel's geoms)
     top: float  # m, the highest point of the robot above its base's origin
     bottom: float  # m, the lowest point of its collision geoms above the floor
+    floor: float  # m, that lowest point relative to the base's origin
 
 
 def _probe(parts: _RobotSpec) -> _Probe:
@@ -523,6 +546,7 @@ def _probe(parts: _RobotSpec) -> _Probe:
         wheel_radius=radius,
         top=max(highs, default=0.0) - float(data.xpos[base][2]),
         bottom=min(lows, default=0.0),
+        floor=min(lows, default=0.0) - float(data.xpos[base][2]),
     )
 
 
@@ -648,6 +672,21 @@ class _Derivation:
         self.sources[key] = f"{self.robot.key}{key} (given)"
         return True
 
+    def wheel_sign(self, joint: int) -> float:
+        """+1 if the joint's positive turn rolls the robot forward (axle along +y of
+        the base), -1 if along -y (a mirrored joint, as many models have)."""
+        m = self.model
+        along_y = float((self.to_base @ self.data.xaxis[joint])[1])
+        if abs(along_y) < 0.9:
+            name = _shown_name(m, mujoco.mjtObj.mjOBJ_JOINT, joint)
+            key = "left_wheel" if name == self.robot.left_wheel else "right_wheel"
+            raise self.parts.fail(
+                key,
+                f"joint {name!r} turns about an axis that is not the robot's left-right (y) "
+                "axis: a wheel's axle must be",
+            )
+        return 1.0 if along_y > 0 else -1.0
+
     def wheel_radius(self, joint: int) -> float:
         m = self.model
         body = int(m.jnt_bodyid[joint])
@@ -662,7 +701,11 @@ class _Derivation:
         if self._given("wheel_radius", self.robot.wheel_radius):
             return float(self.robot.wheel_radius or 0.0)
         geom = geoms[0]
-        name = _shown_name(m, mujoco.mjtObj.mjOBJ_GEOM, geom)
+        name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, geom)
+        if name:
+            name = repr(str(name).removeprefix(ROBOT_PREFIX))
+        else:
+            name = f"of body {_shown_name(m, mujoco.mjtObj.mjOBJ_BODY, body)!r}"
         kind = int(m.geom_type[geom])
         size = m.geom_size[geom]
         # The axle in the geom's frame: the wheel is round about it.
@@ -684,7 +727,7 @@ class _Derivation:
         else:
             radius = float(m.geom_rbound[geom])
         kind_name = mujoco.mjtGeom(kind).name.removeprefix("mjGEOM_").lower()
-        self.sources["wheel_radius"] = f"derived from the {kind_name} geom {name!r}"
+        self.sources["wheel_radius"] = f"derived from the {kind_name} geom {name}"
         return radius
 
     def separation(self, left: int, right: int) -> float:
@@ -887,6 +930,7 @@ class MujocoInterface(RobotHardwareInterface):
         self._variant: Variant = variant
         parts = _RobotSpec(robot_spec, robot, robot_file)
         probe = _probe(parts)
+        parts.casters(probe.floor)
         parts.prepare(probe.mass, probe.wheel_radius)
         lidar_site = parts.mount("lidar", robot.lidar, (0.0, 0.0, probe.top + _MOUNT_ABOVE))
         imu_site = parts.mount("imu", robot.imu, (0.0, 0.0, 0.0))
@@ -925,6 +969,12 @@ class MujocoInterface(RobotHardwareInterface):
         self._quat = _site_sensor(m, mujoco.mjtSensor.mjSENS_FRAMEQUAT, self._imu_site)
 
         derived = _Derivation(m, self._chassis, parts)
+        self._wheel_sign = (derived.wheel_sign(left_joint), derived.wheel_sign(right_joint))
+        self._mirrored = self._wheel_sign != (1.0, 1.0)
+        self._ctrl_scale = (
+            self._ctrl_scale[0] * self._wheel_sign[0],
+            self._ctrl_scale[1] * self._wheel_sign[1],
+        )
         self._geometry = derived.geometry(
             (left_joint, right_joint), self._lidar_site, self._imu_site, self._base_qpos
         )
@@ -1086,12 +1136,12 @@ class MujocoInterface(RobotHardwareInterface):
         )
 
     def read_wheels(self) -> WheelState:
-        qpos, qvel = self._data.qpos, self._data.qvel
+        left_pos, right_pos, left_vel, right_vel = self.wheel_values()
         return WheelState(
-            left_position=float(qpos[self._wheel_qpos[0]]),
-            right_position=float(qpos[self._wheel_qpos[1]]),
-            left_velocity=float(qvel[self._wheel_qvel[0]]),
-            right_velocity=float(qvel[self._wheel_qvel[1]]),
+            left_position=left_pos,
+            right_position=right_pos,
+            left_velocity=left_vel,
+            right_velocity=right_vel,
         )
 
     def wheel_values(self) -> tuple[float, float, float, float]:
@@ -1099,6 +1149,9 @@ class MujocoInterface(RobotHardwareInterface):
         # read_wheels, without building a WheelState (1.1 -> ~0.35 us).
         qpos, qvel = self._data.qpos, self._data.qvel
         (pl, pr), (vl, vr) = self._wheel_qpos, self._wheel_qvel
+        if self._mirrored:  # a joint axis along -y: its positive turn drives backwards
+            sl, sr = self._wheel_sign
+            return sl * qpos.item(pl), sr * qpos.item(pr), sl * qvel.item(vl), sr * qvel.item(vr)
         return qpos.item(pl), qpos.item(pr), qvel.item(vl), qvel.item(vr)
 
     def read_imu(self) -> ImuSample:
