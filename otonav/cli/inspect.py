@@ -11,6 +11,7 @@ def add_parser(commands: Any) -> None:
     g = commands.add_parser("graph", help="actors, topics, types and QoS of the configured stack")
     g.add_argument("--config", type=Path, help="stack config YAML (default: built-in)")
     g.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE")
+    g.add_argument("--actor", dest="actors", action="append", default=[], metavar="MODULE:CLASS")
     g.set_defaults(handler=graph_main)
     s = commands.add_parser("scenarios", help="list the built-in scenarios")
     s.set_defaults(handler=scenarios_main)
@@ -29,20 +30,24 @@ def graph_main(args: argparse.Namespace) -> int:
     from otonav.stack import build_actors, build_world
     from otonav.stack.rosout import attach_rosout
 
-    stack = load_stack(args.config, args.overrides)
+    stack = load_stack(args.config, args.overrides, args.actors)
     hal = build_world(stack)
     try:
-        system = System(build_actors(stack, hal))
+        built = build_actors(stack, hal)
+        system = System(built)
         attach_rosout(system)
         graph = system.graph()
     finally:
         hal.close()
     console = Console(highlight=False, width=140)
     actors = Table(title="actors")
-    for column in ("actor", "kind", "subscribes", "publishes"):
+    for column in ("actor", "kind", "subscribes", "publishes", "parameters"):
         actors.add_column(column)
+    params = {actor.name: parameter_lines(actor.name, actor.parameters) for actor in built}
     for a in graph.actors:
-        actors.add_row(a.name, a.kind, "\n".join(a.inputs), "\n".join(a.outputs))
+        actors.add_row(
+            a.name, a.kind, "\n".join(a.inputs), "\n".join(a.outputs), params.get(a.name, "")
+        )
     console.print(actors)
     topics = Table(title="topics (a recording adds the recorder on every topic)")
     for column in ("topic", "type", "publishers (QoS)", "subscribers (QoS)"):
@@ -56,6 +61,23 @@ def graph_main(args: argparse.Namespace) -> int:
         )
     console.print(topics)
     return 0
+
+
+BUILTIN_SECTIONS = {
+    "bridge": "rates.*, world.lidar_*",
+    "base": "base.*",
+    "nav": "nav.*",
+    "safety": "safety.*",
+}
+"""Where the built-in actors' parameters live in the stack config."""
+
+
+def parameter_lines(name: str, parameters: Any) -> str:
+    """A launched actor's parameters as ``key=value`` lines (``--set actors.NAME.KEY``),
+    or the config section of a built-in one."""
+    if parameters:
+        return "\n".join(f"{key}={value}" for key, value in parameters.items())
+    return BUILTIN_SECTIONS.get(name, "")
 
 
 def scenarios_main(_args: argparse.Namespace) -> int:

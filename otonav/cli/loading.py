@@ -12,8 +12,8 @@ from otonav.scenario.config import ScenarioConfig
 from otonav.stack.config import StackConfig
 from otonav.stack.files import ConfigFileError, load_model
 from otonav.stack.launch import add_actors, check_actors
+from otonav.stack.loading import load_stack_file
 from otonav.stack.overrides import apply_overrides
-from otonav.stack.robot import resolve_paths
 
 
 def load_scenario(spec: str, *, source: str = "--scenario") -> ScenarioConfig:
@@ -34,9 +34,7 @@ def load_stack(
     """The built-in stack config, or ``config`` (YAML; its relative paths resolved
     against its folder), with ``--actor`` nodes added and ``--set`` overrides applied;
     every launched actor's class imported and its parameters validated."""
-    stack = StackConfig()
-    if config is not None:
-        stack = resolve_paths(load_model(config, StackConfig), config.parent)
+    stack = load_stack_file(config) if config is not None else StackConfig()
     if actors:
         stack = add_actors(stack, actors)
     if overrides:

@@ -97,6 +97,7 @@ class Actor:
         self._otonav_remap: dict[str, str] = dict(remap or {})
         self._otonav_ports: dict[str, Any] = {}
         self._otonav_clock: Clock | None = None
+        self._otonav_params: Mapping[str, Any] = {}
 
     @classmethod
     def ports(cls) -> list[_Port[Any]]:
@@ -107,6 +108,12 @@ class Actor:
                 if isinstance(value, _Port):
                     seen[attr] = value
         return list(seen.values())
+
+    @property
+    def parameters(self) -> Mapping[str, Any]:
+        """The parameters the actor was launched with (``otonav graph`` lists them):
+        a launched actor's validated ``Params``, as plain values; empty otherwise."""
+        return self._otonav_params
 
     def topic_of(self, port: _Port[Any]) -> str:
         """The topic ``port`` is bound to for this instance (after remapping)."""

@@ -160,7 +160,10 @@ def make_actor(entry: ActorConfig) -> Actor:
         raise ConfigFileError(
             f"{key}.class: {cls.__name__} must accept {how} as keywords ({exc})"
         ) from None
-    return cls(**kwargs)
+    actor = cls(**kwargs)
+    if params is not None:
+        actor._otonav_params = params.model_dump(mode="json")
+    return actor
 
 
 def add_actors(stack: StackConfig, specs: Sequence[str], *, source: str = "--actor") -> StackConfig:
@@ -179,6 +182,9 @@ def add_actors(stack: StackConfig, specs: Sequence[str], *, source: str = "--act
                 f"{source} {spec}: an actor named {name!r} is already launched; name it in "
                 "the config's actors list instead"
             )
+        where = spec.rpartition(":")[0]
+        if where.endswith(".py"):  # a file: found from any worker's directory
+            spec = f"{Path(where).resolve()}:{attr}"
         entries.append(ActorConfig(name=name, class_=spec))
     return stack.model_copy(update={"actors": tuple(entries)})
 

@@ -4,13 +4,11 @@ against the config file it was written in."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from otonav.hal.description import BUILTIN_ROBOTS, Mount, RobotDescription, builtin_robot
 from otonav.stack.config import BaseConfig, MountConfig, RobotConfig, StackConfig
 from otonav.stack.files import ConfigFileError
 
-__all__ = ["describe_robot", "resolve_paths"]
+__all__ = ["describe_robot", "robot_base", "top_speed"]
 
 
 def _mount(config: MountConfig | None) -> Mount | None:
@@ -49,24 +47,6 @@ def describe_robot(config: RobotConfig) -> RobotDescription:
         max_v=config.max_v if config.max_v is not None else base.max_v,
         max_omega=config.max_omega if config.max_omega is not None else base.max_omega,
     )
-
-
-def resolve_paths(stack: StackConfig, folder: Path) -> StackConfig:
-    """``stack`` with its relative file paths (``robot.model``, an actor's
-    ``path/file.py:Class``) made relative to ``folder`` (the config file's)."""
-    updates: dict[str, object] = {}
-    model = stack.robot.model
-    if model not in BUILTIN_ROBOTS and not Path(model).is_absolute():
-        updates["robot"] = stack.robot.model_copy(update={"model": str(folder / model)})
-    actors = []
-    for entry in stack.actors:
-        where, sep, name = entry.class_.rpartition(":")
-        if sep and where.endswith(".py") and not Path(where).is_absolute():
-            entry = entry.model_copy(update={"class_": f"{folder / where}:{name}"})
-        actors.append(entry)
-    if tuple(actors) != stack.actors:
-        updates["actors"] = tuple(actors)
-    return stack.model_copy(update=updates) if updates else stack
 
 
 def robot_base(stack: StackConfig) -> BaseConfig:

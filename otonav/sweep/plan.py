@@ -20,8 +20,8 @@ from otonav.scenario.builtin import BUILTIN
 from otonav.stack import StackConfig
 from otonav.stack.files import ConfigFileError, describe_validation_error, load_model
 from otonav.stack.launch import add_actors, check_actors
+from otonav.stack.loading import load_stack_file
 from otonav.stack.overrides import apply_overrides
-from otonav.stack.robot import resolve_paths
 from otonav.sweep.spec import GenerateSource, Keep, Scalar, SweepSpec
 from otonav.sweep.worlds import world_name, world_params_json
 
@@ -186,7 +186,7 @@ def _iter_runs(spec: SweepSpec, base: Path, where: str, actors: Sequence[str]) -
     config_path = str(base / spec.config) if spec.config is not None else None
     stack = StackConfig()
     if config_path:
-        stack = resolve_paths(load_model(Path(config_path), StackConfig), Path(config_path).parent)
+        stack = load_stack_file(config_path)
     if actors:
         stack = add_actors(stack, actors)
     scenarios = _resolve_scenarios(spec, base, where)

@@ -11,6 +11,7 @@ from otonav.hal import BoxObstacle, RobotHardwareInterface
 from otonav.hal.mujoco import Variant
 from otonav.runtime import Actor, System
 from otonav.stack import StackConfig, build_actors, build_world
+from otonav.stack.loading import load_stack_file
 from otonav.stack.session import RealTime, StackSession
 
 
@@ -24,7 +25,7 @@ class RunningStack:
 
 @asynccontextmanager
 async def running_stack(
-    config: StackConfig = StackConfig(),
+    config: StackConfig | Path | str = StackConfig(),
     *,
     navigator: bool = True,
     extra_actors: Sequence[Actor] = (),
@@ -41,7 +42,12 @@ async def running_stack(
     ``record_to`` every topic is recorded to that MCAP file, finished on every exit.
     On exit the stack is torn down as every runner's is (:mod:`otonav.stack.session`):
     the loop gets its previous time source back, so the test can go on sleeping.
+
+    ``config`` is a :class:`StackConfig` or the path of a stack config file: the same
+    file ``otonav run --config`` takes, with its robot and its ``actors``.
     """
+    if not isinstance(config, StackConfig):
+        config = load_stack_file(config)
     hal = build_world(config, extra_obstacles=extra_obstacles, variant=variant)
     try:
         actors = [*build_actors(config, hal, navigator=navigator), *extra_actors]

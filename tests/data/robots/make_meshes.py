@@ -11,14 +11,18 @@ from pathlib import Path
 HERE = Path(__file__).parent / "pathfinder" / "meshes"
 
 
-def prism(radius: float, half_height: float, sides: int) -> tuple[list[tuple[float, ...]], list[tuple[int, ...]]]:
+Verts = list[tuple[float, float, float]]
+Tris = list[tuple[int, int, int]]
+
+
+def prism(radius: float, half_height: float, sides: int) -> tuple[Verts, Tris]:
     """A right prism about z: vertices (mm) and triangles (0-based)."""
-    verts = [(0.0, 0.0, -half_height), (0.0, 0.0, half_height)]
+    verts: Verts = [(0.0, 0.0, -half_height), (0.0, 0.0, half_height)]
     for i in range(sides):
         a = 2 * math.pi * i / sides
         x, y = radius * math.cos(a), radius * math.sin(a)
         verts += [(x, y, -half_height), (x, y, half_height)]
-    tris = []
+    tris: Tris = []
     for i in range(sides):
         lo, hi = 2 + 2 * i, 3 + 2 * i
         nlo, nhi = 2 + 2 * ((i + 1) % sides), 3 + 2 * ((i + 1) % sides)
@@ -26,13 +30,13 @@ def prism(radius: float, half_height: float, sides: int) -> tuple[list[tuple[flo
     return verts, tris
 
 
-def write_obj(path: Path, verts: list[tuple[float, ...]], tris: list[tuple[int, ...]]) -> None:
+def write_obj(path: Path, verts: Verts, tris: Tris) -> None:
     lines = [f"v {x:.3f} {y:.3f} {z:.3f}" for x, y, z in verts]
     lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in tris]
     path.write_text("\n".join(lines) + "\n")
 
 
-def write_stl(path: Path, verts: list[tuple[float, ...]], tris: list[tuple[int, ...]]) -> None:
+def write_stl(path: Path, verts: Verts, tris: Tris) -> None:
     data = bytearray(b"pathfinder test mesh".ljust(80, b" "))
     data += struct.pack("<I", len(tris))
     for tri in tris:

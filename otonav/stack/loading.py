@@ -1,0 +1,38 @@
+"""A stack config file as a launch file: loaded, validated, and its relative paths
+(``robot.model``, an actor's ``path/file.py:Class``) taken from the file's folder, as a
+ROS 2 launch file finds what it names relative to its package."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from otonav.hal.description import BUILTIN_ROBOTS
+from otonav.stack.config import StackConfig
+from otonav.stack.files import load_model
+
+__all__ = ["load_stack_file", "resolve_paths"]
+
+
+def load_stack_file(path: Path | str) -> StackConfig:
+    """The stack config in ``path`` (YAML), its relative paths resolved against the
+    file's folder; :class:`~otonav.stack.files.ConfigFileError` on any problem."""
+    path = Path(path)
+    return resolve_paths(load_model(path, StackConfig), path.parent)
+
+
+def resolve_paths(stack: StackConfig, folder: Path) -> StackConfig:
+    """``stack`` with its relative file paths (``robot.model``, an actor's
+    ``path/file.py:Class``) made relative to ``folder`` (the config file's)."""
+    updates: dict[str, object] = {}
+    model = stack.robot.model
+    if model not in BUILTIN_ROBOTS and not Path(model).is_absolute():
+        updates["robot"] = stack.robot.model_copy(update={"model": str(folder / model)})
+    actors = []
+    for entry in stack.actors:
+        where, sep, name = entry.class_.rpartition(":")
+        if sep and where.endswith(".py") and not Path(where).is_absolute():
+            entry = entry.model_copy(update={"class_": f"{folder / where}:{name}"})
+        actors.append(entry)
+    if tuple(actors) != stack.actors:
+        updates["actors"] = tuple(actors)
+    return stack.model_copy(update=updates) if updates else stack
