@@ -101,6 +101,24 @@ def _stack_lines(stack_json: str) -> list[str]:
     return [f"{name}: {_fields(values)}" for name, values in sections.items()]
 
 
+def robot_lines(world: dict[str, str]) -> list[str]:
+    """The robot's geometry as recorded, each value with where it came from."""
+    if "robot" not in world:
+        return []
+    robot = _decoded(world["robot"])
+    sources = _decoded(world.get("robot_sources", "{}"))
+    if not isinstance(robot, dict) or not isinstance(sources, dict):
+        return []
+    lines = []
+    for key in ("wheel_radius", "wheel_separation", "footprint"):
+        source = sources.get(key, "")
+        lines.append(f"{key}={robot.get(key)}" + (f"  <- {source}" if source else ""))
+    for key, source in sources.items():
+        if key not in ("wheel_radius", "wheel_separation", "footprint"):
+            lines.append(f"{key}: {source}")
+    return ["robot:     " + lines[0], *("           " + line for line in lines[1:])]
+
+
 def info_main(args: argparse.Namespace) -> int:
     from otonav.record.reader import summarize
 
@@ -138,6 +156,9 @@ def info_main(args: argparse.Namespace) -> int:
     if "stack_config" in run:
         lines = _stack_lines(run["stack_config"])
         console.print("stack:     " + "\n           ".join(lines), soft_wrap=True)
+    world = summary.metadata.get("otonav.world", {})
+    for line in robot_lines(world):
+        console.print(line, soft_wrap=True)
     if "verdict" in run:
         console.print(f"verdict:   {run['verdict']}", soft_wrap=True)
     elif run:

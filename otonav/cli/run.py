@@ -112,6 +112,19 @@ def add_parser(commands: Any) -> None:
     p.set_defaults(handler=main)
 
 
+def robot_rows(verdict: Verdict) -> list[tuple[str, str]]:
+    """The robot the verdict is about, and the budget it had (scaled to its speed)."""
+    robot = verdict.robot
+    if not robot:
+        return []
+    top = f", top {robot['max_v']:g} m/s" if robot.get("max_v") else ""
+    return [
+        ("robot", f"{robot['model']}{top}"),
+        ("wheels", f"r {robot['wheel_radius']:.4f} m, {robot['wheel_separation']:.3f} m apart"),
+        ("sim budget", f"{verdict.sim_budget_s:g} s"),
+    ]
+
+
 def print_verdict(verdict: Verdict, console: Console) -> None:
     from rich.table import Table
 
@@ -130,6 +143,7 @@ def print_verdict(verdict: Verdict, console: Console) -> None:
         ("sim time", f"{verdict.sim_time_s:.2f} s"),
         ("wall time", f"{verdict.wall_time_s:.3f} s"),
         ("real-time factor", f"{verdict.rtf:.0f}x"),
+        *robot_rows(verdict),
     ):
         table.add_row(key, value)
     console.print(table)

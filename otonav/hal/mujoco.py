@@ -405,11 +405,17 @@ class _RobotSpec:
             if sensor.type == kinds[key] and sensor.objtype == mujoco.mjtObj.mjOBJ_SITE:
                 site = self.spec.site(sensor.objname)
                 if site is not None and self._under_base(site.parent):
-                    self.sources[key] = (
-                        f"site {site.name!r} of the model's {sensor.type.name[9:].lower()} "
-                        f"{sensor.name or '(unnamed)'!r}"
+                    kind = sensor.type.name.removeprefix("mjSENS_").lower()
+                    label = sensor.name or "(unnamed)"
+                    self.sources[key] = f"at site {site.name!r} of the model's {kind} {label!r}"
+                    if key == "imu":
+                        return str(site.name)
+                    # A rangefinder's ray runs along its site's z: the scan is cast from
+                    # the same point, in the base's axes (its own site, unturned).
+                    site.parent.add_site(
+                        name="otonav_lidar", pos=list(site.pos), size=[0.01, 0.01, 0.01], group=4
                     )
-                    return str(site.name)
+                    return "otonav_lidar"
         return None
 
     def imu_sensors(self, site: str) -> None:
@@ -523,7 +529,10 @@ class _Probe:
 
 def _probe(parts: _RobotSpec) -> _Probe:
     """Mass and extent of the robot as modelled, before otonav changes anything."""
-    model = _compile(parts.spec.copy(), parts.file)
+    try:
+        model = parts.spec.copy().compile()
+    except ValueError as exc:  # a missing mesh file, a bad attribute
+        raise parts.fail("model", f"{parts.file} does not compile: {_one_line(exc)}") from None
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
     base = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, parts.base.name))

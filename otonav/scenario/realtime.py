@@ -24,6 +24,7 @@ from otonav.scenario.run import (
     Verdict,
     drive,
     judge_verdict,
+    robot_summary,
     run_task,
     save_artifacts,
     scenario_session,
@@ -161,7 +162,9 @@ def run_scenario_realtime(
         wall = time.perf_counter() - wall_start
         sim_time = hal.ticks / tick_rate(hal.tick)
         try:
-            verdict = judge_verdict(scenario, judge, sim_time, wall)
+            verdict = judge_verdict(
+                scenario, judge, sim_time, wall, robot=robot_summary(stack, hal)
+            )
             if ended != "completed":
                 verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
             elif closed_at and not judge.reached:

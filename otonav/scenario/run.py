@@ -13,7 +13,7 @@ import signal
 import threading
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -74,6 +74,11 @@ class Verdict:
     """The navigator's last /nav/state (e.g. reached, unreachable)."""
     nav_reason: str = ""
     """The navigator's last reason (/nav/diagnostics), e.g. why it gave up."""
+    sim_budget_s: float = 0.0
+    """s of sim time the scenario allowed (scaled to the robot's speed: ``for_robot``)."""
+    robot: dict[str, Any] = field(default_factory=dict)
+    """The robot as run: model, top speeds, the geometry values and where each came
+    from (:func:`robot_summary`)."""
 
     def as_dict(self) -> dict[str, object]:
         return asdict(self)
@@ -316,7 +321,13 @@ def run_scenario(
         raise
     finally:
         try:
-            verdict = judge_verdict(scenario, judge, sim_time, time.perf_counter() - wall_start)
+            verdict = judge_verdict(
+                scenario,
+                judge,
+                sim_time,
+                time.perf_counter() - wall_start,
+                robot=robot_summary(stack, hal),
+            )
             if ended != "completed":
                 verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
             verdict = save_artifacts(verdict, scenario, stack, judge, session, out_dir, plot)
@@ -402,7 +413,31 @@ def run_metadata(scenario: ScenarioConfig, stack: StackConfig) -> dict[str, str]
     }
 
 
-def judge_verdict(scenario: ScenarioConfig, judge: Judge, sim_time: float, wall: float) -> Verdict:
+def robot_summary(stack: StackConfig, hal: RobotHardwareInterface) -> dict[str, Any]:
+    """What the verdict says about the robot: which model, its top speeds, each
+    geometry value and where it came from (derived from the model, or given)."""
+    robot = describe_robot(stack.robot)
+    g = hal.geometry
+    return {
+        "model": robot.label,
+        "max_v": robot.max_v,
+        "max_omega": robot.max_omega,
+        "wheel_radius": g.wheel_radius,
+        "wheel_separation": g.wheel_separation,
+        "footprint_radius": g.footprint_radius,
+        "laser_offset": [g.laser_offset_x, g.laser_offset_z],
+        "sources": hal.geometry_sources(),
+    }
+
+
+def judge_verdict(
+    scenario: ScenarioConfig,
+    judge: Judge,
+    sim_time: float,
+    wall: float,
+    *,
+    robot: dict[str, Any] | None = None,
+) -> Verdict:
     """Pass when the scenario's expected outcome happened (``expect``: the goal reached,
     or the navigator's ``unreachable`` inside the budget) and the clearance held."""
     clear = judge.min_clearance >= scenario.min_clearance
@@ -459,4 +494,6 @@ def judge_verdict(scenario: ScenarioConfig, judge: Judge, sim_time: float, wall:
         unreachable_at_s=judge.unreachable_at,
         nav_state=judge.nav_state,
         nav_reason=judge.nav_reason,
+        sim_budget_s=scenario.sim_budget,
+        robot=robot or {},
     )

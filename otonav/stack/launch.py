@@ -101,7 +101,9 @@ def actor_class(spec: str, key: str) -> type[Actor]:
     target = getattr(module, attr, None)
     if target is None:
         found = sorted(
-            n for n, v in vars(module).items() if isinstance(v, type) and issubclass(v, Actor)
+            n
+            for n, v in vars(module).items()
+            if isinstance(v, type) and issubclass(v, Actor) and v.__module__ == module.__name__
         )
         raise ConfigFileError(
             f"{key}: {where!r} has no {attr!r} (actor classes there: {', '.join(found) or 'none'})"

@@ -20,7 +20,7 @@ def _actor_path(data: dict[str, Any], parts: list[str], source: str, key: str) -
     if parts[0] != "actors" or "actors" not in data:
         return parts
     entries = data["actors"]
-    names = [entry["name"] for entry in entries]
+    names = list(entries) if isinstance(entries, dict) else [entry["name"] for entry in entries]
     if len(parts) < 3 or parts[1] not in names:
         raise ConfigFileError(
             f"{source} {key}: expected actors.NAME.PARAM with NAME one of the launched "

@@ -1,0 +1,155 @@
+"""Your robot and your nodes through every surface: ``otonav run``, ``sweep``,
+``replay`` and ``running_stack``, with a robot and a node from outside ``otonav/``;
+the built-in ``burger`` on the acceptance course and the seven built-in courses."""
+
+from __future__ import annotations
+
+import json
+import logging
+from pathlib import Path
+
+import pytest
+from mcap.reader import make_reader
+
+from otonav.cli import main
+from otonav.msgs import Log, NavState
+from otonav.record.reader import read_messages
+from otonav.runtime import until
+from otonav.scenario import ScenarioConfig, run_scenario
+from otonav.scenario.builtin import BUILTIN
+from otonav.stack import StackConfig
+from otonav.stack.config import RobotConfig
+from otonav.testing import running_stack
+
+pytestmark = pytest.mark.sil
+
+ROOT = Path(__file__).resolve().parents[2]
+PATHFINDER = ROOT / "tests" / "data" / "robots" / "pathfinder"
+MY_NODES = ROOT / "examples" / "my_nodes"
+COURSES = ("empty", "box", "slalom", "gap", "u_trap", "corridor", "cluttered")
+
+
+def metadata(path: Path, name: str) -> dict[str, str]:
+    with path.open("rb") as f:
+        for record in make_reader(f).iter_metadata():
+            if record.name == name:
+                return dict(record.metadata)
+    raise AssertionError(f"no {name} metadata in {path}")
+
+
+@pytest.mark.parametrize("config", ["stack.yaml", "stack_urdf.yaml"])
+def test_a_users_robot_runs_the_acceptance_course(config: str, tmp_path: Path) -> None:
+    assert main(["run", "--config", str(PATHFINDER / config), "--out", str(tmp_path)]) == 0
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["passed"]
+    assert summary["min_clearance_m"] >= 0.3
+    world = metadata(tmp_path / "recording.mcap", "otonav.world")
+    robot = json.loads(world["robot"])
+    assert robot["wheel_radius"] == pytest.approx(0.0762, abs=1e-4)
+    assert robot["wheel_separation"] == pytest.approx(0.30)
+    sources = json.loads(world["robot_sources"])
+    assert "mesh geom" in sources["wheel_radius"]
+    assert summary["robot"]["wheel_radius"] == robot["wheel_radius"]
+
+
+def test_a_users_node_through_run_and_replay(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    config = MY_NODES / "stack.yaml"
+    assert (
+        main(["run", "--scenario", "empty", "--config", str(config), "--out", str(tmp_path)]) == 0
+    )
+    recording = tmp_path / "recording.mcap"
+    states = [m.state for _t, _s, m in read_messages(recording, ["/nav/state"])]
+    assert states[-1] == "reached"  # published by the user's node
+    watch = [m for _t, _s, m in read_messages(recording, ["/rosout"]) if m.level == Log.WARN]
+    assert not [m for m in watch if m.name == "command_watch"]  # it was fed: no warning
+    capsys.readouterr()
+    assert main(["replay", str(recording), "--node", "planner"]) == 0
+    assert "SAME: every output byte-identical" in capsys.readouterr().out
+    # changed parameters change what the node does: the replay diverges
+    assert (
+        main(["replay", str(recording), "--node", "planner", "--set", "actors.planner.max_v=0.2"])
+        == 1
+    )
+
+
+def test_a_users_node_in_a_sweep_with_its_parameter_varied(tmp_path: Path) -> None:
+    args = [
+        "sweep", "--scenario", "empty", "--out", str(tmp_path),
+        "--actor", f"{MY_NODES / 'simple_planner.py'}:StraightToGoal",
+        "--set", "nav.planner=external", "--set", "actors.straight_to_goal.max_v=0.2,0.3",
+    ]  # fmt: skip
+    assert main(args) == 0
+    records = [json.loads(line) for line in (tmp_path / "results.jsonl").read_text().splitlines()]
+    assert sorted(r["overrides"]["actors.straight_to_goal.max_v"] for r in records) == [0.2, 0.3]
+    assert all(r["status"] == "passed" for r in records)
+    slow, fast = sorted(records, key=lambda r: r["overrides"]["actors.straight_to_goal.max_v"])
+    assert slow["time_to_goal_s"] > fast["time_to_goal_s"]  # the parameter reached the node
+
+
+@pytest.mark.sim(wall_ceiling=60)
+async def test_running_stack_brings_up_a_users_robot_and_node_from_one_file(
+    tmp_path: Path,
+) -> None:
+    config = tmp_path / "stack.yaml"
+    config.write_text(
+        f"robot:\n  model: {PATHFINDER / 'pathfinder.xml'}\n  base: chassis_link\n"
+        "  left_wheel: left_wheel_hinge\n  right_wheel: right_wheel_hinge\n"
+        "nav: {planner: external}\n"
+        "actors:\n"
+        f"  - {{name: planner, class: '{MY_NODES / 'simple_planner.py'}:StraightToGoal'}}\n"
+    )
+    async with running_stack(config) as stack:
+        from otonav.msgs import Header, Point, Pose, PoseStamped, Time
+        from otonav.runtime import LATCHED_QOS
+
+        assert stack.hal.geometry.wheel_radius == pytest.approx(0.0762, abs=1e-4)
+        goal = stack.system.publisher("/goal", PoseStamped, LATCHED_QOS, name="test")
+        await goal.publish(
+            PoseStamped(header=Header(stamp=Time()), pose=Pose(position=Point(x=1.0, y=0.5)))
+        )
+        states = stack.system.subscribe("/nav/state", NavState)
+        last = ["none"]
+
+        def arrived() -> bool:
+            while (message := states.try_recv()) is not None:
+                last[0] = message.state
+            return last[0] == "reached"
+
+        await until(arrived, within=15.0, observe=lambda: last[0])
+        truth = stack.hal.ground_truth()
+        assert (truth.x - 1.0) ** 2 + (truth.y - 0.5) ** 2 < 0.15**2
+
+
+@pytest.mark.parametrize("course", ["acceptance", *COURSES])
+def test_burger_passes_the_courses_within_budgets_scaled_to_its_speed(course: str) -> None:
+    stack = StackConfig(robot=RobotConfig(model="burger"))
+    scenario = BUILTIN[course]
+    verdict = run_scenario(scenario, stack, record=False, plot=False)
+    assert verdict.passed, verdict.reason
+    assert verdict.sim_budget_s == pytest.approx(scenario.sim_budget * 0.4 / 0.22, abs=1e-3)
+    assert verdict.robot["max_v"] == 0.22
+
+
+def test_an_external_planner_nobody_feeds_is_named_within_a_second(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    stack = StackConfig.model_validate({"nav": {"planner": "external"}})
+    scenario = ScenarioConfig.model_validate(
+        {"scene": "empty", "goal": {"x": 2.0, "y": 0.0}, "sim_budget": 2.0}
+    )
+    with caplog.at_level(logging.WARNING, logger="otonav"):
+        verdict = run_scenario(scenario, stack, out_dir=tmp_path, plot=False)
+    assert not verdict.passed
+    warnings = [
+        (stamp, m.msg)
+        for _t, stamp, m in read_messages(tmp_path / "recording.mcap", ["/rosout"])
+        if m.name == "command_watch" and m.level == Log.WARN
+    ]
+    assert len(warnings) == 1
+    stamp, text = warnings[0]
+    assert stamp <= 1.0 + 1e-6
+    assert "/cmd_vel_nav" in text
+    assert "nav.planner is 'external'" in text
+    assert any("no message on /cmd_vel_nav" in r.getMessage() for r in caplog.records)

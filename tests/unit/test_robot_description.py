@@ -1,0 +1,262 @@
+"""Robot descriptions: built-in robots, models written the ways people write them
+(meshes in mm, mirrored joints, geared, motor and position actuators, URDF, no
+sensors), the values derived from them, and one-line errors naming the robot key."""
+
+from __future__ import annotations
+
+import math
+import shutil
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from otonav.hal import WheelCommand
+from otonav.hal.description import Mount, RobotDescription, builtin_robot
+from otonav.hal.mujoco import MujocoInterface, SceneError
+
+ROBOTS = Path(__file__).resolve().parents[1] / "data" / "robots"
+PATHFINDER = ROBOTS / "pathfinder"
+
+
+def pathfinder(model: Path = PATHFINDER / "pathfinder.xml", **changes: object) -> RobotDescription:
+    values: dict[str, object] = {
+        "model": str(model),
+        "label": model.name,
+        "base": "chassis_link",
+        "left_wheel": "left_wheel_hinge",
+        "right_wheel": "right_wheel_hinge",
+    }
+    values.update(changes)
+    return RobotDescription(**values)  # type: ignore[arg-type]
+
+
+def urdf(**changes: object) -> RobotDescription:
+    values: dict[str, object] = {
+        "model": str(PATHFINDER / "pathfinder.urdf"),
+        "label": "pathfinder.urdf",
+        "base": "base_link",
+        "left_wheel": "left_wheel_joint",
+        "right_wheel": "right_wheel_joint",
+        "lidar": Mount(body="laser_link", pos=(0.0, 0.0, 0.0)),
+    }
+    values.update(changes)
+    return RobotDescription(**values)  # type: ignore[arg-type]
+
+
+def variant(tmp_path: Path, old: str, new: str) -> RobotDescription:
+    """The MJCF test robot with one edit, next to a copy of its meshes."""
+    shutil.copytree(PATHFINDER / "meshes", tmp_path / "meshes", dirs_exist_ok=True)
+    text = (PATHFINDER / "pathfinder.xml").read_text()
+    assert old in text
+    path = tmp_path / "edited.xml"
+    path.write_text(text.replace(old, new))
+    return pathfinder(path)
+
+
+def drive(world: MujocoInterface, speed: float = 3.0, seconds: float = 1.0) -> None:
+    world.write(WheelCommand(speed, speed))
+    world.advance(round(seconds / world.tick))
+
+
+def test_burger_has_the_turtlebot3_burgers_published_dimensions() -> None:
+    world = MujocoInterface("empty", robot=builtin_robot("burger"))
+    g = world.geometry
+    assert g.wheel_radius == pytest.approx(0.033)
+    assert g.wheel_separation == pytest.approx(0.160)
+    xs = [x for x, _ in g.footprint]
+    ys = [y for _, y in g.footprint]
+    assert max(xs) - min(xs) == pytest.approx(0.138, abs=0.005)
+    assert max(ys) - min(ys) == pytest.approx(0.178, abs=0.005)
+    assert g.base_height + g.laser_offset_z == pytest.approx(0.172, abs=0.002)
+    assert builtin_robot("burger").max_v == 0.22
+
+
+def test_a_mesh_wheel_gives_its_radius_and_the_joints_their_separation() -> None:
+    world = MujocoInterface("empty", robot=pathfinder())
+    g = world.geometry
+    assert g.wheel_radius == pytest.approx(0.0762, abs=1e-5)  # the mesh's 76.2 mm, scaled
+    assert g.wheel_separation == pytest.approx(0.30)
+    sources = world.geometry_sources()
+    assert "mesh geom 'left_tyre'" in sources["wheel_radius"]
+    assert "free joint added" in sources["base"]
+    assert "otonav's default" in sources["lidar"]  # the model has no sensor of its own
+
+
+def test_a_mirrored_geared_wheel_joint_still_drives_forward() -> None:
+    world = MujocoInterface("empty", robot=pathfinder())
+    drive(world)
+    truth = world.ground_truth()
+    assert truth.vx_world == pytest.approx(3.0 * 0.0762, rel=0.05)  # 3 rad/s x r, forward
+    assert truth.x > 0.15
+    assert abs(truth.y) < 0.01
+    assert abs(truth.yaw) < 0.01
+    wheels = world.read_wheels()
+    assert wheels.left_velocity == pytest.approx(3.0, rel=0.05)
+    assert wheels.right_velocity == pytest.approx(3.0, rel=0.05)
+    assert wheels.left_position > 0
+    assert wheels.right_position > 0
+
+
+def test_a_urdf_with_package_meshes_and_no_actuators_drives() -> None:
+    world = MujocoInterface("empty", robot=urdf())
+    sources = world.geometry_sources()
+    assert sources["left_wheel_actuator"].startswith("none in the model")
+    assert "frictionless" in sources["casters"]  # URDF spheres would drag otherwise
+    assert world.geometry.laser_offset_x == pytest.approx(0.05)
+    assert world.geometry.laser_offset_z == pytest.approx(0.12)
+    drive(world)
+    assert world.ground_truth().vx_world == pytest.approx(3.0 * 0.0762, rel=0.05)
+
+
+def test_the_added_lidar_does_not_see_the_robot_itself() -> None:
+    world = MujocoInterface("empty", robot=pathfinder())
+    ranges = world.read_scan().ranges
+    finite = ranges[np.isfinite(ranges)]
+    assert finite.size > 0  # the arena's walls
+    assert float(finite.min()) > 4.0  # nothing of the robot (its deck reaches 0.24 m)
+
+
+@pytest.mark.parametrize(
+    ("actuator", "kind"),
+    [
+        ('<motor name="left_drive" joint="left_wheel_hinge" ctrlrange="-1 1"/>', "motor"),
+        ('<position name="left_drive" joint="left_wheel_hinge" kp="20"/>', "position"),
+    ],
+)
+def test_motor_and_position_actuators_are_driven_as_velocity_loops(
+    tmp_path: Path, actuator: str, kind: str
+) -> None:
+    old = '<velocity name="left_drive" joint="left_wheel_hinge" kv="4" gear="2" forcerange="-1 1"/>'
+    world = MujocoInterface("empty", robot=variant(tmp_path, old, actuator))
+    assert world.geometry_sources()["left_wheel_actuator"].startswith(kind)
+    drive(world)
+    assert world.read_wheels().left_velocity == pytest.approx(3.0, rel=0.05)
+    assert abs(world.ground_truth().yaw) < 0.05  # both wheels at the same speed
+
+
+def test_a_models_own_rangefinder_places_the_lidar(tmp_path: Path) -> None:
+    robot = variant(
+        tmp_path,
+        '<body name="left_wheel_link"',
+        '<site name="scanner" pos="0.08 0 0.1" zaxis="1 0 0"/>\n      <body name="left_wheel_link"',
+    )
+    text = (
+        Path(robot.model)
+        .read_text()
+        .replace(
+            "</actuator>",
+            '</actuator>\n  <sensor><rangefinder name="front" site="scanner"/></sensor>',
+        )
+    )
+    Path(robot.model).write_text(text)
+    world = MujocoInterface("empty", robot=robot)  # its ray faces forward: the scan is cast
+    # from the same point in the base's axes
+    assert "rangefinder 'front'" in world.geometry_sources()["lidar"]
+    assert world.geometry.laser_offset_x == pytest.approx(0.08)
+
+
+def test_a_turned_sensor_site_is_refused(tmp_path: Path) -> None:
+    robot = variant(
+        tmp_path,
+        '<body name="left_wheel_link"',
+        '<site name="scanner" pos="0.08 0 0.1" euler="0 0 180"/>\n'
+        '      <body name="left_wheel_link"',
+    )
+    with pytest.raises(SceneError, match=r"^robot\.lidar: site 'scanner' is turned against"):
+        MujocoInterface("empty", robot=replace(robot, lidar=Mount(site="scanner")))
+
+
+def test_given_values_override_derived_ones() -> None:
+    world = MujocoInterface("empty", robot=pathfinder(wheel_radius=0.08, wheel_separation=0.31))
+    assert world.geometry.wheel_radius == 0.08
+    assert world.geometry.wheel_separation == 0.31
+    assert world.geometry_sources()["wheel_radius"] == "robot.wheel_radius (given)"
+
+
+@pytest.mark.parametrize(
+    ("robot", "message"),
+    [
+        (
+            pathfinder(left_wheel="wheel_l"),
+            r"^robot\.left_wheel: no joint 'wheel_l' in pathfinder\.xml "
+            r"\(hinge joints: left_wheel_hinge, right_wheel_hinge\)$",
+        ),
+        (
+            pathfinder(base="base_footprint"),
+            r"^robot\.base: no body 'base_footprint' in pathfinder\.xml \(bodies: "
+            r"chassis_link, left_wheel_link, right_wheel_link\)$",
+        ),
+        (
+            pathfinder(lidar=Mount(site="laser")),
+            r"^robot\.lidar: no site 'laser' in pathfinder\.xml \(sites: none named\)$",
+        ),
+        (
+            pathfinder(lidar=Mount(pos=(0.0, 0.0, 0.05))),
+            r"^robot\.lidar: the lidar's origin is inside the robot's collision geom "
+            r"'deck_collision'",
+        ),
+        (
+            pathfinder(model=PATHFINDER / "nope.xml"),
+            r"^robot\.model: 'nope\.xml' is neither a built-in robot \(otonav, burger\) nor an "
+            r"existing MJCF or URDF file$",
+        ),
+        (
+            pathfinder(lidar=Mount(pos=(0.0, 0.05, 0.2))),
+            r"^robot\.lidar: the lidar is 0\.050 m off the robot's centre line",
+        ),
+    ],
+)
+def test_bad_robot_descriptions_are_one_line_naming_the_key(
+    robot: RobotDescription, message: str
+) -> None:
+    with pytest.raises(SceneError, match=message) as caught:
+        MujocoInterface("empty", robot=robot)
+    assert "\n" not in str(caught.value)
+
+
+def test_a_wheel_without_a_collision_geom_is_refused(tmp_path: Path) -> None:
+    robot = variant(
+        tmp_path,
+        '<geom name="left_tyre" class="pf_tyre"/>',
+        '<geom name="left_tyre" class="pf_tyre" contype="0" conaffinity="0"/>',
+    )
+    with pytest.raises(SceneError, match=r"^robot\.left_wheel: joint 'left_wheel_hinge' moves "
+                       r"body 'left_wheel_link', which has no collision geom"):  # fmt: skip
+        MujocoInterface("empty", robot=robot)
+
+
+def test_a_wheel_turning_about_the_wrong_axis_is_refused(tmp_path: Path) -> None:
+    robot = variant(tmp_path, 'pos="0 0.15 0" euler="-90 0 0"', 'pos="0 0.15 0"')
+    with pytest.raises(SceneError, match=r"^robot\.left_wheel: joint 'left_wheel_hinge' turns "
+                       r"about an axis that is not the robot's left-right"):  # fmt: skip
+        MujocoInterface("empty", robot=robot)
+
+
+def test_a_urdf_whose_meshes_are_missing_names_the_model(tmp_path: Path) -> None:
+    shutil.copy(PATHFINDER / "pathfinder.urdf", tmp_path / "pathfinder.urdf")
+    robot = urdf(model=str(tmp_path / "pathfinder.urdf"))
+    with pytest.raises(SceneError, match=r"^robot\.model: pathfinder\.urdf does not compile: "
+                       r".*chassis\.stl"):  # fmt: skip
+        MujocoInterface("empty", robot=robot)
+
+
+def test_the_default_robot_attached_moves_as_the_old_included_one(tmp_path: Path) -> None:
+    """A scene that includes robot.xml (as scenes did) and the built-in scene with the
+    robot attached are the same world, step for step."""
+    assets = Path(MujocoInterface("empty").scene_file).parent
+    shutil.copy(assets / "robot.xml", tmp_path / "robot.xml")
+    text = (assets / "obstacles.xml").read_text()
+    old = '<compiler angle="radian"/>\n  <option timestep="0.002" integrator="implicitfast"/>'
+    assert old in text
+    (tmp_path / "old.xml").write_text(text.replace(old, '<include file="robot.xml"/>'))
+    old_world = MujocoInterface(tmp_path / "old.xml")
+    new_world = MujocoInterface("obstacles")
+    for world in (old_world, new_world):
+        world.write(WheelCommand(4.0, 6.0))
+        world.advance(1500)
+    assert old_world.ground_truth() == new_world.ground_truth()
+    assert old_world.read_wheels() == new_world.read_wheels()
+    assert np.array_equal(old_world.read_scan().ranges, new_world.read_scan().ranges)
+    assert math.isfinite(new_world.ground_truth().x)
