@@ -4,6 +4,8 @@ against the config file it was written in."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from otonav.hal.description import BUILTIN_ROBOTS, Mount, RobotDescription, builtin_robot
 from otonav.stack.config import BaseConfig, MountConfig, RobotConfig, StackConfig
 from otonav.stack.files import ConfigFileError
@@ -23,6 +25,11 @@ def describe_robot(config: RobotConfig) -> RobotDescription:
     if config.model in BUILTIN_ROBOTS:
         base = builtin_robot(config.model)
     else:
+        if not Path(config.model).is_file():
+            raise ConfigFileError(
+                f"robot.model: {config.model!r} is neither a built-in robot "
+                f"({', '.join(BUILTIN_ROBOTS)}) nor an existing MJCF or URDF file"
+            )
         missing = [k for k in ("base", "left_wheel", "right_wheel") if getattr(config, k) is None]
         if missing:
             raise ConfigFileError(

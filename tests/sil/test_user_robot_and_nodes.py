@@ -24,7 +24,7 @@ from otonav.testing import running_stack
 pytestmark = pytest.mark.sil
 
 ROOT = Path(__file__).resolve().parents[2]
-PATHFINDER = ROOT / "tests" / "data" / "robots" / "pathfinder"
+PATHFINDER = ROOT / "examples" / "my_robot"
 MY_NODES = ROOT / "examples" / "my_nodes"
 COURSES = ("empty", "box", "slalom", "gap", "u_trap", "corridor", "cluttered")
 
@@ -153,3 +153,29 @@ def test_an_external_planner_nobody_feeds_is_named_within_a_second(
     assert "/cmd_vel_nav" in text
     assert "nav.planner is 'external'" in text
     assert any("no message on /cmd_vel_nav" in r.getMessage() for r in caplog.records)
+
+
+@pytest.mark.parametrize(
+    ("args", "line"),
+    [
+        (["--set", "robot.model=nope.xml"], "robot.model: 'nope.xml' is neither a built-in robot"),
+        (
+            ["--config", str(PATHFINDER / "stack.yaml"), "--set", "robot.left_wheel=wheel_l"],
+            "robot.left_wheel: no joint 'wheel_l' in ",
+        ),
+        (
+            ["--config", str(MY_NODES / "stack.yaml"), "--set", "actors.planner.max_v=-1"],
+            "actors.planner.max_v: Input should be greater than 0 (got -1)",
+        ),
+        (["--actor", "no_such_pkg_q:Node"], "actors.node.class: cannot import 'no_such_pkg_q'"),
+    ],
+)
+def test_bad_robot_or_node_input_is_one_line_and_exit_2(
+    args: list[str], line: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "keep.txt").write_text("recorded before")
+    assert main(["run", "--out", str(tmp_path), *args]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"otonav: error: {line}")
+    assert "\n" not in err
+    assert (tmp_path / "keep.txt").read_text() == "recorded before"

@@ -16,8 +16,7 @@ from otonav.hal import WheelCommand
 from otonav.hal.description import Mount, RobotDescription, builtin_robot
 from otonav.hal.mujoco import MujocoInterface, SceneError
 
-ROBOTS = Path(__file__).resolve().parents[1] / "data" / "robots"
-PATHFINDER = ROBOTS / "pathfinder"
+PATHFINDER = Path(__file__).resolve().parents[2] / "examples" / "my_robot"
 
 
 def pathfinder(model: Path = PATHFINDER / "pathfinder.xml", **changes: object) -> RobotDescription:
@@ -260,3 +259,14 @@ def test_the_default_robot_attached_moves_as_the_old_included_one(tmp_path: Path
     assert old_world.read_wheels() == new_world.read_wheels()
     assert np.array_equal(old_world.read_scan().ranges, new_world.read_scan().ranges)
     assert math.isfinite(new_world.ground_truth().x)
+
+
+def test_a_wheel_with_two_actuators_is_refused(tmp_path: Path) -> None:
+    robot = variant(
+        tmp_path,
+        "</actuator>",
+        '  <motor name="extra" joint="left_wheel_hinge"/>\n  </actuator>',
+    )
+    with pytest.raises(SceneError, match=r"^robot\.left_wheel: joint 'left_wheel_hinge' has 2 "
+                       r"actuators \(left_drive, extra\); give it one$"):  # fmt: skip
+        MujocoInterface("empty", robot=robot)

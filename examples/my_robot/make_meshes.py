@@ -8,7 +8,7 @@ import math
 import struct
 from pathlib import Path
 
-HERE = Path(__file__).parent / "pathfinder" / "meshes"
+HERE = Path(__file__).parent / "meshes"
 
 
 Verts = list[tuple[float, float, float]]
