@@ -34,10 +34,16 @@ __all__ = ("RecordedRobot", "recorded_geometry")
 
 def recorded_geometry(recording: Recording, stack: StackConfig) -> RobotGeometry | None:
     """The robot geometry ``recording`` was made with, when it holds one and ``stack``
-    (the replay's config, after ``--set``) has the recorded world and hardware: changing
-    ``world.*`` or ``hal.*`` asks for another robot, which is then built (None)."""
+    (the replay's config, after ``--set``) has the recorded world, hardware and robot:
+    changing ``world.*``, ``hal.*`` or ``robot.*`` asks for another robot, which is then
+    built (None)."""
     recorded = recording.stack
-    if recorded is None or stack.world != recorded.world or stack.hal != recorded.hal:
+    if (
+        recorded is None
+        or stack.world != recorded.world
+        or stack.hal != recorded.hal
+        or stack.robot != recorded.robot
+    ):
         return None
     return geometry_from_metadata(recording.metadata.get(WORLD_METADATA, {}))
 
