@@ -27,6 +27,7 @@ USAGE_ERRORS: tuple[tuple[str, str], ...] = (
     ("otonav.record.reader", "RecordingError"),
     ("otonav.hal.mujoco", "SceneError"),
     ("otonav.hal.viewer", "NoDisplayError"),
+    ("otonav.record.outlock", "OutputBusyError"),
 )
 """(module, class) of the errors that mean bad input: one line, exit 2. Named, not
 imported: an exception can only be an instance of a class whose module is loaded."""

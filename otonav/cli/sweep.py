@@ -245,6 +245,13 @@ def print_summary(summary: dict[str, Any], console: Console) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    from otonav.record.outlock import lock_output
+
+    with contextlib.ExitStack() as held:
+        return _main(args, held, lock_output)
+
+
+def _main(args: argparse.Namespace, held: contextlib.ExitStack, lock_output: Any) -> int:
     from rich.console import Console
 
     from otonav.stack.files import ConfigFileError
@@ -264,6 +271,7 @@ def main(args: argparse.Namespace) -> int:
     else:
         spec = quick_spec(args)
         tasks = plan_runs(spec, where="otonav sweep")
+    held.enter_context(lock_output(args.out))  # one sweep per --out (issue 27)
     backend = runner.make_backend(args.backend, workers=args.workers, ray_address=args.ray_address)
     prepared = runner.prepare(
         args.out,
