@@ -99,6 +99,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     ):
         args_list = ["run", *args_list]  # no command = run the default scenario
     args = build_parser().parse_args(args_list)
+    from otonav.cli import logs
+
+    logs.install()
     try:
         code: int = args.handler(args)
         return code
