@@ -22,6 +22,17 @@ if TYPE_CHECKING:  # the command's imports are in main(): --help stays fast
     from otonav.sweep.spec import Scalar, SweepSpec
 
 DEFAULT_OUT = Path("out/sweep")
+QUICK_FLAGS = {
+    "--generate": "generate",
+    "--density": "density",
+    "--gen": "gen",
+    "--scenario": "scenario",
+    "--seeds": "seeds",
+    "--set": "overrides",
+    "--keep": "keep",
+}
+"""The quick form's flags (and their dests): with a sweep file they are refused, not
+ignored."""
 
 
 def add_parser(commands: Any) -> None:
@@ -58,7 +69,9 @@ def add_parser(commands: Any) -> None:
         metavar="KEY=V1,V2",
         help="a stack override, or a grid of values (repeatable)",
     )
-    quick.add_argument("--keep", choices=("failures", "all", "none"), default="failures")
+    quick.add_argument(
+        "--keep", choices=("failures", "all", "none"), help="artifacts to keep (default failures)"
+    )
     p.set_defaults(handler=main)
 
 
@@ -119,7 +132,7 @@ def quick_spec(args: argparse.Namespace) -> SweepSpec:
         scenarios=tuple(scenarios),
         overrides=grid,
         seeds=SeedRange(count=args.seeds) if args.seeds else None,
-        keep=args.keep,
+        keep=args.keep or "failures",
     )
 
 
@@ -266,6 +279,12 @@ def _main(args: argparse.Namespace, held: contextlib.ExitStack, lock_output: Any
     if args.retry_errors and not args.resume:
         raise ConfigFileError("--retry-errors: only with --resume")
     if args.sweep is not None:
+        quick = [f for f, dest in QUICK_FLAGS.items() if getattr(args, dest) not in (None, [])]
+        if quick:  # they were silently ignored (issue 27)
+            raise ConfigFileError(
+                f"{' '.join(quick)}: quick-form flags, not used with a sweep file "
+                f"({args.sweep}); put them in the file, or drop the file"
+            )
         spec = load_sweep(args.sweep)
         tasks = plan_runs(spec, base=args.sweep.parent, where=str(args.sweep))
     else:
