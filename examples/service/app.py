@@ -480,12 +480,12 @@ class Service:
                 seconds = float(wait)
             except ValueError:
                 seconds = math.nan
-            if not math.isfinite(seconds):
+            if not (math.isfinite(seconds) and seconds >= 0):  # -5 was taken as 0
                 raise BadRequest(
-                    f"wait={_short(wait)}: expected a number of seconds, e.g. wait=10 "
+                    f"wait={_short(wait)}: expected a number of seconds >= 0, e.g. wait=10 "
                     f"(at most {MAX_WAIT_S:g} are waited)"
                 )
-            with anyio.move_on_after(min(max(seconds, 0.0), MAX_WAIT_S)):
+            with anyio.move_on_after(min(seconds, MAX_WAIT_S)):
                 await _either(run.done, self.closing)
         return _json(run.as_dict())
 

@@ -27,6 +27,7 @@ USAGE_ERRORS: tuple[tuple[str, str], ...] = (
     ("otonav.record.reader", "RecordingError"),
     ("otonav.hal.mujoco", "SceneError"),
     ("otonav.hal.viewer", "NoDisplayError"),
+    ("otonav.record.outlock", "OutputBusyError"),
 )
 """(module, class) of the errors that mean bad input: one line, exit 2. Named, not
 imported: an exception can only be an instance of a class whose module is loaded."""
@@ -98,6 +99,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     ):
         args_list = ["run", *args_list]  # no command = run the default scenario
     args = build_parser().parse_args(args_list)
+    from otonav.cli import logs
+
+    logs.install()
     try:
         code: int = args.handler(args)
         return code

@@ -27,6 +27,7 @@ def add_parser(commands: Any) -> None:
 
 def main(args: argparse.Namespace) -> int:
     from otonav.bench.report import format_report, run_bench, write_json
+    from otonav.stack.files import ConfigFileError
 
     if args.long is not None:
         from otonav.bench.memory import format_long, run_long
@@ -43,6 +44,11 @@ def main(args: argparse.Namespace) -> int:
         print(f"figures: {args.json}")
         return 0
     duration, reps, scaling = args.duration, args.reps, not args.no_scaling
+    # -1 ran, printed a -53x RTF and overwrote out/bench.json with it (issue 27).
+    if not 0 < duration <= 86_400:
+        raise ConfigFileError(f"--duration {duration:g}: must be in (0, 86400] s of sim time")
+    if not 1 <= reps <= 1000:
+        raise ConfigFileError(f"--reps {reps}: must be in [1, 1000]")
     if args.quick:
         duration, reps, scaling = 2.0, 1, False
     result = run_bench(duration, reps, scaling=scaling, profile=not args.quick)

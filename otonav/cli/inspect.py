@@ -17,7 +17,11 @@ def add_parser(commands: Any) -> None:
     s.set_defaults(handler=scenarios_main)
     p = commands.add_parser("plot", help="draw the path recorded in an MCAP file as a PNG")
     p.add_argument("file", type=Path)
-    p.add_argument("--out", type=Path, help="PNG path (default: next to the file)")
+    p.add_argument(
+        "--out",
+        type=Path,
+        help="PNG path, or a directory to write FILE.png in (default: next to the file)",
+    )
     p.set_defaults(handler=plot_main)
 
 
@@ -100,10 +104,27 @@ def plot_main(args: argparse.Namespace) -> int:
     from otonav.record.reader import summarize
     from otonav.scenario.replay import plot_recording
 
+    out = plot_target(args.file, args.out)
     summary = summarize(args.file)
     if summary.truncated:
         warn_cut_off(summary, "drawing")
     damaged = warn_damaged(summary, "drawing")
-    png = plot_recording(args.file, args.out)
+    png = plot_recording(args.file, out)
     print(f"plot: {png}")
     return 1 if damaged else 0  # the plot is not all that was recorded
+
+
+def plot_target(recording: Path, out: Path | None) -> Path | None:
+    """Where ``plot --out`` writes: a directory gets ``<recording stem>.png`` inside it
+    (``--out /tmp`` wrote ``/tmp.png``, issue 27); a file must be a ``.png``."""
+    from otonav.stack.files import ConfigFileError
+
+    if out is None:
+        return None
+    if out.is_dir() or str(out).endswith(("/", "\\")):
+        return out / f"{recording.stem}.png"
+    if out.suffix.lower() != ".png":
+        raise ConfigFileError(
+            f"--out {out}: a plot is a PNG: give a path ending in .png, or a directory"
+        )
+    return out

@@ -5,6 +5,7 @@ compare their outputs with it. Exit 0: no divergence beyond the tolerance; 1: di
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import sys
 from pathlib import Path
@@ -66,10 +67,7 @@ def add_parser(commands: Any) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from rich.console import Console
-
-    from otonav.replay import ReplayInputError, replay_recording
-    from otonav.replay.output import write_replay
+    from otonav.record.outlock import lock_output
     from otonav.stack.files import ConfigFileError
 
     nodes = [name.strip() for spec in args.nodes for name in spec.split(",") if name.strip()]
@@ -77,6 +75,19 @@ def main(args: argparse.Namespace) -> int:
         raise ConfigFileError("--node: name a node to replay, e.g. --node nav")
     if not (math.isfinite(args.tolerance) and args.tolerance >= 0):
         raise ConfigFileError(f"--tolerance {args.tolerance}: must be a finite number >= 0")
+    with contextlib.ExitStack() as held:
+        if args.out is not None:  # one writer per file (issue 27)
+            held.enter_context(lock_output(args.out, is_file=True))
+        return _replay(args, nodes)
+
+
+def _replay(args: argparse.Namespace, nodes: list[str]) -> int:
+    from rich.console import Console
+
+    from otonav.replay import ReplayInputError, replay_recording
+    from otonav.replay.output import write_replay
+    from otonav.stack.files import ConfigFileError
+
     try:
         result = replay_recording(
             args.recording,

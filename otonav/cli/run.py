@@ -7,6 +7,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # the command's imports are in main(): --help stays fast
+    from contextlib import ExitStack
+
     from rich.console import Console
 
     from otonav.cli.signals import StopOnSignals
@@ -154,13 +156,15 @@ def print_verdict(verdict: Verdict, console: Console) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    import contextlib
+
     from otonav.cli.signals import StopOnSignals
 
-    with StopOnSignals() as guard:
-        return _main(args, guard)
+    with StopOnSignals() as guard, contextlib.ExitStack() as locks:
+        return _main(args, guard, locks)
 
 
-def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
+def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> int:
     import asyncio
     import json
     import sys
@@ -171,6 +175,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
     from otonav.cli.loading import load_scenario, load_stack
     from otonav.cli.progress import ProgressLine
     from otonav.limits import check_scale
+    from otonav.record.outlock import lock_output
     from otonav.runtime import WallClockCeilingError
     from otonav.scenario import ScenarioConfig, run_scenario
     from otonav.scenario.builtin import BUILTIN
@@ -196,6 +201,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals) -> int:
             raise ConfigFileError(describe_validation_error("--seed", exc)) from None
     stack = load_stack(args.config, args.overrides, args.actors)
     out: Path = args.out
+    locks.enter_context(lock_output(out))  # one run per --out: a second one is refused
     source = args.scenario if args.scenario not in BUILTIN else f"scenario '{args.scenario}'"
     progress = ProgressLine() if sys.stderr.isatty() else None
     stale = [out / "summary.json"] + ([out / "recording.mcap"] if args.no_record else [])

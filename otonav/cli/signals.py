@@ -11,7 +11,9 @@ unindexed recording, no plot (issue 17). Here, while :class:`StopOnSignals` is a
 - once armed: the first signal cancels the run's task (on its loop, thread-safely), so
   every ``finally`` of the run executes, in order; if the task has not started yet it
   is cancelled as it starts; if it has already finished, the shutdown simply goes on;
-- every further signal prints one note and is ignored (SIGKILL still kills).
+- every further signal prints one note and is ignored (SIGKILL still kills);
+- an actor that computes without yielding never lets the cancellation run: the loop's
+  watchdog thread interrupts it after the loop's ``hold_grace`` (issue 27).
 
 asyncio.Runner and ``run_task`` install their own handlers only over the defaults, so
 they leave these in place.
@@ -75,6 +77,11 @@ class StopOnSignals:
                 loop, task = self._target
                 if not task.done() and not loop.is_closed():
                     loop.call_soon_threadsafe(task.cancel)
+                    # An actor computing without yielding never lets that callback run:
+                    # the loop's watchdog interrupts it (issue 27).
+                    expect_progress = getattr(loop, "expect_progress", None)
+                    if expect_progress is not None:
+                        expect_progress(sig.name)
             return
         if not self._noted:
             self._noted = True
@@ -89,8 +96,11 @@ class StopOnSignals:
         """One line on how the run ended, and its exit code (130 or 143)."""
         sig = self.received or signal.SIGINT
         what = "interrupted" if sig is signal.SIGINT else "terminated"
+        held = getattr(self._target[0], "held_by", None) if self._target else None
+        stopped = f" ({held} held the loop and was interrupted)" if held else ""
         print(
-            f"otonav: {what}; the recording and the plot were finished; no summary written",
+            f"otonav: {what}{stopped}; the recording and the plot were finished; "
+            "no summary written",
             file=sys.stderr,
         )
         return EXIT_CODES[sig]

@@ -22,6 +22,17 @@ if TYPE_CHECKING:  # the command's imports are in main(): --help stays fast
     from otonav.sweep.spec import Scalar, SweepSpec
 
 DEFAULT_OUT = Path("out/sweep")
+QUICK_FLAGS = {
+    "--generate": "generate",
+    "--density": "density",
+    "--gen": "gen",
+    "--scenario": "scenario",
+    "--seeds": "seeds",
+    "--set": "overrides",
+    "--keep": "keep",
+}
+"""The quick form's flags (and their dests): with a sweep file they are refused, not
+ignored."""
 
 
 def add_parser(commands: Any) -> None:
@@ -67,7 +78,9 @@ def add_parser(commands: Any) -> None:
         metavar="KEY=V1,V2",
         help="a stack override, or a grid of values (repeatable)",
     )
-    quick.add_argument("--keep", choices=("failures", "all", "none"), default="failures")
+    quick.add_argument(
+        "--keep", choices=("failures", "all", "none"), help="artifacts to keep (default failures)"
+    )
     p.set_defaults(handler=main)
 
 
@@ -128,7 +141,7 @@ def quick_spec(args: argparse.Namespace) -> SweepSpec:
         scenarios=tuple(scenarios),
         overrides=grid,
         seeds=SeedRange(count=args.seeds) if args.seeds else None,
-        keep=args.keep,
+        keep=args.keep or "failures",
     )
 
 
@@ -254,6 +267,13 @@ def print_summary(summary: dict[str, Any], console: Console) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    from otonav.record.outlock import lock_output
+
+    with contextlib.ExitStack() as held:
+        return _main(args, held, lock_output)
+
+
+def _main(args: argparse.Namespace, held: contextlib.ExitStack, lock_output: Any) -> int:
     from rich.console import Console
 
     from otonav.stack.files import ConfigFileError
@@ -268,11 +288,18 @@ def main(args: argparse.Namespace) -> int:
     if args.retry_errors and not args.resume:
         raise ConfigFileError("--retry-errors: only with --resume")
     if args.sweep is not None:
+        quick = [f for f, dest in QUICK_FLAGS.items() if getattr(args, dest) not in (None, [])]
+        if quick:  # they were silently ignored (issue 27)
+            raise ConfigFileError(
+                f"{' '.join(quick)}: quick-form flags, not used with a sweep file "
+                f"({args.sweep}); put them in the file, or drop the file"
+            )
         spec = load_sweep(args.sweep)
         tasks = plan_runs(spec, base=args.sweep.parent, where=str(args.sweep), actors=args.actors)
     else:
         spec = quick_spec(args)
         tasks = plan_runs(spec, where="otonav sweep", actors=args.actors)
+    held.enter_context(lock_output(args.out))  # one sweep per --out (issue 27)
     backend = runner.make_backend(args.backend, workers=args.workers, ray_address=args.ray_address)
     prepared = runner.prepare(
         args.out,

@@ -1,6 +1,7 @@
 """The actor runtime: generic, no robot, no MuJoCo.
 
-- ``loop``: the virtual-time asyncio loop (sim time is loop time) and ``run_blocking``.
+- ``loop``: the virtual-time asyncio loop (sim time is loop time) and ``run_blocking``;
+  ``watchdog``: its wall-clock ceiling and stop requests, enforced from a thread.
 - ``timesource``: what advances time (a physics world, or ``JumpSource``).
 - ``clock``: sim time for actors in virtual or real-time mode; ``Rate``.
 - ``qos`` / ``mailbox``: QoS with ROS 2 matching, typed topics, publishers, mailboxes.
@@ -14,6 +15,7 @@ from otonav.runtime.clock import Clock, Rate, RealTimeClock, VirtualClock, curre
 from otonav.runtime.errors import (
     ActorCrashedError,
     DeadlockError,
+    LoopHeldError,
     OtonavRuntimeError,
     QoSIncompatibleError,
     SimTimeoutError,
@@ -50,6 +52,7 @@ __all__ = (
     "Graph",
     "Input",
     "JumpSource",
+    "LoopHeldError",
     "MailboxStatistics",
     "OtonavRuntimeError",
     "Output",

@@ -70,3 +70,9 @@ class DeadlockError(OtonavRuntimeError):
 
 class WallClockCeilingError(OtonavRuntimeError):
     """A run exceeded its wall-clock ceiling (a hang or livelock, not a slow sim)."""
+
+
+class LoopHeldError(OtonavRuntimeError):
+    """Raised inside a callback that held the virtual-time loop (computed without
+    yielding) past the wall-clock ceiling or a stop request; the watchdog raises it
+    from outside the loop (``otonav.runtime.watchdog``)."""

@@ -21,6 +21,7 @@ selector call for each (ADR 0027). Debug mode runs asyncio's own iteration.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import contextvars
 import heapq
 import math
@@ -33,6 +34,7 @@ from typing import Any, TypeVar, TypeVarTuple
 
 from otonav.runtime.errors import DeadlockError, TimeSourceError, WallClockCeilingError
 from otonav.runtime.timesource import FrozenSource, JumpSource, TimeSource, tick_rate
+from otonav.runtime.watchdog import LoopWatchdog
 
 _T = TypeVar("_T")
 _Ts = TypeVarTuple("_Ts")
@@ -121,6 +123,9 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
     :class:`WallClockCeilingError` (``None``: no ceiling). ``deadlock_grace``: wall seconds
     the loop waits for outside I/O when nothing else can wake it before raising
     :class:`DeadlockError` (``None``: wait forever, e.g. when a host thread drives it).
+    ``hold_grace``: wall seconds a callback may hold the loop without yielding, once the
+    ceiling has passed or a stop was asked for (:meth:`expect_progress`), before a
+    watchdog thread interrupts it (``otonav.runtime.watchdog``).
     """
 
     def __init__(
@@ -129,6 +134,7 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         *,
         wall_ceiling: float | None = None,
         deadlock_grace: float | None = 0.5,
+        hold_grace: float = 2.0,
     ) -> None:
         selector = _VirtualSelector(selectors.DefaultSelector())
         super().__init__(selector)  # type: ignore[arg-type]
@@ -151,6 +157,12 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         self._failure: BaseException | None = None
         self._fail_stop_at = 0.0
         self.wakes = 0  # time jumps taken, for benchmarks and introspection
+        self.beats = 0  # loop passes run: the watchdog's sign of progress
+        self.waiting = False  # in the selector (time jumps, I/O waits): not held
+        self._hold_grace = hold_grace
+        self._watchdog: LoopWatchdog | None = None
+        self.held_by: str | None = None
+        """What held the loop when the watchdog last had to interrupt it."""
         self._poll = False
         self._update_poll()
         # asyncio's thresholds for dropping all cancelled timers at once.
@@ -359,7 +371,9 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         asyncio's iterations give. The selector is asked only when waiting (time jumps
         there) or when something can be polled."""
         this: Any = self  # asyncio's private attributes, untyped
+        self.beats += 1
         if this._debug:
+            self.waiting = True  # a debug loop: the watchdog only catches a held selector
             super()._run_once()  # type: ignore[misc]
             return
         ready = this._ready
@@ -371,9 +385,13 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
                 this._process_events(inner.select(0))
         else:
             timeout = max(0.0, scheduled[0]._when - self.time()) if scheduled else None
-            this._process_events(self._idle_select(inner, timeout))
+            self.waiting = True
+            events = self._idle_select(inner, timeout)
+            self.waiting = False
+            this._process_events(events)
         passes = 0
         while True:
+            self.beats += 1
             # Due timers join the ready queue, then the callbacks ready now run (not the
             # ones they make ready: those are the next pass, as in asyncio).
             end_time = self.time() + self._clock_resolution
@@ -428,6 +446,18 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
                 )
             )
 
+    def fail_threadsafe(self, error: BaseException) -> None:
+        """From any thread: fail the run with ``error`` (as the ceiling does)."""
+        with contextlib.suppress(RuntimeError):  # the loop has closed: the run is over
+            self.call_soon_threadsafe(self._fail, error)
+
+    def expect_progress(self, why: str) -> None:
+        """From any thread or a signal handler: a stop was asked for (``why`` names it,
+        e.g. "SIGTERM"). If a callback then holds the loop for ``hold_grace`` wall
+        seconds, the watchdog interrupts it (the cancellation itself is the caller's)."""
+        if self._watchdog is not None:
+            self._watchdog.expect_progress(why)
+
     def _fail(self, error: BaseException) -> None:
         """Cancel the run with ``error``; if it has not ended 2 wall seconds later (its
         cleanup hangs too), stop the loop."""
@@ -447,6 +477,8 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         owner: asyncio.Future[_T] = asyncio.ensure_future(future, loop=self)  # type: ignore[arg-type]
         self._owner = owner
         self._wall_start = time.monotonic()
+        watchdog = self._watchdog = LoopWatchdog(self, self._wall_ceiling, self._hold_grace)
+        watchdog.start()
         try:
             result = super().run_until_complete(owner)
         except BaseException as exc:
@@ -458,6 +490,7 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
                 raise failure  # noqa: B904
             raise failure from (None if isinstance(exc, asyncio.CancelledError) else exc)
         finally:
+            watchdog.stop()
             self._owner = None
             failure, self._failure = self._failure, None
         if failure is not None:  # the run swallowed its cancellation and returned

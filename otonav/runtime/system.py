@@ -17,7 +17,7 @@ import contextlib
 import contextvars
 import logging
 import traceback
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Coroutine, Mapping, Sequence
 from dataclasses import dataclass, field
 from types import TracebackType
 from typing import Any
@@ -226,7 +226,7 @@ class System:
                     started = True
                     state.status = "running"
                     self._event(actor.name, "started")
-                    await actor.run()
+                    await _unrequested_cancel_is_a_crash(actor.run())
                     state.status = "finished"
                     self._event(actor.name, "finished")
                     return
@@ -376,6 +376,27 @@ class System:
         """Run until every actor's ``run`` returned, :meth:`stop` is called, or a crash."""
         async with self:
             await self.wait_finished()
+
+
+class UnrequestedCancelError(RuntimeError):
+    """An actor raised ``CancelledError`` although nothing cancelled it: a crash (it
+    used to end the run silently, logged as "stopped"; issue 27)."""
+
+
+async def _unrequested_cancel_is_a_crash(body: Coroutine[Any, Any, None]) -> None:
+    """Await ``body``; a ``CancelledError`` the task was not asked for (no ``cancel()``
+    pending: ``cancelling() == 0``, which anyio's scopes and asyncio both set) becomes
+    :class:`UnrequestedCancelError`, handled like any crash."""
+    try:
+        await body
+    except asyncio.CancelledError as exc:
+        task = asyncio.current_task()
+        if task is None or task.cancelling():
+            raise
+        raise UnrequestedCancelError(
+            f"run() raised CancelledError ({exc or 'no message'}) but nothing cancelled "
+            "it; an actor that wants to end returns from run()"
+        ) from exc
 
 
 def _reset_clock(token: contextvars.Token[Clock] | None) -> None:

@@ -21,6 +21,7 @@ from otonav import limits
 from otonav.actors import topics
 from otonav.hal import RobotHardwareInterface
 from otonav.msgs import Header, Point, Pose, PoseStamped, ScenarioVerdict, Time
+from otonav.record.outlock import lock_output
 from otonav.record.writer import RecordingWriter
 from otonav.runtime import (
     LATCHED_QOS,
@@ -290,50 +291,54 @@ def run_scenario(
     sim_time)`` is called after every judge sample (the CLI's progress line). ``on_start(loop,
     task)`` is called on the run's loop as it starts: a host running this in a worker
     thread cancels the run with ``loop.call_soon_threadsafe(task.cancel)``. A goal
-    outside the arena or on an obstacle raises ``ConfigFileError`` naming ``source``."""
-    scenario, stack, hal = scenario_world(scenario, stack, source=source)
-    judge = Judge(
-        hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance, progress=progress
-    )
-    session = scenario_session(
-        scenario,
-        stack,
-        hal,
-        judge,
-        extra_actors=tuple(extra_actors),
-        recording=out_dir / "recording.mcap" if out_dir and record else None,
-    )
-    for module in LAZY_IMPORTS:
-        importlib.import_module(module)
-    wall_start = time.perf_counter()
-    sim_time = 0.0
-    ended = "completed"
-    try:
-        # The session makes the world the loop's time source when the run starts.
-        factory = virtual_loop_factory(wall_ceiling=wall_ceiling)
-        with asyncio.Runner(loop_factory=factory) as runner:
-            try:
-                runner.run(_main(scenario, session, judge, on_start))
-            finally:
-                sim_time = runner.get_loop().time()
-    except BaseException as exc:
-        ended = f"{type(exc).__name__} at sim time {sim_time:.3f} s: {exc}".strip().rstrip(":")
-        raise
-    finally:
+    outside the arena or on an obstacle raises ``ConfigFileError`` naming ``source``.
+    Another run writing to ``out_dir`` raises :class:`~otonav.record.outlock.OutputBusyError`
+    before anything is touched."""
+    with lock_output(out_dir) if out_dir is not None else contextlib.nullcontext():
+        # one run per out_dir (issue 27): a second is refused before it touches a file
+        scenario, stack, hal = scenario_world(scenario, stack, source=source)
+        judge = Judge(
+            hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance, progress=progress
+        )
+        session = scenario_session(
+            scenario,
+            stack,
+            hal,
+            judge,
+            extra_actors=tuple(extra_actors),
+            recording=out_dir / "recording.mcap" if out_dir and record else None,
+        )
+        for module in LAZY_IMPORTS:
+            importlib.import_module(module)
+        wall_start = time.perf_counter()
+        sim_time = 0.0
+        ended = "completed"
         try:
-            verdict = judge_verdict(
-                scenario,
-                judge,
-                sim_time,
-                time.perf_counter() - wall_start,
-                robot=robot_summary(stack, hal),
-            )
-            if ended != "completed":
-                verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
-            verdict = save_artifacts(verdict, scenario, stack, judge, session, out_dir, plot)
+            # The session makes the world the loop's time source when the run starts.
+            factory = virtual_loop_factory(wall_ceiling=wall_ceiling)
+            with asyncio.Runner(loop_factory=factory) as runner:
+                try:
+                    runner.run(_main(scenario, session, judge, on_start))
+                finally:
+                    sim_time = runner.get_loop().time()
+        except BaseException as exc:
+            ended = f"{type(exc).__name__} at sim time {sim_time:.3f} s: {exc}".strip().rstrip(":")
+            raise
         finally:
-            session.close()  # idempotent: reached even if the verdict or plot failed
-    return verdict
+            try:
+                verdict = judge_verdict(
+                    scenario,
+                    judge,
+                    sim_time,
+                    time.perf_counter() - wall_start,
+                    robot=robot_summary(stack, hal),
+                )
+                if ended != "completed":
+                    verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
+                verdict = save_artifacts(verdict, scenario, stack, judge, session, out_dir, plot)
+            finally:
+                session.close()  # idempotent: reached even if the verdict or plot failed
+        return verdict
 
 
 def save_artifacts(

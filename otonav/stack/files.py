@@ -95,8 +95,11 @@ def load_model(path: Path, model: type[_M]) -> _M:
     except OSError as exc:
         raise ConfigFileError(f"{path}: cannot read ({exc.strerror})") from None
     data = parse_yaml(raw, str(path))
-    if data is None:
-        data = {}
+    if data is None or data == {}:  # it silently ran the defaults (issue 27)
+        raise ConfigFileError(
+            f"{path}: empty (no keys); give at least one key (the README lists them), "
+            "or leave the file out to use the defaults"
+        )
     if not isinstance(data, dict):
         raise ConfigFileError(
             f"{path}: expected a mapping of keys at the top level, got {type(data).__name__}"

@@ -24,7 +24,7 @@ import re
 from typing import Any
 
 import yaml
-from yaml.nodes import MappingNode, Node, SequenceNode
+from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 MAX_BYTES = 1 << 20
 """1 MiB: the shipped configs are under 2 kB; a scenario with the most obstacles allowed
@@ -64,6 +64,21 @@ class _BoundedLoader(yaml.SafeLoader):
             return super().compose_node(parent, index)
         finally:
             self._otonav_depth -= 1
+
+    def construct_mapping(self, node: MappingNode, deep: bool = False) -> dict[Any, Any]:
+        """A key given twice is an error (YAML says keys are unique; PyYAML let the last
+        one win silently, issue 27). Merge keys (``<<``) may still be overridden."""
+        first: dict[str, Node] = {}
+        for key_node, _value in node.value:
+            if not isinstance(key_node, ScalarNode) or key_node.tag == "tag:yaml.org,2002:merge":
+                continue
+            seen = first.setdefault(key_node.value, key_node)
+            if seen is not key_node:
+                raise YamlLimitError(
+                    f"the key {key_node.value!r} is given twice (line {seen.start_mark.line + 1} "
+                    f"and line {key_node.start_mark.line + 1}); keep one"
+                )
+        return super().construct_mapping(node, deep=deep)
 
 
 _BoundedLoader.add_implicit_resolver(

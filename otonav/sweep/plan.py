@@ -9,12 +9,14 @@ import glob
 import hashlib
 import itertools
 import json
+import math
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 from pydantic import ValidationError
 
+from otonav import limits
 from otonav.scenario import ScenarioConfig
 from otonav.scenario.builtin import BUILTIN
 from otonav.stack import StackConfig
@@ -22,7 +24,7 @@ from otonav.stack.files import ConfigFileError, describe_validation_error, load_
 from otonav.stack.launch import add_actors, check_actors
 from otonav.stack.loading import load_stack_file
 from otonav.stack.overrides import apply_overrides
-from otonav.sweep.spec import GenerateSource, Keep, Scalar, SweepSpec
+from otonav.sweep.spec import GenerateSource, Keep, Scalar, SeedRange, SweepSpec
 from otonav.sweep.worlds import world_name, world_params_json
 
 Override = tuple[str, Scalar]
@@ -177,9 +179,44 @@ def plan_runs(
     actors: Sequence[str] = (),
 ) -> list[RunTask]:
     """Every run of ``spec``, in order, each once. ``base``: where relative paths in the
-    spec start (the sweep file's directory); ``where`` names the file in errors.
-    ``actors``: ``module:Class`` nodes launched in every run (``--actor``)."""
+    spec start (the sweep file's directory); ``where`` names the file in errors. A plan
+    of more than :data:`~otonav.limits.MAX_SWEEP_RUNS` runs is refused (counted before
+    it is expanded). ``actors``: ``module:Class`` nodes launched in every run
+    (``--actor``)."""
+    check_plan_size(spec, base, where)
     return list(_iter_runs(spec, base, where, actors))
+
+
+def check_plan_size(spec: SweepSpec, base: Path, where: str) -> int:
+    """The plan's size before expansion, an upper bound (duplicates are dropped later):
+    raise ``ConfigFileError`` when it is over :data:`~otonav.limits.MAX_SWEEP_RUNS`."""
+    scenarios = 0
+    for entry in spec.scenarios:
+        if isinstance(entry, GenerateSource):
+            scenarios += entry.generate.count
+        elif entry not in BUILTIN and any(c in entry for c in "*?["):
+            scenarios += max(1, len(glob.glob(str(base / entry), recursive=True)))
+        else:
+            scenarios += 1
+    if isinstance(spec.overrides, dict):
+        combos = math.prod(len(values) for values in spec.overrides.values())
+    else:
+        combos = max(1, len(spec.overrides))
+    if spec.seeds is None:
+        seeds = 1
+    elif isinstance(spec.seeds, SeedRange):
+        seeds = spec.seeds.count
+    else:
+        seeds = len(spec.seeds)
+    total = scenarios * combos * seeds
+    if total > limits.MAX_SWEEP_RUNS:
+        raise ConfigFileError(
+            f"{where}: the plan has {total:,} runs (scenarios x override combinations x "
+            f"seeds = {scenarios:,} x {combos:,} x {seeds:,}), more than "
+            f"{limits.MAX_SWEEP_RUNS:,} (otonav.limits.MAX_SWEEP_RUNS); split it into "
+            "smaller sweeps"
+        )
+    return total
 
 
 def _iter_runs(spec: SweepSpec, base: Path, where: str, actors: Sequence[str]) -> Iterator[RunTask]:

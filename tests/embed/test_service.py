@@ -423,7 +423,7 @@ def test_adversarial_requests_get_4xx_and_reveal_no_files(
         assert "\n" not in message
         assert len(message) < 500, message[:600]
     run_id = _start(client, {"scenario": "acceptance"})
-    for wait in ("nan", "inf", "-inf", "1e999", "soon"):
+    for wait in ("nan", "inf", "-inf", "1e999", "soon", "-5"):  # -5 was "no wait" (issue 27)
         response = client.get(f"/runs/{run_id}", params={"wait": wait})
         assert response.status_code == 400, (wait, response.text)
         assert "wait=" in response.json()["error"]

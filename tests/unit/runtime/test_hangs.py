@@ -83,3 +83,24 @@ def test_a_failure_is_raised_once_and_never_leaks_into_the_next_run() -> None:
         assert loop.run_until_complete(fine()) == "ok"
     finally:
         loop.close()
+
+
+def test_wall_ceiling_fires_on_a_callback_that_never_yields() -> None:
+    """The loop never reaches its own ceiling check; the watchdog thread does, names
+    the task (an actor's is ``actor:NAME``) and where it was computing (issue 27)."""
+
+    async def hog() -> None:
+        await asyncio.sleep(1.0)
+        spins = 0
+        while True:
+            spins += 1
+
+    async def main() -> None:
+        await asyncio.get_running_loop().create_task(hog(), name="actor:hog")
+
+    factory = lambda: VirtualTimeLoop(wall_ceiling=0.3, hold_grace=0.2)  # noqa: E731
+    with (
+        pytest.raises(WallClockCeilingError, match=r"sim time reached 1\.000 s\): actor 'hog'"),
+        asyncio.Runner(loop_factory=factory) as runner,
+    ):
+        runner.run(main())

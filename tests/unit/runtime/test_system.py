@@ -286,3 +286,24 @@ def test_actors_stop_one_after_another_in_reverse_start_order(how: str) -> None:
     ]
     expected = [t0, t0 + 0.25, t0 + 0.25, t0 + 0.75, t0 + 0.75, t0 + 0.75]
     assert [t for *_, t in log] == pytest.approx(expected)
+
+
+class SelfCanceller(Actor):
+    async def run(self) -> None:
+        await self.clock.sleep(1.0)
+        raise asyncio.CancelledError("nobody asked")
+
+
+def test_a_cancelled_error_nobody_asked_for_is_a_crash() -> None:
+    """It used to be logged as "stopped" and end the run silently at 1.0 s (issue 27)."""
+    counter, rogue = Counter(), SelfCanceller("rogue")
+    system = System([counter, rogue])
+
+    async def main() -> None:
+        with pytest.raises(ActorCrashedError, match=r"actor 'rogue' crashed at sim time 1\.000"):
+            async with system:
+                await anyio.sleep(100)
+
+    _run(main)
+    assert ("rogue", "crashed") in [(e.actor, e.kind) for e in system.events]
+    assert counter.stopped
