@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import json
 import signal
 import sys
 import threading
@@ -259,11 +260,61 @@ def print_summary(summary: dict[str, Any], console: Console) -> None:
                 f"{label}: p50 {s['p50']:.3f} {unit}, p95 {s['p95']:.3f} {unit}, "
                 f"max {s['max']:.3f} {unit} ({s['count']} runs)"
             )
+    from rich.markup import escape
+
     for group in summary["failures"]:
         first = group["runs"][0]
-        console.print(f"[red]{group['count']} x[/red] {group['reason']}")
+        # The run's own words: the group's key masks its numbers (for grouping only).
+        like = f" (and {group['count'] - 1} more like it)" if group["count"] > 1 else ""
+        console.print(f"[red]{group['count']} x[/red] {escape(str(first['reason']))}{like}")
         if first["repro"]:
             console.print(f"    repro: {first['repro']}", soft_wrap=True)
+
+
+_PLAN_FLAGS = {"sweep": "SWEEP", **QUICK_FLAGS, "--actor": "actors"}
+"""What makes the plan (stored in sweep.json): the sweep file or the quick-form flags,
+and the launched nodes."""
+
+
+def _invocation(args: argparse.Namespace) -> dict[str, Any]:
+    """The arguments that made this sweep's plan, as JSON (paths absolute)."""
+    stored: dict[str, Any] = {}
+    for flag, dest in _PLAN_FLAGS.items():
+        key = "sweep" if flag == "sweep" else dest
+        value = getattr(args, key)
+        if key == "sweep" and value is not None:
+            value = str(Path(value).resolve())
+        stored[key] = value
+    return stored
+
+
+def _resume_plan(args: argparse.Namespace) -> None:
+    """``--resume``: with no plan arguments, take the stored ones; with some, refuse
+    those that differ from the stored plan (one line naming them)."""
+    from otonav.stack.files import ConfigFileError
+    from otonav.sweep.results import PLAN
+
+    try:
+        stored = json.loads((args.out / PLAN).read_text()).get("invocation")
+    except (OSError, ValueError):
+        stored = None
+    if not isinstance(stored, dict):
+        return  # nothing stored (an older sweep): the arguments must be given again
+    given = _invocation(args)
+    if all(value in (None, []) for value in given.values()):
+        for key, value in stored.items():
+            setattr(args, key, Path(value) if key == "sweep" and value else value)
+        return
+    differ = [
+        f"{flag} (stored {stored.get(key)!r}, given {given[key]!r})"
+        for flag, dest in _PLAN_FLAGS.items()
+        if given[(key := "sweep" if flag == "sweep" else dest)] != stored.get(key)
+    ]
+    if differ:
+        raise ConfigFileError(
+            f"--resume: {args.out} holds a sweep made with other arguments: "
+            f"{'; '.join(differ)}; give the same ones, or none to resume it as stored"
+        )
 
 
 def main(args: argparse.Namespace) -> int:
@@ -287,6 +338,8 @@ def _main(args: argparse.Namespace, held: contextlib.ExitStack, lock_output: Any
         raise ConfigFileError(f"--workers {args.workers}: must be a count > 0")
     if args.retry_errors and not args.resume:
         raise ConfigFileError("--retry-errors: only with --resume")
+    if args.resume:
+        _resume_plan(args)  # the stored plan, so --resume --out DIR alone resumes
     if args.sweep is not None:
         quick = [f for f, dest in QUICK_FLAGS.items() if getattr(args, dest) not in (None, [])]
         if quick:  # they were silently ignored (issue 27)
@@ -299,6 +352,17 @@ def _main(args: argparse.Namespace, held: contextlib.ExitStack, lock_output: Any
     else:
         spec = quick_spec(args)
         tasks = plan_runs(spec, where="otonav sweep", actors=args.actors)
+    from otonav.sweep.precheck import check_tasks
+
+    problems = check_tasks(tasks)  # before the first run, not as late "error" runs
+    if problems:
+        for line in problems:
+            print(f"otonav: error: {line}", file=sys.stderr)
+        print(
+            f"otonav: {len(problems)} scenario(s) of the sweep cannot run; nothing was run",
+            file=sys.stderr,
+        )
+        return 2
     held.enter_context(lock_output(args.out))  # one sweep per --out (issue 27)
     backend = runner.make_backend(args.backend, workers=args.workers, ray_address=args.ray_address)
     prepared = runner.prepare(
@@ -306,7 +370,7 @@ def _main(args: argparse.Namespace, held: contextlib.ExitStack, lock_output: Any
         tasks,
         resume=args.resume,
         retry_errors=args.retry_errors,
-        meta={"name": spec.name, "spec": describe(spec)},
+        meta={"name": spec.name, "spec": describe(spec), "invocation": _invocation(args)},
     )
     console = Console(highlight=False)
     stop = threading.Event()
