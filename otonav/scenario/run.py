@@ -77,6 +77,8 @@ class Verdict:
     """The navigator's last reason (/nav/diagnostics), e.g. why it gave up."""
     sim_budget_s: float = 0.0
     """s of sim time the scenario allowed (scaled to the robot's speed: ``for_robot``)."""
+    clearance_floor_m: float = 0.0
+    """m: the scenario's ``min_clearance``, the floor ``min_clearance_m`` is judged on."""
     robot: dict[str, Any] = field(default_factory=dict)
     """The robot as run: model, top speeds, the geometry values and where each came
     from (:func:`robot_summary`)."""
@@ -500,5 +502,6 @@ def judge_verdict(
         nav_state=judge.nav_state,
         nav_reason=judge.nav_reason,
         sim_budget_s=scenario.sim_budget,
+        clearance_floor_m=scenario.min_clearance,
         robot=robot or {},
     )

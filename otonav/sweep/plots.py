@@ -28,11 +28,32 @@ def _world(record: dict[str, Any]) -> str:
     return str(record["scenario"])
 
 
+STRIP_RUNS = 60
+"""Up to this many runs a panel shows every run as a dot; beyond, step histograms."""
+
+
+def _message(fig: Any, text: str) -> None:
+    """A figure that says in words what there is to see (when there is nothing to plot)."""
+    ax = fig.add_subplot(1, 1, 1)
+    ax.axis("off")
+    ax.text(0.5, 0.5, text, ha="center", va="center", wrap=True, fontsize=11)
+
+
 def pass_fail_grid(records: Sequence[dict[str, Any]], png: Path) -> Path:
     """One cell per world (columns) and override combination (rows): the share of its
-    runs (over seeds) that passed, red 0 .. green 1; a cross marks an error."""
+    runs (over seeds) that passed, red 0 .. green 1; a cross marks an error. When every
+    run passed, the picture says so in words (a green band teaches nothing)."""
     worlds = list(dict.fromkeys(_world(r) for r in records))
     combos = list(dict.fromkeys(_combo(r) for r in records))
+    if all(r["status"] == "passed" for r in records):
+        fig = _figure(6.0, 2.0)
+        _message(
+            fig,
+            f"all {len(records)} runs passed: {len(worlds)} world(s) x {len(combos)} "
+            "override combination(s), no cell to tell apart",
+        )
+        fig.savefig(png)
+        return png
     cells: dict[tuple[int, int], list[dict[str, Any]]] = defaultdict(list)
     for r in records:
         cells[(combos.index(_combo(r)), worlds.index(_world(r)))].append(r)
@@ -53,27 +74,63 @@ def pass_fail_grid(records: Sequence[dict[str, Any]], png: Path) -> Path:
     else:
         ax.set_xlabel(f"{len(worlds)} worlds, in sweep order")
     fig.colorbar(image, ax=ax, label="share of runs passed")
-    ax.set_title("pass / fail per world (x: error)")
+    failed = sum(r["status"] != "passed" for r in records)
+    ax.set_title(f"pass / fail per world: {failed} of {len(records)} runs failed (x: error)")
     fig.tight_layout()
     fig.savefig(png)
     return png
 
 
 def histograms(records: Sequence[dict[str, Any]], png: Path) -> Path:
-    """Time to goal (runs that reached it) and minimum clearance (every judged run)."""
-    ttg = [r["time_to_goal_s"] for r in records if r.get("time_to_goal_s") is not None]
-    clearance = [r["min_clearance_m"] for r in records if r.get("min_clearance_m") is not None]
-    fig = _figure(9.0, 3.6)
-    for i, (values, label) in enumerate(
-        ((ttg, "time to goal (s of sim time)"), (clearance, "minimum clearance (m)"))
-    ):
+    """Time to goal (runs that reached it) and minimum clearance (every judged run), one
+    outline per override combination (a mix of them would be a many-humped shape), with
+    the limits drawn: the longest budget and the clearance floor."""
+    groups: dict[str, list[dict[str, Any]]] = defaultdict(list)
+    for r in records:
+        groups[_combo(r)].append(r)
+    budgets = [r["sim_budget_s"] for r in records if r.get("sim_budget_s")]
+    floors = [r["clearance_floor_m"] for r in records if r.get("clearance_floor_m")]
+    panels = (
+        ("time_to_goal_s", "time to goal (s of sim time)", max(budgets, default=None), "budget",
+         "no run reached the goal: no times to show"),
+        ("min_clearance_m", "minimum clearance (m)", max(floors, default=None), "floor",
+         "no run was judged: no clearances to show"),
+    )  # fmt: skip
+    from matplotlib.ticker import MaxNLocator
+
+    fig = _figure(10.0, 3.8)
+    for i, (key, label, limit, limit_name, empty) in enumerate(panels):
         ax = fig.add_subplot(1, 2, i + 1)
-        if values:
-            ax.hist(values, bins=min(30, max(5, len(values) // 5)), color="tab:blue")
+        values = {c: [r[key] for r in rs if r.get(key) is not None] for c, rs in groups.items()}
+        shown = {c: v for c, v in values.items() if v}
+        if not shown:
+            ax.axis("off")
+            ax.text(0.5, 0.5, empty, ha="center", va="center", transform=ax.transAxes)
+            continue
+        every = [v for vs in shown.values() for v in vs]
+        if len(every) <= STRIP_RUNS:  # few runs: each one a dot, a row per combination
+            for row, (combo, vs) in enumerate(shown.items()):
+                ax.plot(vs, [row] * len(vs), "o", alpha=0.7, label=f"{combo} ({len(vs)})")
+            ax.set_yticks(range(len(shown)), list(shown), fontsize=7)
+            ax.set_ylim(-0.5, len(shown) - 0.5)
         else:
-            ax.text(0.5, 0.5, "no data", ha="center", va="center", transform=ax.transAxes)
+            lo = min(every + ([limit] if limit else []))
+            hi = max(every + ([limit] if limit else []))
+            bins = [lo + (hi - lo) * k / 20 for k in range(21)] if hi > lo else 10
+            for combo, vs in shown.items():
+                ax.hist(vs, bins=bins, histtype="step", linewidth=1.5, label=f"{combo} ({len(vs)})")
+            ax.set_ylabel("runs")
+            ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+            ax.legend(fontsize=7)
+        if limit:
+            ax.axvline(limit, color="red", linestyle="--")
+            ax.annotate(
+                f"{limit_name} {limit:g}", (limit, 1.0), xycoords=("data", "axes fraction"),
+                ha="right", va="bottom", color="red", fontsize=8,
+            )  # fmt: skip
         ax.set_xlabel(label)
-        ax.set_ylabel("runs")
+    if sum(len(rs) for rs in groups.values()) <= STRIP_RUNS:
+        fig.suptitle("each dot a run, a row per override combination; red: the limit", fontsize=9)
     fig.tight_layout()
     fig.savefig(png)
     return png

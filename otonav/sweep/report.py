@@ -78,6 +78,39 @@ def _num(value: float | None, unit: str) -> str:
     return "-" if value is None else f"{value:.3f} {unit}"
 
 
+def _margin(record: dict[str, Any]) -> float:
+    """How far the run stayed above its clearance floor (m; -inf when not judged)."""
+    clearance, floor = record.get("min_clearance_m"), record.get("clearance_floor_m") or 0.0
+    return float("-inf") if clearance is None else float(clearance) - float(floor)
+
+
+def worst_case(records: Sequence[dict[str, Any]]) -> list[str]:
+    """The report's first lines: the worst run, its figures against the limits, and its
+    one-line repro. A failed run is worse than any pass; among equals, the one closest
+    to (or furthest below) the clearance floor."""
+    if not records:
+        return []
+    worst = min(records, key=lambda r: (r.get("status") == "passed", _margin(r)))
+    sets = ", ".join(f"{k}={v}" for k, v in (worst.get("overrides") or {}).items())
+    clearance = worst.get("min_clearance_m")
+    floor = worst.get("clearance_floor_m")
+    ttg, budget = worst.get("time_to_goal_s"), worst.get("sim_budget_s")
+    lines = [
+        "## Worst case",
+        "",
+        f"- run `{worst['run_id']}`: `{worst['scenario']}` seed {worst['seed']}"
+        + (f", {sets}" if sets else "")
+        + f": **{worst['status']}**, {worst.get('reason', '')}",
+        f"- min clearance {_num(clearance, 'm')}"
+        + (f" (floor {floor:g} m)" if floor else "")
+        + f"; time to goal {_num(ttg, 's')}"
+        + (f" (budget {budget:g} s)" if budget else ""),
+    ]
+    if worst.get("repro"):
+        lines.append(f"- repro: `{worst['repro']}`")
+    return [*lines, ""]
+
+
 def write_report(out: Path, summary: dict[str, Any], records: Sequence[dict[str, Any]]) -> Path:
     """Write ``summary.json``, the plots and ``report.md`` into ``out``."""
     from otonav.sweep.plots import histograms, pass_fail_grid
@@ -86,7 +119,7 @@ def write_report(out: Path, summary: dict[str, Any], records: Sequence[dict[str,
     pictures = []
     if records:
         pictures = [pass_fail_grid(records, out / GRID_PNG), histograms(records, out / HIST_PNG)]
-    lines = [f"# Sweep report: {summary['name']}", ""]
+    lines = [f"# Sweep report: {summary['name']}", "", *worst_case(records)]
     if not summary["complete"]:
         lines += [
             f"**Incomplete:** {summary['finished']} of {summary['planned']} runs finished "
