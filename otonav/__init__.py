@@ -12,3 +12,7 @@ Layers, top to bottom; imports point down only (import-linter contracts in pypro
     nav, control       pure math: go-to-goal, obstacle guard, diff-drive kinematics
     msgs, runtime      ROS 2-shaped messages; virtual-time loop, actors, topics, QoS, waits
 """
+
+from otonav._version import __version__
+
+__all__ = ["__version__"]

@@ -52,21 +52,17 @@ class _Parser(argparse.ArgumentParser):
 
 
 class _VersionAction(argparse.Action):
-    """``--version``: looks the version up only when asked (importlib.metadata costs
-    ~25 ms, a quarter of ``--help``)."""
+    """``--version``: the code's version (``otonav/_version.py``, the one pyproject.toml
+    and recordings carry)."""
 
     def __init__(self, option_strings: Sequence[str], dest: str, **kwargs: Any) -> None:
         kwargs.update(nargs=0, default=argparse.SUPPRESS)
         super().__init__(option_strings, argparse.SUPPRESS, **kwargs)
 
     def __call__(self, parser: argparse.ArgumentParser, *_args: object, **_kw: object) -> None:
-        from importlib.metadata import PackageNotFoundError, version
+        from otonav._version import __version__
 
-        try:
-            found = version("otonav")
-        except PackageNotFoundError:  # a source tree that was never installed
-            found = "unknown (not installed)"
-        print(f"otonav {found}")
+        print(f"otonav {__version__}")
         parser.exit()
 
 

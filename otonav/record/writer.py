@@ -21,6 +21,7 @@ from typing import IO
 
 from mcap.writer import CompressionType
 
+from otonav._version import __version__
 from otonav.msgs import Message
 from otonav.msgs.flat import real_type
 from otonav.record.cdr import encode
@@ -31,12 +32,8 @@ CHUNK_SIZE = 64 * 1024
 
 
 def _library() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return f"otonav {version('otonav')}"
-    except PackageNotFoundError:  # running from a source tree without installing
-        return "otonav"
+    # The code's version, never the installed metadata on disk (otonav/_version.py).
+    return f"otonav {__version__}"
 
 
 class RecordingWriter:

@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from otonav import limits
+from otonav._version import __version__
 from otonav.actors import topics
 from otonav.hal import RobotHardwareInterface
 from otonav.msgs import Header, Point, Pose, PoseStamped, ScenarioVerdict, Time
@@ -88,12 +89,9 @@ class Verdict:
 
 
 def otonav_version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("otonav")
-    except PackageNotFoundError:  # a source tree that was never installed
-        return "unknown"
+    """The version recorded with a run: the code's (otonav/_version.py), never the
+    installed metadata on disk, which a reinstall can hide for a moment."""
+    return __version__
 
 
 BUDGET_SPEED = 0.4

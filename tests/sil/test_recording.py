@@ -3,11 +3,13 @@
 
 from __future__ import annotations
 
+import importlib.metadata
 import math
 from pathlib import Path
 
 import pytest
 
+import otonav
 from otonav.control import DiffDriveGeometry, twist_to_wheels
 from otonav.record.reader import read_messages, summarize
 from otonav.scenario import ScenarioConfig, run_scenario
@@ -31,6 +33,31 @@ def test_two_runs_give_byte_identical_recordings(tmp_path: Path) -> None:
     b = (tmp_path / "b" / "recording.mcap").read_bytes()
     assert len(a) > 100_000
     assert a == b
+
+
+def test_the_recording_does_not_depend_on_the_installed_metadata(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The version a recording carries is the code's. Looked up in the installed
+    metadata at each run, it read ``unknown`` while the venv was being reinstalled (pip
+    removes the old .dist-info before it writes the new one): the same config and seed,
+    other bytes, with the same verdict."""
+    scenario = ScenarioConfig(sim_budget=0.5)  # the bytes, not the outcome: 0.5 s will do
+    run_scenario(scenario, out_dir=tmp_path / "a", plot=False)
+
+    def hidden(name: str) -> object:  # as importlib.metadata answers mid-reinstall
+        raise importlib.metadata.PackageNotFoundError(name)
+
+    monkeypatch.setattr(importlib.metadata, "version", hidden)
+    monkeypatch.setattr(importlib.metadata, "distribution", hidden)
+    run_scenario(scenario, out_dir=tmp_path / "b", plot=False)
+    a = (tmp_path / "a" / "recording.mcap").read_bytes()
+    b = (tmp_path / "b" / "recording.mcap").read_bytes()
+    assert a == b
+    assert (
+        summarize(tmp_path / "b" / "recording.mcap").metadata["otonav"]["otonav_version"]
+        == otonav.__version__
+    )
 
 
 def _assert_failed_recording(
