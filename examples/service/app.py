@@ -569,6 +569,7 @@ class Service:
                     {
                         "name": t.name,
                         "type": t.type,
+                        "ros_type": t.ros_type,
                         "publishers": [
                             {"actor": p.actor, "qos": p.qos, "published": p.published}
                             for p in t.publishers

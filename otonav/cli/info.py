@@ -131,10 +131,11 @@ def info_main(args: argparse.Namespace) -> int:
         print(json.dumps(as_json(summary), indent=2))
         return code
 
-    from rich.console import Console
     from rich.table import Table
 
-    console = Console(highlight=False)
+    from otonav.cli.console import make_console
+
+    console = make_console()
     console.print(f"file:      {summary.path} ({summary.size_bytes / 1024:.1f} KiB)")
     console.print(f"profile:   {summary.profile or '-'}   library: {summary.library or '-'}")
     console.print(

@@ -26,9 +26,9 @@ def add_parser(commands: Any) -> None:
 
 
 def graph_main(args: argparse.Namespace) -> int:
-    from rich.console import Console
     from rich.table import Table
 
+    from otonav.cli.console import make_console
     from otonav.cli.loading import load_stack
     from otonav.runtime import System
     from otonav.stack import build_actors, build_world
@@ -43,7 +43,7 @@ def graph_main(args: argparse.Namespace) -> int:
         graph = system.graph()
     finally:
         hal.close()
-    console = Console(highlight=False, width=140)
+    console = make_console(width=140)
     actors = Table(title="actors")
     for column in ("actor", "kind", "subscribes", "publishes", "parameters"):
         actors.add_column(column)
@@ -54,12 +54,12 @@ def graph_main(args: argparse.Namespace) -> int:
         )
     console.print(actors)
     topics = Table(title="topics (a recording adds the recorder on every topic)")
-    for column in ("topic", "type", "publishers (QoS)", "subscribers (QoS)"):
+    for column in ("topic", "type (ROS 2)", "publishers (QoS)", "subscribers (QoS)"):
         topics.add_column(column)
     for t in graph.topics:
         topics.add_row(
             t.name,
-            t.type.rsplit(".", 1)[-1],
+            t.ros_type or t.type.rsplit(".", 1)[-1],
             "\n".join(f"{p.actor} ({p.qos})" for p in t.publishers),
             "\n".join(f"{s.actor} ({s.qos})" for s in t.subscriptions),
         )
@@ -85,9 +85,9 @@ def parameter_lines(name: str, parameters: Any) -> str:
 
 
 def scenarios_main(_args: argparse.Namespace) -> int:
-    from rich.console import Console
     from rich.table import Table
 
+    from otonav.cli.console import make_console
     from otonav.scenario.builtin import BUILTIN, describe
 
     table = Table(title="built-in scenarios (run one: otonav run --scenario NAME)")
@@ -95,7 +95,7 @@ def scenarios_main(_args: argparse.Namespace) -> int:
     table.add_column("what")
     for name in BUILTIN:
         table.add_row(name, describe(name))
-    Console(highlight=False).print(table)
+    make_console().print(table)
     return 0
 
 

@@ -82,8 +82,7 @@ def main(args: argparse.Namespace) -> int:
 
 
 def _replay(args: argparse.Namespace, nodes: list[str]) -> int:
-    from rich.console import Console
-
+    from otonav.cli.console import make_console
     from otonav.replay import ReplayInputError, replay_recording
     from otonav.replay.output import write_replay
     from otonav.stack.files import ConfigFileError
@@ -101,7 +100,7 @@ def _replay(args: argparse.Namespace, nodes: list[str]) -> int:
         raise ConfigFileError(str(exc)) from None
     except ValueError as exc:  # --out on the input file
         raise ConfigFileError(str(exc)) from None
-    console = Console(highlight=False)
+    console = make_console()
     print_result(result, console)
     if written is not None:
         console.print(f"written: {written} (replayed outputs; recorded ones under /recorded/...)")
@@ -124,7 +123,10 @@ def print_result(result: ReplayResult, console: Console) -> None:
             line += f", {t.within_tolerance} within the tolerance"
         if t.missing or t.extra:
             line += f", {t.missing} missing, {t.extra} extra"
-        if t.max_diff_field:
+        if t.max_diff_field and math.isinf(t.max_abs_diff) and t.max_diff_values:
+            recorded, replayed = t.max_diff_values  # text, or a length: no |diff| to print
+            line += f" (at {t.max_diff_field}: recorded {recorded!r}, replayed {replayed!r})"
+        elif t.max_diff_field:
             line += f" (largest |diff| {t.max_abs_diff:.6g} at {t.max_diff_field})"
         console.print(line)
     if result.crash is not None:

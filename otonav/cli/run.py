@@ -170,8 +170,8 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
     import sys
 
     from pydantic import ValidationError
-    from rich.console import Console
 
+    from otonav.cli.console import make_console
     from otonav.cli.loading import load_scenario, load_stack
     from otonav.cli.progress import ProgressLine
     from otonav.limits import check_scale
@@ -215,7 +215,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
         guard.attach(loop, task)  # a signal now cancels the run, which then finishes
 
     server, extra = _live_view(args)
-    console = Console(highlight=False)
+    console = make_console()
     held: list[Verdict] = []
 
     def hold(verdict: Verdict) -> None:

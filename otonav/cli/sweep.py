@@ -325,8 +325,7 @@ def main(args: argparse.Namespace) -> int:
 
 
 def _main(args: argparse.Namespace, held: contextlib.ExitStack, lock_output: Any) -> int:
-    from rich.console import Console
-
+    from otonav.cli.console import make_console
     from otonav.stack.files import ConfigFileError
     from otonav.sweep import runner
     from otonav.sweep.plan import plan_runs
@@ -372,7 +371,7 @@ def _main(args: argparse.Namespace, held: contextlib.ExitStack, lock_output: Any
         retry_errors=args.retry_errors,
         meta={"name": spec.name, "spec": describe(spec), "invocation": _invocation(args)},
     )
-    console = Console(highlight=False)
+    console = make_console()
     stop = threading.Event()
     passed_before = sum(r["status"] == "passed" for r in prepared.finished.values())
     start = time.perf_counter()

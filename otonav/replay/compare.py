@@ -68,6 +68,9 @@ class TopicComparison:
     max_abs_diff: float = 0.0
     """Largest absolute difference of a numeric field over the pairs."""
     max_diff_field: str = ""
+    max_diff_values: tuple[Any, Any] | None = None
+    """(recorded, replayed) at ``max_diff_field``: what to print when the field is not a
+    number (its difference counts as inf)."""
     first: Divergence | None = None
 
     @property
@@ -129,6 +132,7 @@ def compare_topic(
             for path, a, b, diff in _differences(old, new):
                 if diff > summary.max_abs_diff:
                     summary.max_abs_diff, summary.max_diff_field = diff, path
+                    summary.max_diff_values = (a, b)
                 if first is None and not diff <= tolerance:
                     first = (path, a, b)
             if first is None:

@@ -29,6 +29,8 @@ class TopicInfo:
     type: str
     publishers: tuple[PublisherInfo, ...]
     subscriptions: tuple[SubscriptionInfo, ...]
+    ros_type: str = ""
+    """The ROS 2 type name (``nav_msgs/msg/Odometry``) when the message declares one."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -73,7 +75,9 @@ def build_graph(bus: Bus, actors: dict[str, tuple[str, str, int]]) -> Graph:
         for s in subs:
             inputs.setdefault(s.actor, []).append(topic.name)
         kind = topic.msg_type
-        topics.append(TopicInfo(topic.name, f"{kind.__module__}.{kind.__qualname__}", pubs, subs))
+        ros_type = str(getattr(kind, "ros_type", "") or "")
+        python_type = f"{kind.__module__}.{kind.__qualname__}"
+        topics.append(TopicInfo(topic.name, python_type, pubs, subs, ros_type))
     infos = tuple(
         ActorInfo(name, kind, status, restarts, tuple(inputs[name]), tuple(outputs[name]))
         for name, (kind, status, restarts) in actors.items()
