@@ -81,6 +81,7 @@ def _can_world(config: StackConfig, world: MujocoInterface) -> CanBusInterface:
         )
         from otonav.hal.can.protocol import InputMode
         from otonav.hal.sim import AxisParams, DriveEmulator, DriveMount
+        from otonav.stack.faults import fault_plan
     except ImportError as exc:  # python-can is an extra
         raise ConfigFileError(
             f"hal.kind: can needs python-can ({exc.name} is missing): pip install 'otonav[can]'"
@@ -112,6 +113,7 @@ def _can_world(config: StackConfig, world: MujocoInterface) -> CanBusInterface:
                 heartbeat_period=sim.heartbeat_period,
                 encoder_period=sim.encoder_period,
                 seed=sim.seed,
+                schedule=fault_plan(sim.faults),
             )
         limits = MonitorLimits(
             startup_timeout=can.startup_timeout,

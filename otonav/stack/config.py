@@ -273,6 +273,83 @@ class CanConfig(_Section):
     """Publish every frame on /can/frames (and so into the recording)."""
 
 
+_FaultTime = Annotated[float, _within(0.0, limits.MAX_SIM_BUDGET_S, " s")]
+"""s of sim time at which a fault starts or ends."""
+
+
+class _Timed(_Section):
+    at: _FaultTime = 0.0
+    """s of sim time the fault starts."""
+    until: _FaultTime | None = None
+    """s of sim time it ends (null: it lasts to the end of the run)."""
+
+    @model_validator(mode="after")
+    def _ordered(self) -> _Timed:
+        if self.until is not None and self.until <= self.at:
+            raise ValueError(f"until ({self.until:g} s) must be after at ({self.at:g} s)")
+        return self
+
+
+class DropFault(_Timed):
+    """Frames lost at random, both ways."""
+
+    rate: Annotated[float, _within(0.0, 1.0)] = 0.0
+    """probability a frame is lost, in [0, 1] (0: off)."""
+
+
+class DelayFault(_Timed):
+    """Frames held back, both ways (with jitter they may arrive out of order)."""
+
+    delay: _CanDelay = 0.0
+    """s every frame is held back (0 and no jitter: off)."""
+    jitter: _CanDelay = 0.0
+    """s, up to this much more, uniform."""
+
+
+class AxisErrorFault(_Section):
+    """A drive reports an axis error and disarms, until the host clears it."""
+
+    node_id: _NodeId | None = None
+    """the drive (null: off)."""
+    code: Annotated[int, _within(1, 0xFFFFFFFF)] = 0x20
+    """ODrive error bits (default DRV_FAULT, 0x20)."""
+    at: _FaultTime = 0.0
+
+
+class BusOffFault(_Section):
+    """The bus goes bus-off (nothing passes) and restarts."""
+
+    at: _FaultTime | None = None
+    """s it goes off (null: never)."""
+    until: _FaultTime | None = None
+
+    @model_validator(mode="after")
+    def _ordered(self) -> BusOffFault:
+        if self.at is None and self.until is not None:
+            raise ValueError("until needs at (when the bus goes off)")
+        if self.at is not None and self.until is not None and self.until <= self.at:
+            raise ValueError(f"until ({self.until:g} s) must be after at ({self.at:g} s)")
+        return self
+
+
+class HeartbeatFault(_Timed):
+    """A drive's heartbeat stops (it still obeys commands)."""
+
+    node_id: _NodeId | None = None
+    """the drive (null: off)."""
+
+
+class FaultsConfig(_Section):
+    """Faults the emulated drives and bus inject, each from a time of the run (ADR 0046):
+    e.g. ``--set hal.sim.faults.drop.rate=0.5 --set hal.sim.faults.drop.at=2``."""
+
+    drop: DropFault = DropFault()
+    delay: DelayFault = DelayFault()
+    axis_error: AxisErrorFault = AxisErrorFault()
+    bus_off: BusOffFault = BusOffFault()
+    heartbeat: HeartbeatFault = HeartbeatFault()
+
+
 class DriveSimConfig(_Section):
     """The emulated drives (``otonav.hal.sim``): how they are configured, which can
     differ from what the host expects (a wrong node id, a slower heartbeat: faults to
@@ -295,6 +372,8 @@ class DriveSimConfig(_Section):
     arm_time: _CanDelay = 0.01
     seed: int = Field(0, ge=0, le=limits.MAX_SEED)
     """Seeds the injected faults' random numbers."""
+    faults: FaultsConfig = FaultsConfig()
+    """Faults to inject, on a timetable (nothing by default)."""
 
 
 class HalConfig(_Section):
@@ -449,6 +528,16 @@ class StackConfig(_Section):
                 f"hal.sim.left_node_id and hal.sim.right_node_id must differ "
                 f"(both {sim.left_node_id})"
             )
+        drives = (sim.left_node_id, sim.right_node_id)
+        for key, node in (
+            ("axis_error", sim.faults.axis_error.node_id),
+            ("heartbeat", sim.faults.heartbeat.node_id),
+        ):
+            if node is not None and node not in drives:
+                raise ValueError(
+                    f"hal.sim.faults.{key}.node_id = {node} is not an emulated drive "
+                    f"(hal.sim.left_node_id {drives[0]}, hal.sim.right_node_id {drives[1]})"
+                )
         timestep = self.world.timestep
         periods = {
             "hal.can.encoder_period": can.encoder_period,

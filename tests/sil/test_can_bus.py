@@ -617,3 +617,21 @@ def test_cli_without_python_can_names_the_extra(
     assert err.strip().splitlines() == [
         "otonav: error: hal.kind: can needs python-can (can is missing): pip install 'otonav[can]'"
     ]
+
+
+def test_a_fault_from_the_cli_starts_at_its_time(tmp_path: Path) -> None:
+    from otonav.cli import main
+    from otonav.msgs import HardwareStatus
+    from otonav.record.reader import read_messages
+
+    args = ["run", "--out", str(tmp_path), "--set", "hal.kind=can",
+            "--set", "hal.sim.faults.axis_error.node_id=1",
+            "--set", "hal.sim.faults.axis_error.at=3"]  # fmt: skip
+    main(args)
+    faulted = [
+        t
+        for _topic, t, m in read_messages(tmp_path / "recording.mcap", ["/hardware/status"])
+        if m.level >= HardwareStatus().level + 2  # ERROR: a fault
+    ]
+    assert faulted
+    assert 3.0 <= faulted[0] <= 3.0 + 0.05  # within an encoder period or two of 3 s

@@ -33,6 +33,7 @@ from otonav.hal.can import protocol as p
 from otonav.hal.can.bus import CAN_ERR_BUSOFF, CAN_ERR_RESTARTED, CanEndpoint, RawFrame
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.sim.odrive import AxisModel, AxisParams
+from otonav.hal.sim.schedule import FaultPlan, FaultSchedule
 from otonav.hal.types import WheelCommand
 
 __all__ = ["BusFaults", "DriveEmulator", "DriveMount"]
@@ -113,6 +114,7 @@ class DriveEmulator:
         heartbeat_period: float = 0.1,
         encoder_period: float = 0.01,
         seed: int = 0,
+        schedule: FaultPlan | None = None,
     ) -> None:
         if left.node_id == right.node_id:
             raise ValueError(f"both drives have node id {left.node_id}")
@@ -125,6 +127,13 @@ class DriveEmulator:
         self.drives = (_Drive(left, left_mount), _Drive(right, right_mount))
         self._by_node = {d.node_id: d for d in self.drives}
         self.faults = BusFaults()
+        # Faults on a timetable (hal.sim.faults); None: only what a caller injects.
+        self._schedule = FaultSchedule(schedule) if schedule and not schedule.empty else None
+        for node in (schedule.axis_error_node, schedule.heartbeat_node) if schedule else ():
+            if node is not None and node not in self._by_node:
+                raise ValueError(
+                    f"a scheduled fault names drive {node}; the drives are {sorted(self._by_node)}"
+                )
         # Made at the first injected fault: numpy.random is imported for it alone
         # (~6 ms of CPU per run over CAN, measured; the MuJoCo stack never imports it).
         self._seed = seed
@@ -188,6 +197,8 @@ class DriveEmulator:
         (a Set_Input_Vel in PASSTHROUGH); in VEL_RAMP a Set_Input_Vel alone moves
         nothing before time passes (the ramp is ``vel_ramp_rate * dt`` and dt is 0)."""
         t = now * self._tick
+        if self._schedule is not None:
+            self._schedule.apply(self, t)
         changed = False
         incoming = self._endpoint.poll()
         if incoming and not self._bus_off:  # nothing crosses a bus-off bus

@@ -1,0 +1,108 @@
+"""Faults on a timetable: every fault the drive emulator can inject, each with a start
+(and, where it can end, an end) in seconds of sim time, so that a config file, the CLI
+(``--set hal.sim.faults...``) and a sweep can ask for them, not only Python.
+
+The emulator asks :meth:`FaultSchedule.apply` at each exchange (every encoder period,
+10 ms by default): a fault starts or ends at the first exchange at or after its time.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from otonav.hal.can.protocol import AxisError
+
+if TYPE_CHECKING:
+    from otonav.hal.sim.emulator import DriveEmulator
+
+__all__ = ["FaultPlan", "FaultSchedule", "Window"]
+
+
+@dataclass(frozen=True, slots=True)
+class Window:
+    """From ``start`` to ``end`` (None: to the end of the run), s of sim time."""
+
+    start: float
+    end: float | None = None
+
+    def holds(self, t: float) -> bool:
+        return self.start <= t and (self.end is None or t < self.end)
+
+
+@dataclass(frozen=True, slots=True)
+class FaultPlan:
+    """What to inject and when. A field left at its default injects nothing."""
+
+    drop_rate: float = 0.0
+    """Probability (0..1) that a frame is lost, during ``drop``."""
+    drop: Window = Window(0.0)
+    delay: float = 0.0
+    """s every frame is held back (plus up to ``jitter`` s), during ``delayed``."""
+    jitter: float = 0.0
+    delayed: Window = Window(0.0)
+    axis_error_node: int | None = None
+    """The drive that reports ``axis_error_code`` and disarms at ``axis_error_at``."""
+    axis_error_code: int = int(AxisError.DRV_FAULT)
+    axis_error_at: float = 0.0
+    bus_off: Window | None = None
+    """The bus is off (nothing passes) during this window."""
+    heartbeat_node: int | None = None
+    """The drive whose heartbeat stops during ``heartbeat_lost``."""
+    heartbeat_lost: Window = Window(0.0)
+
+    @property
+    def empty(self) -> bool:
+        return (
+            self.drop_rate == 0.0
+            and self.delay == 0.0
+            and self.jitter == 0.0
+            and self.axis_error_node is None
+            and self.bus_off is None
+            and self.heartbeat_node is None
+        )
+
+    def times(self) -> list[float]:
+        """Every instant at which something starts or ends."""
+        windows = [self.drop, self.delayed, self.heartbeat_lost]
+        if self.bus_off is not None:
+            windows.append(self.bus_off)
+        edges = [w.start for w in windows] + [w.end for w in windows if w.end is not None]
+        if self.axis_error_node is not None:
+            edges.append(self.axis_error_at)
+        return sorted(set(edges))
+
+
+class FaultSchedule:
+    """Applies a :class:`FaultPlan` to an emulator as sim time passes."""
+
+    def __init__(self, plan: FaultPlan) -> None:
+        self.plan = plan
+        self._edges = plan.times()
+        self._next = 0  # index of the next edge not yet applied
+        self._axis_error_done = False
+
+    @property
+    def next_time(self) -> float:
+        """The next instant at which the faults change (inf: none left)."""
+        return self._edges[self._next] if self._next < len(self._edges) else math.inf
+
+    def apply(self, emulator: DriveEmulator, t: float) -> None:
+        """Bring the emulator's faults to what the plan says at ``t`` (s of sim time)."""
+        if t < self.next_time:
+            return
+        while self._next < len(self._edges) and self._edges[self._next] <= t:
+            self._next += 1
+        plan, faults = self.plan, emulator.faults
+        faults.drop_rate = plan.drop_rate if plan.drop.holds(t) else 0.0
+        on = plan.delayed.holds(t)
+        faults.delay, faults.jitter = (plan.delay, plan.jitter) if on else (0.0, 0.0)
+        if plan.bus_off is not None:
+            emulator.set_bus_off(plan.bus_off.holds(t))
+        if plan.heartbeat_node is not None:
+            emulator.silence_heartbeat(plan.heartbeat_node, plan.heartbeat_lost.holds(t))
+        node = plan.axis_error_node
+        if node is not None and not self._axis_error_done and t >= plan.axis_error_at:
+            self._axis_error_done = True
+            emulator.inject_axis_error(node, plan.axis_error_code)
