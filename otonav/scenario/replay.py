@@ -15,7 +15,7 @@ from otonav.record.reader import read_messages, summarize
 from otonav.record.verify import Damage
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.plot import plot_trajectory
-from otonav.scenario.run import effective_stack
+from otonav.scenario.run import effective_stack, verdict_title
 from otonav.stack import StackConfig, build_world
 from otonav.stack.worldmeta import WORLD_METADATA, boxes_from_metadata
 
@@ -59,6 +59,8 @@ class RecordedPlot:
     truncated: bool
     damaged: tuple[Damage, ...] = ()
     """Chunks that failed their CRC: not drawn."""
+    closest: tuple[float, float] | None = None
+    """Where the recorded verdict says the robot came closest to an obstacle."""
 
 
 def recorded_plot(recording: Path) -> RecordedPlot:
@@ -82,7 +84,18 @@ def recorded_plot(recording: Path) -> RecordedPlot:
         obstacles = boxes_from_metadata(summary.metadata[WORLD_METADATA])
     elif scenario is not None:
         obstacles = _rebuilt_world(scenario)
-    title = f"{recording.name} (odometry)"
+    verdict = json.loads(meta["verdict"]) if "verdict" in meta else None
+    closest = None
+    if verdict is not None:  # the run's verdict, as `otonav run` draws it
+        title = verdict_title(
+            str(verdict.get("scenario", recording.name)),
+            bool(verdict.get("passed")),
+            str(verdict.get("reason", "")),
+        )
+        xy = verdict.get("closest_xy")
+        closest = (float(xy[0]), float(xy[1])) if xy else None
+    else:
+        title = f"{recording.name} (odometry): no verdict recorded"
     if summary.truncated:
         title += ", cut off: complete chunks only"
     if summary.damaged:
@@ -95,6 +108,7 @@ def recorded_plot(recording: Path) -> RecordedPlot:
         title,
         summary.truncated,
         summary.damaged,
+        closest,
     )
 
 
@@ -122,7 +136,7 @@ def plot_recording(recording: Path, png: Path | None = None) -> Path:
         plot.obstacles,
         plot.goal,
         plot.tolerance,
-        None,
+        plot.closest,
         plot.title,
         path_label="path (odometry)",
     )

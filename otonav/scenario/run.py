@@ -80,6 +80,8 @@ class Verdict:
     """s of sim time the scenario allowed (scaled to the robot's speed: ``for_robot``)."""
     clearance_floor_m: float = 0.0
     """m: the scenario's ``min_clearance``, the floor ``min_clearance_m`` is judged on."""
+    closest_xy: tuple[float, float] | None = None
+    """Where the robot came closest to an obstacle (world frame, m); None if nowhere."""
     robot: dict[str, Any] = field(default_factory=dict)
     """The robot as run: model, top speeds, the geometry values and where each came
     from (:func:`robot_summary`)."""
@@ -341,6 +343,18 @@ def run_scenario(
         return verdict
 
 
+TITLE_REASON_WIDTH = 64
+"""Characters per line of the verdict's reason in a plot's title (two lines at most)."""
+
+
+def verdict_title(scenario: str, passed: bool, reason: str) -> str:
+    """A plot's title that tells the verdict: the scenario, PASSED or FAILED, and why."""
+    import textwrap
+
+    why = textwrap.wrap(reason, TITLE_REASON_WIDTH, max_lines=2, placeholder=" …")
+    return "\n".join([f"{scenario}: {'PASSED' if passed else 'FAILED'}", *why])
+
+
 def save_artifacts(
     verdict: Verdict,
     scenario: ScenarioConfig,
@@ -363,7 +377,7 @@ def save_artifacts(
             (scenario.goal.x, scenario.goal.y),
             scenario.goal_tolerance,
             judge.min_clearance_at,
-            f"{scenario.name}: {'PASSED' if verdict.passed else 'FAILED'}",
+            verdict_title(verdict.scenario, verdict.passed, verdict.reason),
         )
         verdict = replace(verdict, plot=str(png))
     return verdict
@@ -501,5 +515,6 @@ def judge_verdict(
         nav_reason=judge.nav_reason,
         sim_budget_s=scenario.sim_budget,
         clearance_floor_m=scenario.min_clearance,
+        closest_xy=judge.min_clearance_at,
         robot=robot or {},
     )
