@@ -123,3 +123,16 @@ def test_the_class_key_is_written_as_class() -> None:
     assert StackConfig.model_validate_json(
         StackConfig(actors=(entry,)).model_dump_json()
     ).actors == (entry,)
+
+
+def test_recovery_speeds_respect_the_navigators_limits() -> None:
+    from otonav.stack.build import navigation_params
+    from otonav.stack.overrides import apply_overrides
+
+    stack = apply_overrides(StackConfig(), ["nav.max_v=0.0001", "nav.max_omega=0.5"])
+    params = navigation_params(stack, FakeHardware().geometry)
+    assert params.backup_speed == 0.0001
+    assert params.follow_speed == 0.0001
+    assert params.spin_speed == 0.5
+    default = navigation_params(StackConfig(), FakeHardware().geometry)
+    assert (default.backup_speed, default.follow_speed, default.spin_speed) == (0.1, 0.2, 1.0)
