@@ -19,9 +19,27 @@ def _figure(w: float, h: float) -> Any:
     return fig
 
 
-def _combo(record: dict[str, Any]) -> str:
+def _combo(record: dict[str, Any], shown: frozenset[str] | None = None) -> str:
+    """The run's override combination, as labels say it: only the ``shown`` keys (those
+    that vary across the sweep; a key every run sets alike says nothing)."""
     o = record.get("overrides") or {}
-    return ", ".join(f"{k}={v}" for k, v in o.items()) or "(no overrides)"
+    return ", ".join(f"{k}={v}" for k, v in o.items() if shown is None or k in shown) or (
+        "(no overrides)"
+    )
+
+
+def varying_keys(records: Sequence[dict[str, Any]]) -> frozenset[str]:
+    """The override keys whose value differs between runs."""
+    values: dict[str, set[str]] = defaultdict(set)
+    for r in records:
+        for k, v in (r.get("overrides") or {}).items():
+            values[k].add(repr(v))
+    keys = {k for r in records for k in (r.get("overrides") or {})}
+    return frozenset(
+        k
+        for k in keys
+        if len(values[k]) > 1 or any(k not in (r.get("overrides") or {}) for r in records)
+    )
 
 
 def _world(record: dict[str, Any]) -> str:
@@ -43,8 +61,9 @@ def pass_fail_grid(records: Sequence[dict[str, Any]], png: Path) -> Path:
     """One cell per world (columns) and override combination (rows): the share of its
     runs (over seeds) that passed, red 0 .. green 1; a cross marks an error. When every
     run passed, the picture says so in words (a green band teaches nothing)."""
+    shown = varying_keys(records)
     worlds = list(dict.fromkeys(_world(r) for r in records))
-    combos = list(dict.fromkeys(_combo(r) for r in records))
+    combos = list(dict.fromkeys(_combo(r, shown) for r in records))
     if all(r["status"] == "passed" for r in records):
         fig = _figure(6.0, 2.0)
         _message(
@@ -56,11 +75,11 @@ def pass_fail_grid(records: Sequence[dict[str, Any]], png: Path) -> Path:
         return png
     cells: dict[tuple[int, int], list[dict[str, Any]]] = defaultdict(list)
     for r in records:
-        cells[(combos.index(_combo(r)), worlds.index(_world(r)))].append(r)
+        cells[(combos.index(_combo(r, shown)), worlds.index(_world(r)))].append(r)
     grid = [[float("nan")] * len(worlds) for _ in combos]
     for (row, col), runs in cells.items():
         grid[row][col] = sum(r["status"] == "passed" for r in runs) / len(runs)
-    width = min(16.0, max(5.0, 0.25 * len(worlds) + 3.0))
+    width = min(16.0, max(7.0, 0.25 * len(worlds) + 3.0))
     height = min(12.0, max(2.5, 0.35 * len(combos) + 1.8))
     fig = _figure(width, height)
     ax = fig.add_subplot(1, 1, 1)
@@ -75,7 +94,7 @@ def pass_fail_grid(records: Sequence[dict[str, Any]], png: Path) -> Path:
         ax.set_xlabel(f"{len(worlds)} worlds, in sweep order")
     fig.colorbar(image, ax=ax, label="share of runs passed")
     failed = sum(r["status"] != "passed" for r in records)
-    ax.set_title(f"pass / fail per world: {failed} of {len(records)} runs failed (x: error)")
+    ax.set_title(f"{failed} of {len(records)} runs failed\n(share passed per world; x: error)")
     fig.tight_layout()
     fig.savefig(png)
     return png
@@ -86,20 +105,21 @@ def histograms(records: Sequence[dict[str, Any]], png: Path) -> Path:
     outline per override combination (a mix of them would be a many-humped shape), with
     the limits drawn: the longest budget and the clearance floor."""
     groups: dict[str, list[dict[str, Any]]] = defaultdict(list)
+    shown_keys = varying_keys(records)
     for r in records:
-        groups[_combo(r)].append(r)
+        groups[_combo(r, shown_keys)].append(r)
     budgets = [r["sim_budget_s"] for r in records if r.get("sim_budget_s")]
     floors = [r["clearance_floor_m"] for r in records if r.get("clearance_floor_m")]
     panels = (
         ("time_to_goal_s", "time to goal (s of sim time)", max(budgets, default=None), "budget",
-         "no run reached the goal: no times to show"),
+         "no run reached the goal: no times to show", "never reached the goal"),
         ("min_clearance_m", "minimum clearance (m)", max(floors, default=None), "floor",
-         "no run was judged: no clearances to show"),
+         "no run was judged: no clearances to show", "not judged (errors)"),
     )  # fmt: skip
     from matplotlib.ticker import MaxNLocator
 
     fig = _figure(10.0, 3.8)
-    for i, (key, label, limit, limit_name, empty) in enumerate(panels):
+    for i, (key, label, limit, limit_name, empty, unshown) in enumerate(panels):
         ax = fig.add_subplot(1, 2, i + 1)
         values = {c: [r[key] for r in rs if r.get(key) is not None] for c, rs in groups.items()}
         shown = {c: v for c, v in values.items() if v}
@@ -129,6 +149,9 @@ def histograms(records: Sequence[dict[str, Any]], png: Path) -> Path:
                 ha="right", va="bottom", color="red", fontsize=8,
             )  # fmt: skip
         ax.set_xlabel(label)
+        missing = sum(len(rs) for rs in groups.values()) - len(every)
+        if missing:
+            ax.set_title(f"not shown: {missing} run(s) {unshown}", fontsize=8, loc="left")
     if sum(len(rs) for rs in groups.values()) <= STRIP_RUNS:
         fig.suptitle("each dot a run, a row per override combination; red: the limit", fontsize=9)
     fig.tight_layout()
