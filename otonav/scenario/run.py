@@ -80,8 +80,9 @@ class Verdict:
     """s of sim time the scenario allowed (scaled to the robot's speed: ``for_robot``)."""
     clearance_floor_m: float = 0.0
     """m: the scenario's ``min_clearance``, the floor ``min_clearance_m`` is judged on."""
-    closest_xy: tuple[float, float] | None = None
-    """Where the robot came closest to an obstacle (world frame, m); None if nowhere."""
+    closest_xy: list[float] | None = None
+    """[x, y] where the robot came closest to an obstacle (world frame, m; a list, as it
+    reads back from JSON); None if nowhere."""
     robot: dict[str, Any] = field(default_factory=dict)
     """The robot as run: model, top speeds, the geometry values and where each came
     from (:func:`robot_summary`)."""
@@ -515,6 +516,6 @@ def judge_verdict(
         nav_reason=judge.nav_reason,
         sim_budget_s=scenario.sim_budget,
         clearance_floor_m=scenario.min_clearance,
-        closest_xy=judge.min_clearance_at,
+        closest_xy=list(judge.min_clearance_at) if judge.min_clearance_at else None,
         robot=robot or {},
     )

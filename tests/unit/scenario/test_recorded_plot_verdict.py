@@ -19,8 +19,8 @@ def test_a_recorded_verdict_titles_the_plot(tmp_path: Path) -> None:
     plot = recorded_plot(tmp_path / "recording.mcap")
     assert plot.title.splitlines()[0] == "short: FAILED"
     assert "did not reach the goal within 1 s" in plot.title
-    assert plot.closest == verdict.closest_xy
     assert plot.closest is not None
+    assert list(plot.closest) == verdict.closest_xy
 
 
 def test_a_long_reason_is_wrapped_onto_two_lines_at_most() -> None:
