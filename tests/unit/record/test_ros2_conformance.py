@@ -170,7 +170,11 @@ def test_sweep_bag_makes_a_bag_beside_every_kept_recording(tmp_path: Path) -> No
     from otonav.cli.sweep import _write_bags
 
     _record(tmp_path / "runs" / "a" / "recording.mcap")
-    records = [{"artifacts": "runs/a"}, {"artifacts": None}, {"artifacts": "runs/gone"}]
+    records: list[dict[str, Any]] = [
+        {"artifacts": "runs/a"},
+        {"artifacts": None},
+        {"artifacts": "runs/gone"},
+    ]
     _write_bags(tmp_path, records)
     with Reader(tmp_path / "runs" / "a" / "bag") as reader:
         assert reader.message_count == 7
