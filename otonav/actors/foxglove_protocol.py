@@ -3,10 +3,13 @@
 The only module that imports ``websockets`` (an import-linter contract); the live view
 (:mod:`otonav.actors.live_view`) is its one user.
 
-It speaks the part of the protocol a live view needs (docs/adr/0032): ``serverInfo``
-with the ``time`` capability, ``advertise`` of channels (topic, ``cdr``
+It speaks the part of the protocol a live view needs (docs/adr/0032, 0044):
+``serverInfo`` with the ``time`` capability, ``advertise`` of channels (topic, ``cdr``
 encoding, ``ros2msg`` schema), ``subscribe``/``unsubscribe`` from clients, binary
-message data and time frames. The handshake accepts the protocol under both its names:
+message data and time frames; with ``on_client_message``, ``clientPublish`` (clients
+``advertise`` their own channels and send binary ``clientMessageData``); with
+``parameters``, ``getParameters``/``setParameters`` answered by ``parameterValues``.
+The handshake accepts the protocol under both its names:
 ``foxglove.sdk.v1`` (what foxglove-sdk's servers accept, and current Foxglove apps offer)
 and ``foxglove.websocket.v1`` (the specification's name, which the @foxglove/ws-protocol
 client library, roslibjs-foxglove and Lichtblick before its December 2025 change offer
@@ -42,6 +45,35 @@ SUBPROTOCOLS = (Subprotocol("foxglove.sdk.v1"), Subprotocol("foxglove.websocket.
 
 _MESSAGE_DATA = struct.Struct("<BIQ")  # opcode 0x01, subscription id, log time ns
 _TIME = struct.Struct("<BQ")  # opcode 0x02, time ns
+_CLIENT_DATA = struct.Struct("<BI")  # opcode 0x01, client channel id; then the payload
+
+
+@dataclass(frozen=True, slots=True)
+class ClientChannel:
+    """A channel a client advertised (``clientPublish``)."""
+
+    client: int
+    id: int
+    topic: str
+    encoding: str
+    schema_name: str
+
+
+class Parameters:
+    """What ``getParameters``/``setParameters`` ask (the ``parameters`` capability).
+    Called on the server's thread; :meth:`set` answers later through ``reply``."""
+
+    def get(self, names: list[str]) -> list[dict[str, Any]]:
+        """``[{"name", "value"}]`` of ``names`` (every parameter when empty)."""
+        raise NotImplementedError
+
+    def set(
+        self,
+        changes: list[tuple[str, Any]],
+        reply: Callable[[list[dict[str, Any]], str | None], None],
+    ) -> None:
+        """Apply ``changes``; then ``reply(values, error)`` (error: one line, or None)."""
+        raise NotImplementedError
 
 
 @dataclass(eq=False)
@@ -53,6 +85,8 @@ class _Client:
     data: deque[bytes] = field(default_factory=deque)
     subscriptions: dict[int, int] = field(default_factory=dict)
     """subscription id -> channel id."""
+    advertised: dict[int, ClientChannel] = field(default_factory=dict)
+    """client channel id -> what the client said it publishes there."""
     by_channel: dict[int, list[int]] = field(default_factory=dict)
     """channel id -> subscription ids."""
     dropped: int = 0
@@ -108,8 +142,18 @@ class ProtocolServer:
         backlog: int,
         on_subscribe: Callable[[int, int], None] = lambda client, channel: None,
         on_unsubscribe: Callable[[int, int], None] = lambda client, channel: None,
+        on_client_message: Callable[[ClientChannel, bytes], str | None] | None = None,
+        parameters: Parameters | None = None,
     ) -> None:
         self.name = name
+        self._on_client_message = on_client_message
+        """``(channel, payload) -> None`` taken, or one line why not (sent as a status)."""
+        self._parameters = parameters
+        self.capabilities = ["time"]
+        if on_client_message is not None:
+            self.capabilities.append("clientPublish")
+        if parameters is not None:
+            self.capabilities.append("parameters")
         self.backlog = backlog
         self._on_subscribe = on_subscribe
         self._on_unsubscribe = on_unsubscribe
@@ -246,8 +290,9 @@ class ProtocolServer:
             info = {
                 "op": "serverInfo",
                 "name": self.name,
-                "capabilities": ["time"],
-                "supportedEncodings": [],
+                "capabilities": self.capabilities,
+                # what clients may publish in (clientPublish)
+                "supportedEncodings": ["cdr", "json"] if self._on_client_message else [],
                 "metadata": {},
             }
             self._queue_control(client, json.dumps(info))
@@ -294,9 +339,16 @@ class ProtocolServer:
 
     def _handle(self, client: _Client, raw: str | bytes) -> None:
         try:
+            if isinstance(raw, bytes):
+                self._client_data(client, raw)
+                return
             message = json.loads(raw)
             op = message["op"]
-            if op == "subscribe":
+            if op in ("advertise", "unadvertise") and self._on_client_message is not None:
+                self._client_advertise(client, op, message)
+            elif op in ("getParameters", "setParameters") and self._parameters is not None:
+                self._parameter_op(client, op, message)
+            elif op == "subscribe":
                 for sub in message["subscriptions"]:
                     self._subscribe(client, int(sub["id"]), int(sub["channelId"]))
             elif op == "unsubscribe":
@@ -306,6 +358,52 @@ class ProtocolServer:
                 self._status(client, 1, f"unsupported operation {op!r}: this server only serves")
         except (ValueError, KeyError, TypeError) as exc:
             self._status(client, 2, f"bad message ({exc!r})")
+
+    def _client_advertise(self, client: _Client, op: str, message: dict[str, Any]) -> None:
+        if op == "unadvertise":
+            for channel_id in message["channelIds"]:
+                client.advertised.pop(int(channel_id), None)
+            return
+        for c in message["channels"]:
+            encoding = str(c["encoding"])
+            if encoding not in ("cdr", "json"):
+                self._status(
+                    client, 2, f"channel {c['topic']}: encoding {encoding!r}: use cdr or json"
+                )
+                continue
+            client.advertised[int(c["id"])] = ClientChannel(
+                client.id, int(c["id"]), str(c["topic"]), encoding, str(c.get("schemaName", ""))
+            )
+
+    def _client_data(self, client: _Client, raw: bytes) -> None:
+        opcode, channel_id = _CLIENT_DATA.unpack_from(raw)
+        channel = client.advertised.get(channel_id)
+        if opcode != 0x01 or channel is None or self._on_client_message is None:
+            self._status(client, 2, f"client message on unadvertised channel {channel_id}")
+            return
+        problem = self._on_client_message(channel, raw[_CLIENT_DATA.size :])
+        if problem is not None:
+            self._status(client, 2, problem)
+
+    def _parameter_op(self, client: _Client, op: str, message: dict[str, Any]) -> None:
+        assert self._parameters is not None
+        request_id = message.get("id")
+
+        def reply(values: list[dict[str, Any]], error: str | None) -> None:
+            if error is not None:
+                self._status(client, 2, error)
+            answer: dict[str, Any] = {"op": "parameterValues", "parameters": values}
+            if request_id is not None:
+                answer["id"] = request_id
+            with self._lock:
+                if client.id in self._clients:
+                    self._queue_control(client, json.dumps(answer))
+
+        if op == "getParameters":
+            reply(self._parameters.get([str(n) for n in message["parameterNames"]]), None)
+        else:
+            changes = [(str(p["name"]), p.get("value")) for p in message["parameters"]]
+            self._parameters.set(changes, reply)
 
     def _subscribe(self, client: _Client, sub_id: int, channel_id: int) -> None:
         with self._lock:

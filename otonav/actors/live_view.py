@@ -16,22 +16,39 @@ Two parts (docs/adr/0031-live-view-over-foxglove-sdk.md, amended by 0032):
   encodes what came in, for the channels some client subscribed to only, hands it to
   the server and broadcasts the sim time. Latched topics (/tf_static, /goal) are sent
   again to each client that subscribes to them, since the protocol has no latching.
+
+It also acts (docs/adr/0044): clients may publish (``clientPublish``) on the topics of
+``LiveViewOptions.client_publish`` (``/goal`` by default: Foxglove's Publish panel or
+3D panel sends a goal), in CDR or JSON, each message decoded and checked against the
+topic's type on the server's thread and published from the loop's; and, once
+:meth:`LiveView.serve_parameters` is given the system's actors, read and set
+parameters (``parameters``, :mod:`otonav.actors.live_parameters`). Every change, and
+every refusal, is logged on /rosout, so the recording shows it.
 """
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
 import math
 import os
 import threading
 from collections import deque
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
-from otonav.msgs import Message
+import anyio
+from pydantic import ValidationError
+
+from otonav.actors import topics
+from otonav.actors.live_parameters import ActorParameters, ParameterError
+from otonav.msgs import Log, Message, Time
 from otonav.record.cdr import encode
+from otonav.record.cdr_decode import decode
 from otonav.record.schemas import schema_for
-from otonav.runtime import Actor, Bus, Durability, QoS, Reliability, run_blocking
-from otonav.runtime.mailbox import Endpoint, Subscription, Topic
+from otonav.runtime import Actor, Bus, Durability, Output, QoS, Reliability, run_blocking
+from otonav.runtime.mailbox import Endpoint, Publisher, Subscription, Topic
 
 DEFAULT_HOST = "127.0.0.1"
 DEFAULT_PORT = 8765
@@ -60,6 +77,8 @@ class LiveViewOptions:
     wall seconds (None: do not wait). Sim time does not move while it waits."""
     wait_for_subscriptions: int = 1
     """With ``wait_for_subscriber``: how many channel subscriptions to wait for."""
+    client_publish: tuple[str, ...] = (topics.GOAL,)
+    """Topics clients may publish on (``clientPublish``); empty: clients only watch."""
 
     def __post_init__(self) -> None:
         if not 0 <= self.port <= 65535:
@@ -80,7 +99,7 @@ class FoxgloveServer:
 
     def __init__(self, options: LiveViewOptions = LiveViewOptions()) -> None:
         try:
-            from otonav.actors.foxglove_protocol import ProtocolServer
+            from otonav.actors.foxglove_protocol import Parameters, ProtocolServer
         except ImportError:
             raise LiveViewError(
                 "--foxglove needs the foxglove extra: pip install 'otonav[foxglove]'"
@@ -94,6 +113,24 @@ class FoxgloveServer:
         self.clients_seen: set[int] = set()
         self._changed = threading.Condition(self._lock)
         self._subscribed_total = 0
+        self.client_sink: Callable[[Any, bytes], str | None] | None = None
+        """Where client messages go (the live view sets it once wired)."""
+        self.parameter_sink: Any = None
+        """Who answers parameter requests (the live view, once given the actors)."""
+        outer = self
+
+        class _Parameters(Parameters):
+            def get(self, names: list[str]) -> list[dict[str, Any]]:
+                sink = outer.parameter_sink
+                return [] if sink is None else list(sink.get_parameters(names))
+
+            def set(self, changes: list[tuple[str, Any]], reply: Any) -> None:
+                sink = outer.parameter_sink
+                if sink is None:
+                    reply([], "parameters: not served yet (the stack is starting)")
+                else:
+                    sink.set_parameters(changes, reply)
+
         try:
             self._server = ProtocolServer(
                 options.host,
@@ -102,6 +139,8 @@ class FoxgloveServer:
                 backlog=options.backlog,
                 on_subscribe=self._subscribed,
                 on_unsubscribe=self._unsubscribed,
+                on_client_message=self._client_message if options.client_publish else None,
+                parameters=_Parameters(),
             )
         except OSError as exc:
             raise LiveViewError(
@@ -156,6 +195,12 @@ class FoxgloveServer:
         subscriptions in all since the server started; False on timeout."""
         with self._changed:
             return self._changed.wait_for(lambda: self._subscribed_total >= count, timeout)
+
+    def _client_message(self, channel: Any, payload: bytes) -> str | None:
+        sink = self.client_sink
+        if sink is None:
+            return f"{channel.topic}: not taken yet (the stack is starting)"
+        return sink(channel, payload)
 
     def _unsubscribed(self, client: int, channel_id: int) -> None:
         with self._lock:
@@ -237,6 +282,8 @@ class _TopicState:
 class LiveView(Actor):
     """Serves every topic of its system through ``server`` (see the module docstring)."""
 
+    rosout = Output(topics.ROSOUT, Log, topics.ROSOUT_QOS)
+
     def __init__(
         self,
         server: FoxgloveServer,
@@ -251,11 +298,109 @@ class LiveView(Actor):
         self.period = period or server.options.period
         self._topics: dict[str, _TopicState] = {}
         self.sent_bytes = 0
+        self._client_publishers: dict[str, Publisher[Any]] = {}
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._parameters: ActorParameters | None = None
+        self.client_messages = 0
+        """Messages clients published that were taken."""
 
     def on_wired(self, bus: Bus) -> None:
         for topic in list(bus.topics.values()):
             self._tap(topic)
         bus.add_topic_listener(self._tap)
+        for name in self.server.options.client_publish:
+            used = bus.topics.get(name)
+            if used is None:
+                continue  # nobody uses it in this system: refused when a client sends
+            # What its own publishers offer (a latched /goal stays latched), else what
+            # serves every subscriber (reliable; transient-local if one asks for it).
+            latched = any(
+                e.qos.durability is Durability.TRANSIENT_LOCAL for e in used.subscriptions
+            )
+            qos = (
+                used.publishers[0].qos
+                if used.publishers
+                else QoS(depth=1, durability=Durability.TRANSIENT_LOCAL)
+                if latched
+                else QoS()
+            )
+            endpoint = Endpoint(self.name, f"client{name}")
+            self._client_publishers[name] = bus.publisher(
+                name, used.msg_type, qos, endpoint=endpoint
+            )
+
+    # -- acting: client messages and parameters (called on the server's thread) ---------
+
+    def _take_client_message(self, channel: Any, payload: bytes) -> str | None:
+        publisher = self._client_publishers.get(channel.topic)
+        loop = self._loop
+        if publisher is None:
+            allowed = ", ".join(sorted(self._client_publishers)) or "none"
+            return f"{channel.topic}: clients may not publish here (allowed: {allowed})"
+        kind: type[Message] = publisher.msg_type
+        if channel.schema_name and channel.schema_name not in (
+            kind.ros_type,
+            kind.ros_type.replace("/msg/", "/"),
+        ):
+            return f"{channel.topic}: is {kind.ros_type}, not {channel.schema_name}"
+        try:
+            message = (
+                kind.model_validate_json(payload)
+                if channel.encoding == "json"
+                else decode(kind, payload)
+            )
+        except (ValidationError, ValueError, IndexError) as exc:
+            first = str(exc).splitlines()[0]
+            return f"{channel.topic}: not a {kind.ros_type} in {channel.encoding} ({first})"
+        if loop is None or loop.is_closed():
+            return f"{channel.topic}: not taken (the stack is not running)"
+        loop.call_soon_threadsafe(self._publish_client, publisher, message)
+        return None
+
+    def _publish_client(self, publisher: Publisher[Any], message: Message) -> None:
+        try:
+            publisher.publish_nowait(message)
+            self.client_messages += 1
+        except anyio.WouldBlock:
+            self._log(Log.WARN, f"{publisher.topic}: a client's message dropped (full)")
+
+    def serve_parameters(self, actors: Iterable[Actor]) -> None:
+        """Serve the parameters of ``actors`` (the system's) to clients."""
+        self._parameters = ActorParameters(actors)
+        self.server.parameter_sink = self
+
+    def get_parameters(self, names: list[str]) -> list[dict[str, Any]]:
+        table = self._parameters
+        values = table.values() if table is not None else {}
+        wanted = names or list(values)
+        return [{"name": n, "value": values[n]} for n in wanted if n in values]
+
+    def set_parameters(self, changes: list[tuple[str, Any]], reply: Any) -> None:
+        loop = self._loop
+        if loop is None or loop.is_closed():
+            reply([], "parameters: the stack is not running")
+            return
+        loop.call_soon_threadsafe(self._apply_parameters, changes, reply)
+
+    def _apply_parameters(self, changes: list[tuple[str, Any]], reply: Any) -> None:
+        table = self._parameters
+        assert table is not None
+        errors: list[str] = []
+        for name, value in changes:
+            try:
+                old, new = table.set(name, value)
+            except ParameterError as exc:
+                errors.append(str(exc))
+                self._log(Log.WARN, f"refused a client's change: {exc}")
+                continue
+            self._log(Log.INFO, f"parameter {name}: {old!r} -> {new!r} (set by a client)")
+        reply(self.get_parameters([name for name, _ in changes]), "; ".join(errors) or None)
+
+    def _log(self, level: int, text: str) -> None:
+        log = Log(stamp=Time.from_seconds(self._now()), level=level, name=self.name, msg=text)
+        # /rosout full: the line is lost, the robot is not held
+        with contextlib.suppress(anyio.WouldBlock):
+            self.rosout.publish_nowait(log)
 
     def _now(self) -> float:
         # Until the System hands out clocks, time is the start (0).
@@ -275,6 +420,8 @@ class LiveView(Actor):
                 tap._offer(message)
 
     async def on_start(self) -> None:
+        self._loop = asyncio.get_running_loop()
+        self.server.client_sink = self._take_client_message
         options = self.server.options
         if options.wait_for_subscriber is not None:
             # A worker thread waits; sim time holds still meanwhile (run_blocking).

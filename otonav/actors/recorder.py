@@ -49,6 +49,11 @@ class Recorder(Actor):
 
     def on_wired(self, bus: Bus) -> None:
         wanted = self._wanted
+        # What each topic's publishers offer goes into its channel (rosbag2's
+        # offered_qos_profiles), so `ros2 bag play` offers the same QoS again.
+        self.writer.offered_qos = lambda name: (
+            [p.qos for p in bus.topics[name].publishers] if name in bus.topics else []
+        )
         self._funnel = Funnel(
             bus,
             self.name,

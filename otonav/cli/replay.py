@@ -56,6 +56,12 @@ def add_parser(commands: Any) -> None:
         "--out", type=Path, help="write an MCAP with the replayed outputs beside the inputs"
     )
     p.add_argument(
+        "--bag",
+        action="store_true",
+        help="with --out: also a rosbag2 bag directory beside it (OUT without .mcap, plus "
+        "_bag: metadata.yaml + the written MCAP)",
+    )
+    p.add_argument(
         "--wake",
         choices=("timers", "recorded"),
         default="timers",
@@ -66,6 +72,11 @@ def add_parser(commands: Any) -> None:
     p.set_defaults(handler=main)
 
 
+def replay_bag_path(written: Path) -> Path:
+    """``--bag``: ``replayed.mcap`` -> the directory ``replayed_bag`` beside it."""
+    return written.with_name(f"{written.stem}_bag")
+
+
 def main(args: argparse.Namespace) -> int:
     from otonav.record.outlock import lock_output
     from otonav.stack.files import ConfigFileError
@@ -73,6 +84,8 @@ def main(args: argparse.Namespace) -> int:
     nodes = [name.strip() for spec in args.nodes for name in spec.split(",") if name.strip()]
     if not nodes:
         raise ConfigFileError("--node: name a node to replay, e.g. --node nav")
+    if args.bag and args.out is None:
+        raise ConfigFileError("--bag: only with --out (the bag holds the written MCAP)")
     if not (math.isfinite(args.tolerance) and args.tolerance >= 0):
         raise ConfigFileError(f"--tolerance {args.tolerance}: must be a finite number >= 0")
     with contextlib.ExitStack() as held:
@@ -104,6 +117,11 @@ def _replay(args: argparse.Namespace, nodes: list[str]) -> int:
     print_result(result, console)
     if written is not None:
         console.print(f"written: {written} (replayed outputs; recorded ones under /recorded/...)")
+        if args.bag:
+            from otonav.record.bag import write_bag_directory
+
+            bag = write_bag_directory(Path(written), replay_bag_path(Path(written)))
+            console.print(f"bag: {bag}")
     return 0 if result.passed else 1
 
 

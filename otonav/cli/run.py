@@ -15,6 +15,8 @@ if TYPE_CHECKING:  # the command's imports are in main(): --help stays fast
     from otonav.scenario import Verdict
 
 DEFAULT_OUT = Path("out")
+BAG_DIR = "bag"
+"""``--bag``: the rosbag2 directory inside ``--out``."""
 
 
 class _HelpFormatter(argparse.HelpFormatter):
@@ -66,6 +68,12 @@ def add_parser(commands: Any) -> None:
         "--out", type=Path, default=DEFAULT_OUT, help="artifact directory (default: out)"
     )
     p.add_argument("--no-record", action="store_true", help="do not write recording.mcap")
+    p.add_argument(
+        "--bag",
+        action="store_true",
+        help="also make OUT/bag a rosbag2 bag directory (metadata.yaml + the recording) "
+        "for ros2 bag and rosbags",
+    )
     p.add_argument(
         "--realtime", action="store_true", help="pace sim time to the wall clock (same actors)"
     )
@@ -167,6 +175,7 @@ def main(args: argparse.Namespace) -> int:
 def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> int:
     import asyncio
     import json
+    import shutil
     import sys
 
     from pydantic import ValidationError
@@ -188,6 +197,8 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
             f"--scale {args.scale:g}: only with --realtime or --gui "
             "(a headless run is not paced: it runs as fast as it can)"
         )
+    if args.bag and args.no_record:
+        raise ConfigFileError("--bag: not with --no-record (the bag is the recording)")
     if args.hold and not args.gui:
         raise ConfigFileError("--hold: only with --gui (it keeps the viewer window open)")
     problem = check_scale(scale)
@@ -212,6 +223,8 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
         # deleted on bad input. An interrupted run writes no summary.json.
         for path in stale:
             path.unlink(missing_ok=True)
+        # The bag's file is a link to recording.mcap, which this run rewrites.
+        shutil.rmtree(out / BAG_DIR, ignore_errors=True)
         guard.attach(loop, task)  # a signal now cancels the run, which then finishes
 
     server, extra = _live_view(args)
@@ -273,6 +286,10 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
     if guard.received is not None:  # the run had ended; the signal came while saving
         return guard.report()
     out.mkdir(parents=True, exist_ok=True)
+    if args.bag and verdict.recording:
+        from otonav.record.bag import write_bag_directory
+
+        console.print(f"bag: {write_bag_directory(Path(verdict.recording), out / BAG_DIR)}")
     summary = out / "summary.json"
     summary.write_text(json.dumps(finite_figures(verdict.as_dict()), indent=2, default=str) + "\n")
     if held:  # the table was printed while the window was held open

@@ -11,7 +11,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from types import FrameType
 from typing import TYPE_CHECKING, Any
@@ -81,6 +81,12 @@ def add_parser(commands: Any) -> None:
     )
     quick.add_argument(
         "--keep", choices=("failures", "all", "none"), help="artifacts to keep (default failures)"
+    )
+    p.add_argument(
+        "--bag",
+        action="store_true",
+        help="beside each kept recording, a rosbag2 bag directory (bag/: metadata.yaml + "
+        "the recording) for ros2 bag and rosbags",
     )
     p.set_defaults(handler=main)
 
@@ -324,6 +330,18 @@ def main(args: argparse.Namespace) -> int:
         return _main(args, held, lock_output)
 
 
+def _write_bags(out: Path, records: Iterable[dict[str, Any]]) -> None:
+    """``--bag``: a bag directory beside every kept recording (after the sweep: the
+    driver alone writes into ``--out``)."""
+    from otonav.record.bag import write_bag_directory
+
+    for record in records:
+        folder = record.get("artifacts")
+        recording = out / str(folder) / "recording.mcap" if folder else None
+        if recording is not None and recording.exists():
+            write_bag_directory(recording, recording.parent / "bag")
+
+
 def _main(args: argparse.Namespace, held: contextlib.ExitStack, lock_output: Any) -> int:
     from otonav.cli.console import make_console
     from otonav.stack.files import ConfigFileError
@@ -384,6 +402,8 @@ def _main(args: argparse.Namespace, held: contextlib.ExitStack, lock_output: Any
     ran = len(prepared.pending)
     summary["this_invocation"] = {"wall_time_s": wall, "backend": backend.name, "pending": ran}
     report = write_report(args.out, summary, records)
+    if args.bag:
+        _write_bags(args.out, records)
     print_summary(summary, console)
     console.print(f"results: {args.out / RESULTS}\nreport:  {report}")
     if received:

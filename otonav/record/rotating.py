@@ -55,10 +55,10 @@ class RotatingRecordingWriter(RecordingWriter):
                 older.replace(self.rotated(n))
         if self.keep == 0:
             self.path.unlink()
-        start, messages = self._start_metadata, self.messages
+        start, messages, offered = self._start_metadata, self.messages, self.offered_qos
         # A fresh file under the same name: the base class's own set-up, again.
         RecordingWriter.__init__(self, self.path, chunk_size=self._chunk_size)
-        self.messages = messages
+        self.messages, self.offered_qos = messages, offered
         for name, data in start:
             super().add_metadata(name, data)
         self.rotations += 1

@@ -14,7 +14,7 @@ stamps. Crash-safe by construction (notes/recording.md):
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from types import TracebackType
 from typing import IO
@@ -26,7 +26,10 @@ from otonav.msgs import Message
 from otonav.msgs.flat import real_type
 from otonav.record.cdr import encode
 from otonav.record.fastwriter import FastWriter
+from otonav.record.qos_profile import offered_qos_yaml
 from otonav.record.schemas import schema_for
+from otonav.record.type_hash import rihs01
+from otonav.runtime.qos import QoS
 
 CHUNK_SIZE = 64 * 1024
 
@@ -53,6 +56,9 @@ class RecordingWriter:
         self._sequence: dict[int, int] = {}
         self.messages = 0
         self.finished = False
+        self.offered_qos: Callable[[str], Sequence[QoS]] = lambda _topic: ()
+        """The QoS profiles a topic's publishers offer, asked once when its channel
+        opens (the recorder answers from the bus); none: ROS 2's default profile."""
 
     def _channel(self, topic: str, kind: type[Message]) -> int:
         schema_id = self._schemas.get(kind)
@@ -60,7 +66,12 @@ class RecordingWriter:
             name, definition = schema_for(kind)
             schema_id = self._writer.register_schema(name, "ros2msg", definition.encode())
             self._schemas[kind] = schema_id
-        channel_id = self._writer.register_channel(topic, "cdr", schema_id)
+        # The ros2 profile's required key, and the type hash rosbag2 (Jazzy) adds.
+        metadata = {
+            "offered_qos_profiles": offered_qos_yaml(self.offered_qos(topic)),
+            "topic_type_hash": rihs01(kind),
+        }
+        channel_id = self._writer.register_channel(topic, "cdr", schema_id, metadata)
         self._channels[topic] = channel_id
         self._sequence[channel_id] = 0
         return channel_id

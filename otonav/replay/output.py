@@ -17,7 +17,9 @@ from mcap.writer import CompressionType
 
 from otonav.record.cdr import encode
 from otonav.record.fastwriter import FastWriter
+from otonav.record.qos_profile import offered_qos_yaml
 from otonav.record.schemas import schema_for
+from otonav.record.type_hash import rihs01
 from otonav.record.writer import CHUNK_SIZE
 from otonav.replay.recording import load_recording
 from otonav.replay.runner import ReplayResult
@@ -50,22 +52,36 @@ def write_replay(result: ReplayResult, out: Path) -> Path:
         writer.start(profile="ros2", library="otonav replay")
         schema_ids: dict[str, int] = {}
         channels: dict[str, int] = {}
+        # Each channel keeps its recorded metadata (offered_qos_profiles, the type
+        # hash); a replayed output gets the QoS its recorded topic was offered with.
+        recorded_metadata = {
+            c.topic: dict(c.metadata)
+            for c in (source.summary.channels.values() if source.summary is not None else ())
+        }
         sequences: dict[int, int] = {}
 
         def channel(topic: str) -> int:
             channel_id = channels.get(topic)
             if channel_id is not None:
                 return channel_id
+            metadata = recorded_metadata.get(topic.removeprefix(RECORDED_PREFIX), {})
             if topic in types:
                 name, definition = schema_for(types[topic])
                 encoding, data = "ros2msg", definition.encode()
+                metadata = {
+                    "offered_qos_profiles": metadata.get("offered_qos_profiles")
+                    or offered_qos_yaml(()),
+                    "topic_type_hash": rihs01(types[topic]),
+                }
             else:
                 recorded = source.schemas[topic.removeprefix(RECORDED_PREFIX)]
                 name, encoding, data = recorded.name, recorded.encoding, recorded.data
             schema_id = schema_ids.get(name)
             if schema_id is None:
                 schema_id = schema_ids[name] = writer.register_schema(name, encoding, data)
-            channel_id = channels[topic] = writer.register_channel(topic, "cdr", schema_id)
+            channel_id = channels[topic] = writer.register_channel(
+                topic, "cdr", schema_id, metadata
+            )
             sequences[channel_id] = 0
             return channel_id
 

@@ -66,7 +66,7 @@ def test_every_topic_is_advertised_and_odom_arrives_as_recorded(tmp_path: Path) 
         client.stop()
     assert verdict.sim_time_s == pytest.approx(3.0, abs=0.05)
     assert client.subprotocol == "foxglove.websocket.v1"
-    assert client.server_info["capabilities"] == ["time"]
+    assert client.server_info["capabilities"] == ["time", "clientPublish", "parameters"]
     types = {t.topic: t.type for t in summarize(recording).topics}
     types.pop("/scenario/verdict")  # written by the runner after the run, not a topic
     assert set(types) >= STACK_TOPICS
@@ -251,7 +251,8 @@ async def test_both_names_of_the_protocol_are_accepted_and_nothing_else() -> Non
             async with connect(server.url, subprotocols=offered) as ws:
                 assert ws.subprotocol == expected
                 info = json.loads(await ws.recv())
-                assert (info["op"], info["capabilities"]) == ("serverInfo", ["time"])
+                assert info["op"] == "serverInfo"
+                assert info["capabilities"] == ["time", "clientPublish", "parameters"]
         for offered in ([Subprotocol("foxglove.websocket.v2")], []):
             with pytest.raises(InvalidStatus, match="400"):
                 async with connect(server.url, subprotocols=offered or None):

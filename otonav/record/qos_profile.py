@@ -1,0 +1,53 @@
+"""``offered_qos_profiles``: a topic's QoS in the YAML rosbag2 writes (docs/adr/0044).
+
+rosbag2 stores, per topic, the QoS profiles its publishers offered, so ``ros2 bag play``
+offers the same again (a latched ``/tf_static`` needs transient-local there). The MCAP
+``ros2`` profile makes the key required in every channel's metadata. The form is
+rosbag2's metadata version 9 (ROS 2 Jazzy): a YAML list, one mapping per publisher,
+enums as lower-case names and durations as ``{sec, nsec}``. otonav's QoS has no
+deadline, lifespan or liveliness lease: those are "infinite", written as rmw reports an
+unset duration of a live endpoint (``RMW_DURATION_INFINITE``: 9223372036 s 854775807 ns),
+liveliness ``automatic``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any, Final
+
+import yaml
+
+from otonav.runtime.qos import DEFAULT_QOS, QoS
+
+__all__ = ("INFINITE", "offered_qos_profiles", "offered_qos_yaml")
+
+INFINITE: Final = {"sec": 9223372036, "nsec": 854775807}
+"""``RMW_DURATION_INFINITE`` as rosbag2 writes it."""
+
+
+def _profile(qos: QoS) -> dict[str, Any]:
+    return {
+        "history": "keep_last",
+        "depth": qos.depth,
+        "reliability": qos.reliability.value,
+        "durability": qos.durability.value,
+        "deadline": dict(INFINITE),
+        "lifespan": dict(INFINITE),
+        "liveliness": "automatic",
+        "liveliness_lease_duration": dict(INFINITE),
+        "avoid_ros_namespace_conventions": False,
+    }
+
+
+def offered_qos_profiles(offered: Sequence[QoS]) -> list[dict[str, Any]]:
+    """One rosbag2 profile per offered QoS (ROS 2's default profile when none was
+    offered: a topic written by no publisher, such as the verdict)."""
+    return [_profile(qos) for qos in (offered or (DEFAULT_QOS,))]
+
+
+def offered_qos_yaml(offered: Sequence[QoS]) -> str:
+    """:func:`offered_qos_profiles` as the YAML string of an MCAP channel's metadata."""
+    text: str = yaml.safe_dump(
+        offered_qos_profiles(offered), default_flow_style=False, sort_keys=False
+    )
+    return text.strip()
