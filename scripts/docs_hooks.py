@@ -38,6 +38,7 @@ from pydantic.functional_validators import AfterValidator
 from pydantic_core import PydanticUndefined
 
 MARKER = re.compile(r"^<!-- generated: ([a-z0-9:_-]+) -->$", flags=re.MULTILINE)
+DASH = "\N{EN DASH}"
 COLUMNS = "110"
 """Terminal width the samples and the CLI help are formatted for."""
 
@@ -213,7 +214,7 @@ def _bounds(metadata: list[Any], annotation: Any) -> str:
     if low or high:
         return f"{low or '(-∞'}, {high or '∞)'}"
     if len(lengths) == 2:
-        return "length " + "–".join(text.split()[-1] for text in lengths)
+        return "length " + DASH.join(text.split()[-1] for text in lengths)
     return ", ".join(lengths)
 
 
@@ -251,7 +252,7 @@ def _unit(name: str, doc: str, metadata: list[Any], annotation: Any) -> str:
 
 def _show(value: Any) -> str:
     if value is None:
-        return "–"
+        return DASH
     if isinstance(value, BaseModel):
         return "`" + ", ".join(f"{k}: {v}" for k, v in value.model_dump().items()) + "`"
     if isinstance(value, bool):
@@ -269,7 +270,9 @@ def _prose(doc: str) -> str:
     return text.replace("``", "`").replace("|", "\\|")
 
 
-def config_rows(model: type[BaseModel], instance: BaseModel | None, prefix: str = "") -> Iterator[Row]:
+def config_rows(
+    model: type[BaseModel], instance: BaseModel | None, prefix: str = ""
+) -> Iterator[Row]:
     """One row per leaf key of ``model``, defaults read from ``instance`` (a section's
     default can differ from its class's, e.g. ``hal.can.left.sign``)."""
     docs = _attribute_docs(model)
@@ -293,9 +296,8 @@ def config_rows(model: type[BaseModel], instance: BaseModel | None, prefix: str 
         sub = _submodel(info.annotation)
         if sub is not None and typing.get_origin(info.annotation) is not dict:
             if value is None:
-                yield Row(key, _type_name(info.annotation), "–", "", "", _prose(doc))
-            yield from config_rows(sub, value if isinstance(value, BaseModel) else None,
-                                   f"{key}.")
+                yield Row(key, _type_name(info.annotation), DASH, "", "", _prose(doc))
+            yield from config_rows(sub, value if isinstance(value, BaseModel) else None, f"{key}.")
             continue
         required = instance is None and info.is_required()
         yield Row(
@@ -319,9 +321,23 @@ def config_table(model: type[BaseModel], instance: BaseModel | None) -> str:
 
 
 def stack_config_reference() -> str:
+    """One table per top-level section, headed by the section's class docstring."""
     from otonav.stack import StackConfig
 
-    return config_table(StackConfig, StackConfig())
+    parts = []
+    defaults = StackConfig()
+    for name, info in StackConfig.model_fields.items():
+        sub = _submodel(info.annotation)
+        listed = _is_list_of_models(info.annotation)
+        model = listed or sub
+        if model is None:
+            raise ValueError(f"StackConfig.{name}: a top-level key that is no section")
+        rows = config_table(model, None if listed else getattr(defaults, name))
+        prefix = f"{name}[]." if listed else f"{name}."
+        rows = re.sub(r"^\| `", f"| `{prefix}", rows, flags=re.MULTILINE)
+        rows = rows.replace(f"| `{prefix}key` |", "| key |")
+        parts.append(f"## `{name}`\n\n{_prose(model.__doc__ or '')}\n\n{rows}")
+    return "\n".join(parts)
 
 
 def scenario_reference() -> str:
@@ -409,6 +425,35 @@ def sample(name: str) -> str:
     return _sample_outputs()[name]
 
 
+# ------------------------------------------------------------------------------- blocks
+
+ROOT = DOCS.parent
+FENCE = re.compile(r"^```(\w*)\n(.*?)^```$", flags=re.DOTALL | re.MULTILINE)
+SNIPPET = re.compile(r'^--8<-- "([^"]+)"\s*$')
+
+
+def doc_sources() -> list[Path]:
+    """The Markdown the tests read: every page of the site (ADRs aside) and the README."""
+    pages = [p for p in sorted(DOCS.rglob("*.md")) if "adr" not in p.relative_to(DOCS).parts]
+    return [ROOT / "README.md", *pages]
+
+
+def code_blocks(lang: str) -> list[tuple[Path, str]]:
+    """Every fenced block of ``lang`` in :func:`doc_sources`, with its file."""
+    return [
+        (path, body)
+        for path in doc_sources()
+        for block_lang, body in FENCE.findall(path.read_text())
+        if block_lang == lang
+    ]
+
+
+def included_file(body: str) -> Path | None:
+    """The file a block includes whole (``--8<-- "path"``), or None."""
+    match = SNIPPET.match(body.strip())
+    return ROOT / match.group(1) if match else None
+
+
 # --------------------------------------------------------------------------------- hook
 
 GENERATORS: dict[str, Callable[[], str]] = {
@@ -428,7 +473,9 @@ def render(markdown: str, where: str = "page") -> str:
     def one(match: re.Match[str]) -> str:
         name = match.group(1)
         if name not in GENERATORS:
-            raise ValueError(f"{where}: unknown generated block {name!r}; known: {list(GENERATORS)}")
+            raise ValueError(
+                f"{where}: unknown generated block {name!r}; known: {list(GENERATORS)}"
+            )
         return GENERATORS[name]().rstrip("\n")
 
     return MARKER.sub(one, markdown)
