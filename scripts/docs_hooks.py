@@ -428,7 +428,8 @@ def sample(name: str) -> str:
 # ------------------------------------------------------------------------------- blocks
 
 ROOT = DOCS.parent
-FENCE = re.compile(r"^```(\w*)\n(.*?)^```$", flags=re.DOTALL | re.MULTILINE)
+FENCE = re.compile(r"^```\{?\.?(\w*)[^\n]*\n(.*?)^```$", flags=re.DOTALL | re.MULTILINE)
+"""A fenced block: ```python, or ```{.python title="..."} (which ruff's formatter leaves be)."""
 SNIPPET = re.compile(r'^--8<-- "([^"]+)"\s*$')
 
 
