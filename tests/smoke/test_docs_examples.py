@@ -76,7 +76,7 @@ def test_each_extra_adds_what_the_install_page_says(extra: str) -> None:
     assert set(re.findall(r"[a-z][a-z0-9-]+", row.group(1))) == names
 
 
-def test_the_pytest_example_passes_and_its_failure_reads_as_the_readme_says(
+def test_the_first_test_passes_and_its_failure_reads_as_the_page_says(
     pytester: pytest.Pytester,
 ) -> None:
     pytester.makeini(INI)
