@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: run test lint bench clean
+.PHONY: run test lint bench docs test-docs clean
 
 $(STAMP): pyproject.toml constraints.txt
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -31,5 +31,16 @@ lint: $(STAMP)
 bench: $(STAMP)
 	$(PY) -m otonav bench
 
+## build the docs site into site/ (--strict: a broken link or reference fails; the
+## reference pages and sample outputs are generated from the code and a real run)
+docs: $(STAMP)
+	NO_MKDOCS_2_WARNING=1 $(PY) -m mkdocs build --strict --site-dir site
+
+## the built site renders in headless Chromium (Debian's chromium: installed here when
+## missing); screenshots in out/docs-screenshots/. CI runs it after `make test`.
+test-docs: docs
+	@sh scripts/ensure_chromium.sh
+	$(PY) scripts/docs_screenshots.py site out/docs-screenshots
+
 clean:
-	rm -rf $(VENV) .mypy_cache .ruff_cache .pytest_cache .hypothesis
+	rm -rf $(VENV) site .mypy_cache .ruff_cache .pytest_cache .hypothesis

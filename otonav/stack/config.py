@@ -58,6 +58,7 @@ class WorldConfig(_Section):
     lidar_beams: PositiveInt = Field(360, le=limits.MAX_LIDAR_BEAMS)
     """Beams over a full circle, at most 3600 (0.1 degree, the finest 2D lidars)."""
     lidar_range_min: float = Field(0.12, ge=0.0)
+    """m, returns closer than this read as -inf (below range), < ``lidar_range_max``."""
     lidar_range_max: PositiveFloat = Field(8.0, le=limits.MAX_LIDAR_RANGE_M)
     """m, at most 1 km: ranges are float32 in the recording."""
 
@@ -77,11 +78,16 @@ class BaseConfig(_Section):
 
     rate_hz: PositiveFloat = 50.0
     cmd_timeout: PositiveFloat = 0.5
+    """s of sim time without a valid /cmd_vel before the wheels stop (watchdog)."""
     # Bounded so that wheel speeds stay finite and the limits still limit (limits.py).
     max_v: PositiveFloat = Field(0.5, le=limits.MAX_BASE_V)
+    """m/s, the fastest the base drives, whatever /cmd_vel asks."""
     max_omega: PositiveFloat = Field(1.5, le=limits.MAX_BASE_OMEGA)
+    """rad/s, the fastest the base turns."""
     max_accel: PositiveFloat = Field(1.0, le=limits.MAX_BASE_ACCEL)
+    """m/s², linear acceleration limit."""
     max_alpha: PositiveFloat = Field(3.0, le=limits.MAX_BASE_ALPHA)
+    """rad/s², angular acceleration limit."""
 
 
 class DwaConfig(_Section):
@@ -174,12 +180,18 @@ class NavConfig(_Section):
     actor, your own node publishes /cmd_vel_nav (behind the safety layer)."""
     rate_hz: PositiveFloat = 20.0
     kp_lin: float = Field(0.8, ge=0.0)
+    """Proportional gain on the distance to the goal (``stop`` planner, and the final
+    approach of ``dwa``), 1/s."""
     kp_ang: float = Field(2.0, ge=0.0)
+    """Proportional gain on the heading error, 1/s."""
     max_v: PositiveFloat = 0.4
+    """m/s, the fastest the navigator asks for."""
     max_omega: PositiveFloat = 1.2
+    """rad/s, the fastest turn the navigator asks for."""
     tolerance: PositiveFloat = 0.08
     """m: the navigator stops within this distance of the goal (by odometry)."""
     turn_in_place_threshold: PositiveFloat = 0.6
+    """rad of heading error above which the robot turns in place first."""
     clearance: float = Field(0.35, ge=0.0, le=5.0)
     """m, robot centre (base_link, the judged point) to any return: what the planner
     keeps, in [0, 5]; at least ``safety.clearance``."""
@@ -222,7 +234,9 @@ class GuardConfig(_Section):
     """Obstacle guard: front sector half-angle (rad) and stop distance (m)."""
 
     sector_half_angle: float = Field(0.5, gt=0.0, le=math.pi)
+    """rad either side of straight ahead that the guard watches."""
     stop_distance: PositiveFloat = 0.35
+    """m: stop when a valid return in the sector is this close."""
 
 
 class CanAxisConfig(_Section):
@@ -244,6 +258,7 @@ class CanConfig(_Section):
     """python-can interface: ``virtual`` (in-process, with the drive emulator) or
     ``socketcan`` (a Linux CAN link such as ``can0`` or ``vcan0``)."""
     channel: str = Field("can0", min_length=1, max_length=limits.MAX_CAN_NAME_CHARS)
+    """python-can channel, e.g. ``can0`` or ``vcan0`` for SocketCAN."""
     emulate: bool = True
     """Run the drive emulator at the far end of the bus (false: real drives)."""
     left: CanAxisConfig = CanAxisConfig(node_id=0, sign=-1)
@@ -381,6 +396,8 @@ class HalConfig(_Section):
     CAN bus (drives emulated on MuJoCo's wheels, or real drives)."""
 
     kind: Literal["mujoco", "can"] = "mujoco"
+    """``mujoco``: the wheels are MuJoCo's actuators; ``can``: the wheels are drives on a
+    CAN bus (``hal.can``)."""
     can: CanConfig = CanConfig()
     sim: DriveSimConfig = DriveSimConfig()
 

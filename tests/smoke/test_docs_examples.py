@@ -1,8 +1,10 @@
-"""The README's Python examples run, as a user would run them, so they cannot drift: each
-fenced ``python`` block is matched to how it is meant to be used (a test file for pytest,
-an ``async def`` to await, a notebook cell with a top-level ``async for``). A block no
-runner claims fails the suite. The README's claims about what the ``test`` extra
-installs and what a failing example test reports are checked here too."""
+"""The Python examples of the docs site and the README run, as a user would run them, so
+they cannot drift: each fenced ``python`` block is matched to how it is meant to be used (a
+test file for pytest, an ``async def`` to await, a notebook cell with a top-level ``async
+for``, a script). A block no runner claims fails the suite. A block that includes a file
+whole (``--8<--``) is that file, which its own tests run. The install page's claims about
+what each extra installs and the first-test page's about what a failing example reports
+are checked here too."""
 
 from __future__ import annotations
 
@@ -11,6 +13,8 @@ import asyncio
 import contextlib
 import io
 import re
+import shutil
+import sys
 import tomllib
 from collections.abc import Callable
 from pathlib import Path
@@ -23,8 +27,15 @@ from otonav.scenario import ScenarioConfig, run_scenario
 pytestmark = pytest.mark.smoke
 
 ROOT = Path(__file__).resolve().parents[2]
-README = (ROOT / "README.md").read_text()
-BLOCKS = re.findall(r"^```python\n(.*?)^```$", README, flags=re.DOTALL | re.MULTILINE)
+sys.path.insert(0, str(ROOT / "scripts"))
+
+import docs_hooks  # noqa: E402
+
+BLOCKS = [
+    body for _path, body in docs_hooks.code_blocks("python") if not docs_hooks.included_file(body)
+]
+FIRST_TEST = (ROOT / "docs" / "getting-started" / "first-test.md").read_text()
+INSTALL = (ROOT / "docs" / "getting-started" / "install.md").read_text()
 INI = """[pytest]
 asyncio_default_fixture_loop_scope = function
 """
@@ -36,7 +47,11 @@ def _block(marker: str) -> str:
 
 
 RUNNERS: dict[str, str] = {
-    "def test_reaches_the_goal": "the pytest example (test_my_robot.py)",
+    "def test_reaches_the_goal(": "the first scenario test (test_my_robot.py)",
+    "def test_reaches_the_goal_in_20_s": "the README's example",
+    "def test_my_planner_arrives": "the tutorial's test of the user's node",
+    "virtual_loop_factory()": "the sim-time concept's loop",
+    "FakeHardware()": "the HAL concept's fake",
     "def test_the_navigator_still_decides_the_same": "the replay regression suite",
     "async for record in sweep_results": "the sweep from Python",
     "async def watch": "the live embedding",
@@ -49,23 +64,23 @@ def test_every_python_block_has_a_runner() -> None:
     assert len(BLOCKS) >= len(RUNNERS)
     for block in BLOCKS:
         claimed = [marker for marker in RUNNERS if marker in block]
-        assert len(claimed) == 1, f"no runner (or several) for this README block:\n{block}"
+        assert len(claimed) == 1, f"no runner (or several) for this docs block:\n{block}"
 
 
-def test_the_test_extra_is_what_the_readme_says() -> None:
+@pytest.mark.parametrize("extra", ["test", "can", "foxglove", "ray", "service", "docs"])
+def test_each_extra_adds_what_the_install_page_says(extra: str) -> None:
     extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
-    names = {re.split(r"[<>=\[]", dep)[0] for dep in extras["optional-dependencies"]["test"]}
-    said = re.search(r"`test` extra, which adds ([^:]*?):", README.replace("\n", " "))
-    assert said is not None
-    listed = set(re.findall(r"[a-z][a-z0-9-]+", said.group(1).replace(" and ", ", ")))
-    assert listed == names
+    names = {re.split(r"[<>=\[]", dep)[0] for dep in extras["optional-dependencies"][extra]}
+    row = re.search(rf"^\| `{extra}` \| ([^|]*) \|", INSTALL, flags=re.MULTILINE)
+    assert row is not None, f"install.md has no row for the {extra} extra"
+    assert set(re.findall(r"[a-z][a-z0-9-]+", row.group(1))) == names
 
 
-def test_the_pytest_example_passes_and_its_failure_reads_as_the_readme_says(
+def test_the_first_test_passes_and_its_failure_reads_as_the_page_says(
     pytester: pytest.Pytester,
 ) -> None:
     pytester.makeini(INI)
-    block = _block("def test_reaches_the_goal")
+    block = _block("def test_reaches_the_goal(")
     pytester.makepyfile(test_my_robot=block)
     passed = pytester.runpytest_subprocess("-q", "-p", "no:cacheprovider")
     passed.assert_outcomes(passed=2)
@@ -80,9 +95,34 @@ def test_the_pytest_example_passes_and_its_failure_reads_as_the_readme_says(
     assert "SimTimeoutError" in text
     assert "otonav artifacts" in text
     assert list((pytester.path / "kept").rglob("trajectory.png"))
-    # What the README says about the error's type is true:
-    says_group = "ExceptionGroup" in README.split("## Scenario files")[0].split("def test_")[-1]
-    assert says_group == ("ExceptionGroup" in text)
+    # What the page says about the error's type is true:
+    assert ("ExceptionGroup" in FIRST_TEST) == ("ExceptionGroup" in text)
+    assert "The error is the plain `SimTimeoutError`" in FIRST_TEST
+
+
+def test_the_readme_example_passes(pytester: pytest.Pytester) -> None:
+    pytester.makeini(INI)
+    pytester.makepyfile(test_readme=_block("def test_reaches_the_goal_in_20_s"))
+    pytester.runpytest_subprocess("-q", "-p", "no:cacheprovider").assert_outcomes(passed=1)
+
+
+def test_the_tutorials_node_test_passes(pytester: pytest.Pytester) -> None:
+    pytester.makeini(INI)
+    shutil.copytree(ROOT / "examples" / "my_nodes", pytester.path / "examples" / "my_nodes")
+    pytester.makepyfile(test_my_node=_block("def test_my_planner_arrives"))
+    pytester.runpytest_subprocess("-q", "-p", "no:cacheprovider").assert_outcomes(passed=1)
+
+
+@pytest.mark.parametrize(
+    ("marker", "printed"),
+    [("virtual_loop_factory()", "3600.0\n"), ("FakeHardware()", "left_velocity=1.0")],
+    ids=["sim-time", "hal"],
+)
+def test_a_script_example_prints_what_its_comment_says(marker: str, printed: str) -> None:
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        exec(compile(_block(marker), "docs", "exec"), {"__name__": "docs"})
+    assert printed in out.getvalue()
 
 
 def test_the_replay_regression_suite_runs(pytester: pytest.Pytester) -> None:
@@ -102,17 +142,17 @@ def test_the_replay_regression_suite_runs(pytester: pytest.Pytester) -> None:
 def _run_async(source: str, call: str | None) -> str:
     """Run a block: its ``call`` coroutine function, or the block itself as a notebook
     cell (top-level await); return what it printed."""
-    namespace: dict[str, Any] = {"__name__": "readme"}
+    namespace: dict[str, Any] = {"__name__": "docs"}
     printed = io.StringIO()
     with contextlib.redirect_stdout(printed):
         if call is None:
             flags = ast.PyCF_ALLOW_TOP_LEVEL_AWAIT
-            code = compile(source, "README.md", "exec", flags=flags)
+            code = compile(source, "docs", "exec", flags=flags)
             result = eval(code, namespace)  # a coroutine: the cell's top-level awaits
             if result is not None:
                 asyncio.run(result)
         else:
-            exec(compile(source, "README.md", "exec"), namespace)
+            exec(compile(source, "docs", "exec"), namespace)
             asyncio.run(namespace[call]())
     return printed.getvalue()
 
@@ -153,6 +193,6 @@ def test_an_embedding_example_runs(
 
 def test_the_world_generator_example_runs() -> None:
     namespace: dict[str, Any] = {}
-    exec(compile(_block("generate_world(7, DENSE)"), "README.md", "exec"), namespace)
+    exec(compile(_block("generate_world(7, DENSE)"), "docs", "exec"), namespace)
     assert namespace["world"].reachable
     assert [w.scenario.expect for w in namespace["family"]] == ["unreachable"] * 3
