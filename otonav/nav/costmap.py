@@ -79,6 +79,9 @@ class ClearanceMap:
         self._k = k
         kernel = np.hypot(offsets[:, None], offsets[None, :])
         slack = resolution * math.sqrt(2.0)
+        self.slack = slack
+        """m: how far :meth:`clearance` may fall short of the distance between the
+        query point and the return that set it (each may sit anywhere in its cell)."""
         # min over returns of max(d - slack, 0) is max(min d - slack, 0): stamping the
         # slack-reduced disk keeps the lower bound exact under np.minimum.
         self._kernel = np.where(
@@ -193,6 +196,14 @@ class ClearanceMap:
         cleared = int(rr.size)
         self.cleared += cleared
         return cleared
+
+    def interior(self) -> NDArray[np.float32]:
+        """:meth:`clearance` at every map cell (a read-only view, rows = y): the
+        global planner pools it into its coarser grid (:mod:`otonav.nav.plan_grid`)."""
+        pad = self._pad
+        view = self._lower[pad : pad + self.size, pad : pad + self.size]
+        view.flags.writeable = False
+        return view
 
     def coarse(self, stride: int) -> NDArray[np.float32]:
         """clearance() at the centre cell of every ``stride`` x ``stride`` block: the

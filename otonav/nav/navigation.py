@@ -42,9 +42,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from otonav.nav.costmap import ClearanceMap
-from otonav.nav.dwa import DwaParams, DwaResult, clear_arc, dwa_step
+from otonav.nav.dwa import ClearanceFn, DwaParams, DwaResult, clear_arc, dwa_step
 from otonav.nav.geometry import wrap_angle
-from otonav.nav.global_path import astar
+from otonav.nav.global_path import AstarSearch, GridPath
+from otonav.nav.local_clearance import local_clearance, nearby
+from otonav.nav.plan_grid import best_points, free_threshold, pooled
 from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
 from otonav.nav.scan import ScanRays
 
@@ -76,6 +78,9 @@ class NavigationParams:
         replan_period: blocked-path check period, s.
         lookahead: the DWA's target is this far along the path, m.
         max_expansions: A* gives up (no proof either way) after this many cells.
+        expansions_per_tick: A* expands at most this many cells per step; a search
+            that needs more goes on at the next step (the robot follows the previous
+            path, or heads for the goal, meanwhile; the DWA keeps it clear).
         clear_range: before a replan, occupied cells within this distance of the laser
             that the last observed scan saw through are cleared (ADR 0026), m; 0: the
             map never clears.
@@ -104,6 +109,7 @@ class NavigationParams:
     replan_period: float = 0.5
     lookahead: float = 0.8
     max_expansions: int = 60_000
+    expansions_per_tick: int = 600
     clear_range: float = 3.0
     progress_distance: float = 0.3
     progress_window: float = 4.0
@@ -169,6 +175,11 @@ class Navigation:
     _gave_up: str | None = None
     _stride: int = field(init=False)
     _rays: ScanRays | Callable[[], ScanRays] | None = None
+    _returns: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+    _search: AstarSearch | None = None
+    expansions: int = 0
+    """A* cells expanded so far, over all searches."""
+    _replan_now: bool = True
     _reached: bool = False
 
     def __post_init__(self) -> None:
@@ -191,6 +202,8 @@ class Navigation:
         if goal != self.goal:
             self.goal = goal
             self.path = None
+            self._search = None
+            self._replan_now = True
             self._gave_up = None
             self._reached = False
             self._stage = None
@@ -211,8 +224,15 @@ class Navigation:
         if rays is not None:
             self._rays = rays
         if isinstance(points_odom, tuple):
+            self._returns = points_odom
             return self.map.mark_xy(*points_odom)
+        self._returns = (points_odom[:, 0], points_odom[:, 1])
         return self.map.mark(points_odom)
+
+    @property
+    def searching(self) -> bool:
+        """A global search is in progress (it goes on at the next step)."""
+        return self._search is not None
 
     # -- the step ----------------------------------------------------------------------
 
@@ -250,9 +270,16 @@ class Navigation:
         due = now - self._checked_at >= self.params.replan_period
         if due:
             self._checked_at = now
-        replan = self.path is None or (due and self._path_blocked(pose))
-        if replan:
-            proven_none = self._plan(now, pose)
+        if self._search is None and (
+            self._replan_now or (due and (self.path is None or self._path_blocked(pose)))
+        ):
+            self._start_search(now, pose)
+        if self._search is not None:
+            search = self._search
+            done = search.expansions
+            planned = search.advance(self.params.expansions_per_tick)
+            self.expansions += search.expansions - done
+            proven_none = planned is not None and self._adopt(planned, pose)
             if proven_none:
                 if not self._looked_around:
                     self._looked_around = True
@@ -279,7 +306,7 @@ class Navigation:
             clear_arc(pose, v0, omega0, target, distance, self.map.clearance_at, dwa)
             if dwa.fast_path
             else None
-        ) or dwa_step(pose, v0, omega0, target, distance, self.map.clearance, dwa)
+        ) or dwa_step(pose, v0, omega0, target, distance, self._local_clearance(pose), dwa)
         if result.admissible == 0:
             state = "blocked"
         else:
@@ -328,12 +355,22 @@ class Navigation:
         self._stage = None
         return self._out(0.0, 0.0, "unreachable", reason, distance, heading)
 
+    def _local_clearance(self, pose: tuple[float, float, float]) -> ClearanceFn:
+        """The DWA's distances: exact to the latest scan's returns near the robot, the
+        map's elsewhere (:mod:`otonav.nav.local_clearance`)."""
+        dwa = self.params.dwa
+        if self._returns is None:
+            return self.map.clearance
+        reach = dwa.max_v * dwa.horizon + dwa.radius + 0.1
+        rx, ry = nearby(*self._returns, pose[0], pose[1], reach)
+        return local_clearance(self.map.clearance, self.map.slack, dwa.radius, rx, ry)
+
     def _free_grid(self) -> tuple[NDArray[np.bool_], NDArray[np.float32]]:
         # float32 like the map, np.minimum/np.maximum for np.clip: on the 200 x 200
         # grid the conversions were most of a replan's set-up.
-        coarse = self.map.coarse(self._stride)
+        coarse = pooled(self.map.interior(), self._stride)
         radius = self.params.dwa.radius
-        free = coarse >= radius
+        free = coarse >= np.float32(free_threshold(radius, self.map.resolution))
         room = self.params.dwa.clearance_cap
         gap = np.minimum(np.maximum(np.float32(radius + room) - coarse, 0.0), room)
         penalty = gap * np.float32(self.params.plan_penalty / room)
@@ -343,13 +380,14 @@ class Navigation:
         s, res = self._stride, self.map.resolution
         col = math.floor((x - self.map.origin_x) / (res * s))
         row = math.floor((y - self.map.origin_y) / (res * s))
-        n = self.map.coarse(s).shape[0]
+        n = self.map.size // s
         return min(max(row, 0), n - 1), min(max(col, 0), n - 1)
 
-    def _plan(self, now: float, pose: tuple[float, float, float]) -> bool:
-        """Replan; True when the search proved there is no path."""
+    def _start_search(self, now: float, pose: tuple[float, float, float]) -> None:
+        """Begin a replan (it may take several steps: :meth:`step` advances it)."""
         assert self.goal is not None
         self._planned_at = self._checked_at = now
+        self._replan_now = False
         self.replans += 1
         if self._rays is not None and self.params.clear_range > 0.0:
             rays = self._rays() if callable(self._rays) else self._rays
@@ -358,21 +396,27 @@ class Navigation:
                 rays, reach=self.params.clear_range, margin=2.0 * self.map.resolution
             )
         free, penalty = self._free_grid()
-        result = astar(
+        self._search = AstarSearch(
             free,
             penalty,
             self._coarse_cell(pose[0], pose[1]),
             self._coarse_cell(*self.goal),
             max_expansions=self.params.max_expansions,
         )
+
+    def _adopt(self, result: GridPath, pose: tuple[float, float, float]) -> bool:
+        """Take a finished search's path; True when it proved there is none."""
+        assert self.goal is not None
+        self._search = None
         if not result.found:
             self.path = None
             return result.exhausted
-        s, res = self._stride, self.map.resolution
-        cells = np.asarray(result.cells, dtype=np.float64)
+        cells = np.asarray(result.cells, dtype=np.intp)
+        rows, cols = best_points(self.map.interior(), self._stride, cells[:, 0], cells[:, 1])
+        res = self.map.resolution
         xy = np.empty((cells.shape[0], 2))
-        xy[:, 0] = self.map.origin_x + (cells[:, 1] * s + s // 2 + 0.5) * res
-        xy[:, 1] = self.map.origin_y + (cells[:, 0] * s + s // 2 + 0.5) * res
+        xy[:, 0] = self.map.origin_x + (cols + 0.5) * res
+        xy[:, 1] = self.map.origin_y + (rows + 0.5) * res
         xy[0] = pose[:2]
         xy[-1] = self.goal
         self.path = xy
@@ -386,7 +430,10 @@ class Navigation:
         if ahead.shape[0] == 0:
             return False
         clear = self.map.clearance(ahead[:, 0], ahead[:, 1])
-        return bool((clear[:-1] < self.params.dwa.radius).any()) if clear.size > 1 else False
+        if clear.size <= 1:
+            return False
+        limit = free_threshold(self.params.dwa.radius, self.map.resolution)
+        return bool((clear[:-1] < limit).any())
 
     def _ahead(self, pose: tuple[float, float, float]) -> NDArray[np.float64]:
         assert self.path is not None
@@ -475,5 +522,7 @@ class Navigation:
             self._stage = None
             self._checker.reset()
             self.path = None  # replan from here
+            self._search = None
+            self._replan_now = True
             return None
         return self._out(v, omega, "recovering", st.name, distance, heading)

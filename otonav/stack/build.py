@@ -258,6 +258,7 @@ def navigation_params(config: StackConfig, geometry: RobotGeometry) -> Navigatio
         replan_period=grid.replan_period,
         lookahead=grid.lookahead,
         max_expansions=grid.max_expansions,
+        expansions_per_tick=grid.expansions_per_tick,
         clear_range=grid.clear_range,
         progress_distance=rec.progress_distance,
         progress_window=rec.progress_window,

@@ -213,13 +213,21 @@ def test_navigation_replans_through_a_phantom_once_a_scan_sees_through_it() -> N
     nav = Navigation(NavigationParams(), (0.0, 0.0))
     nav.set_goal((3.0, 0.0))
     nav.observe(_wall(1.5, -3.0, 3.0))  # a wall across the way, long enough to detour
-    nav.step(0.0, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
+    t = 0.0
+    nav.step(t, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
+    while nav.searching:  # a search spans steps (expansions_per_tick)
+        t += 0.05
+        nav.step(t, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
     assert nav.path is not None
     detour = nav.path_length
     assert detour > 4.0
     nav.observe(np.empty((0, 2)), _rays(np.full(360, np.inf)))  # the wall is gone
-    nav.path = None  # next step replans (as after a blocked-path check)
-    nav.step(0.1, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
+    nav.path = None  # the next check replans (as after a blocked-path check)
+    t += 0.5
+    nav.step(t, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
+    while nav.searching:
+        t += 0.05
+        nav.step(t, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
     assert nav.map.cleared > 0
     assert nav.path_length == pytest.approx(3.0, abs=0.2)
 
