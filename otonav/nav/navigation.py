@@ -50,7 +50,7 @@ from otonav.nav.plan_grid import best_points, free_threshold, pooled
 from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
 from otonav.nav.scan import ScanRays
 
-__all__ = ("LADDER", "NavOutput", "Navigation", "NavigationParams", "Points")
+__all__ = ("LADDER", "TURN_CREDIT", "NavOutput", "Navigation", "NavigationParams", "Points")
 
 Points = NDArray[np.float64] | Callable[[], NDArray[np.float64]]
 """Scan returns in base_link, ``(N, 2)`` m, or a function that computes them."""
@@ -59,6 +59,9 @@ Points = NDArray[np.float64] | Callable[[], NDArray[np.float64]]
 def _resolve(points: Points) -> NDArray[np.float64]:
     return points() if callable(points) else points
 
+
+TURN_CREDIT = 0.25
+"""m of progress per radian turned toward the target (a half turn: 0.8 m)."""
 
 LADDER = ("spin", "backup", "follow")
 """The recovery stages, in order."""
@@ -85,8 +88,11 @@ class NavigationParams:
             that the last observed scan saw through are cleared (ADR 0026), m; 0: the
             map never clears.
         progress_distance: progress that counts, m.
-        progress_window: time to move ``progress_distance``, s.
+        progress_window: time to shrink the distance to go (along the path) by
+            ``progress_distance``, s (:class:`~otonav.nav.recovery.ProgressChecker`).
         goal_progress_window: time to get ``progress_distance`` closer to the goal, s.
+        clear_radius: the spin rung first clears the map within this distance of the
+            robot, m (0: never).
         spin_angle: the look-around turn, rad.
         spin_speed: its yaw rate, rad/s.
         backup_distance: the back-up distance, m.
@@ -112,15 +118,16 @@ class NavigationParams:
     expansions_per_tick: int = 600
     clear_range: float = 3.0
     progress_distance: float = 0.3
-    progress_window: float = 4.0
-    goal_progress_window: float = 15.0
+    progress_window: float = 3.5
+    goal_progress_window: float = 30.0
     spin_angle: float = math.pi / 2
     spin_speed: float = 1.0
     backup_distance: float = 0.3
-    backup_speed: float = 0.1
-    follow_time: float = 8.0
+    backup_speed: float = 0.15
+    follow_time: float = 5.0
     follow_speed: float = 0.2
     follow_distance: float = 0.45
+    clear_radius: float = 1.0
     approach_radius: float = 0.25
     kp_lin: float = 0.8
     kp_ang: float = 2.0
@@ -152,6 +159,7 @@ class _Stage:
     yaw: float
     goal_distance: float
     side: int = 1
+    why: str = ""
 
 
 @dataclass(slots=True)
@@ -171,6 +179,9 @@ class Navigation:
     _looked_around: bool = False
     _ladder: int = 0
     _ladder_best: float = math.inf
+    _ladder_to_go: float | None = None
+    _remaining: NDArray[np.float64] | None = None
+    _new_path: bool = False
     _stage: _Stage | None = None
     _gave_up: str | None = None
     _stride: int = field(init=False)
@@ -209,6 +220,7 @@ class Navigation:
             self._stage = None
             self._ladder = 0
             self._ladder_best = math.inf
+            self._ladder_to_go = None
             self._looked_around = False
             self._checker.reset()
 
@@ -284,23 +296,43 @@ class Navigation:
                 if not self._looked_around:
                     self._looked_around = True
                     return self._begin(
-                        "spin", now, pose, distance, heading, points, "no path, looking around"
+                        "spin", now, pose, distance, heading, points, "look-around, no path"
                     )
                 return self._give_up("no path to the goal in the observed map", distance, heading)
-        stuck = self._checker.update(now, x, y, distance)
-        if distance <= self._ladder_best - self.params.progress_distance:
-            self._ladder, self._ladder_best = 0, distance
-        if stuck is not None:
+        to_go = self._to_go(pose, distance)
+        target = self._target(pose)
+        # Turning toward the way on counts too (a robot facing away from a new path
+        # turns in place first): TURN_CREDIT m per radian of bearing to the target.
+        bearing = abs(wrap_angle(math.atan2(target[1] - y, target[0] - x) - yaw))
+        measure = to_go + TURN_CREDIT * bearing
+        if self._new_path:  # new knowledge is not progress, and not a lack of it
+            self._new_path = False
+            self._checker.rebase(measure)
+            if self._ladder_to_go is not None and to_go > self._ladder_to_go:
+                self._ladder_to_go = to_go
+        stuck = self._checker.update(now, measure, distance)
+        if self._ladder_to_go is None:
+            self._ladder_to_go = to_go
+        # The ladder starts over after real progress: a progress distance closer to
+        # the goal than where it began, or three along the path since the last rung.
+        if distance <= self._ladder_best - self.params.progress_distance or (
+            to_go <= self._ladder_to_go - 3.0 * self.params.progress_distance
+        ):
+            self._ladder, self._ladder_best, self._ladder_to_go = 0, distance, to_go
+        if stuck is not None and not (self._search is not None and self.path is None):
+            # (while the first search for a path is still running, the robot heads for
+            # the goal and the verdict waits for it: at most max_expansions /
+            # expansions_per_tick steps)
             if self._ladder >= len(LADDER):
                 return self._give_up(
                     f"no progress after {', '.join(LADDER)} ({stuck})", distance, heading
                 )
             stage = LADDER[self._ladder]
             self._ladder += 1
-            return self._begin(stage, now, pose, distance, heading, points, stuck)
+            why = f"rung {self._ladder}/{len(LADDER)}, {stuck}"
+            return self._begin(stage, now, pose, distance, heading, points, why)
         if distance < self.params.approach_radius:
             return self._approach(distance, heading)
-        target = self._target(pose)
         dwa = self.params.dwa
         result = (
             clear_arc(pose, v0, omega0, target, distance, self.map.clearance_at, dwa)
@@ -420,8 +452,23 @@ class Navigation:
         xy[0] = pose[:2]
         xy[-1] = self.goal
         self.path = xy
-        self.path_length = float(np.hypot(*np.diff(xy, axis=0).T).sum())
+        legs = np.hypot(*np.diff(xy, axis=0).T)
+        self.path_length = float(legs.sum())
+        remaining = np.zeros(xy.shape[0])
+        remaining[:-1] = np.cumsum(legs[::-1])[::-1]
+        self._remaining = remaining
+        self._new_path = True
         return False
+
+    def _to_go(self, pose: tuple[float, float, float], distance: float) -> float:
+        """Distance to go, m: along the path from its point nearest the robot, or
+        straight to the goal without a path."""
+        path, remaining = self.path, self._remaining
+        if path is None or remaining is None:
+            return distance
+        d = np.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1])
+        i = int(d.argmin())
+        return float(d[i] + remaining[i])
 
     def _path_blocked(self, pose: tuple[float, float, float]) -> bool:
         if self.path is None:
@@ -469,23 +516,16 @@ class Navigation:
             side = boundary_side(_resolve(points), heading)
         else:
             side = 1 if heading >= 0 else -1
-        self._stage = _Stage(name, now, pose[0], pose[1], pose[2], distance, side)
+        self._stage = _Stage(name, now, pose[0], pose[1], pose[2], distance, side, why)
         if self._ladder_best == math.inf:
             self._ladder_best = distance
+        if name == "spin" and self.params.clear_radius > 0.0:
+            # Nav2's first recovery: forget the map around the robot (a smeared wall,
+            # a misread), and look around to see it again.
+            self.map.clear_near(pose[0], pose[1], self.params.clear_radius)
         out = self._recover(now, pose, distance, heading, points)
         assert out is not None
-        return NavOutput(
-            out.v,
-            out.omega,
-            out.state,
-            f"{name}: {why}",
-            distance,
-            heading,
-            None,
-            name,
-            out.path_length,
-            out.replans,
-        )
+        return out
 
     def _recover(
         self,
@@ -503,11 +543,11 @@ class Navigation:
         v = omega = 0.0
         if st.name == "spin":
             turned = abs(wrap_angle(pose[2] - st.yaw))
-            done = turned >= p.spin_angle - 0.05 or elapsed > p.spin_angle / p.spin_speed + 2.0
+            done = turned >= p.spin_angle - 0.05 or elapsed > p.spin_angle / p.spin_speed + 0.5
             omega = st.side * p.spin_speed
         elif st.name == "backup":
             moved = math.hypot(pose[0] - st.x, pose[1] - st.y)
-            done = moved >= p.backup_distance or elapsed > p.backup_distance / p.backup_speed + 2.0
+            done = moved >= p.backup_distance or elapsed > p.backup_distance / p.backup_speed + 0.5
             v = -p.backup_speed
         else:
             done = elapsed > p.follow_time or distance <= st.goal_distance - p.progress_distance
@@ -524,5 +564,6 @@ class Navigation:
             self.path = None  # replan from here
             self._search = None
             self._replan_now = True
+            self._ladder_to_go = None
             return None
-        return self._out(v, omega, "recovering", st.name, distance, heading)
+        return self._out(v, omega, "recovering", f"{st.name}: {st.why}", distance, heading)

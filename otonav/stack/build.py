@@ -270,6 +270,7 @@ def navigation_params(config: StackConfig, geometry: RobotGeometry) -> Navigatio
         follow_time=rec.follow_time,
         follow_speed=rec.follow_speed,
         follow_distance=rec.follow_distance,
+        clear_radius=rec.clear_radius,
         approach_radius=nav.approach_radius,
         kp_lin=nav.kp_lin,
         kp_ang=nav.kp_ang,

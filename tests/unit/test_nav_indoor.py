@@ -140,3 +140,70 @@ def test_proving_no_path_is_spread_over_steps_each_within_its_budget() -> None:
     assert out.stage == "spin"
     assert "no path" in out.reason
     assert steps > 10  # the proof took many steps (about 40 000 cells)
+
+
+# -- no stalls -----------------------------------------------------------------------
+
+
+def _drive(
+    nav: Navigation, motion: object, until: float, stop: object
+) -> tuple[float, list[tuple[float, str, str, str]]]:
+    """Step at 20 Hz with the pose ``motion(t)`` (what the robot really does, whatever
+    is commanded) until ``stop(out)`` or ``until`` s; returns the time and the log."""
+    log: list[tuple[float, str, str, str]] = []
+    t = 0.0
+    while t < until:
+        out = nav.step(t, motion(t), 0.0, 0.0, NONE)  # type: ignore[operator]
+        log.append((t, out.state, out.stage, out.reason))
+        if stop(out):  # type: ignore[operator]
+            return t, log
+        t = round(t + 0.05, 6)
+    return t, log
+
+
+def test_a_robot_oscillating_across_its_path_is_in_recovery_within_the_window() -> None:
+    """It moves all the time (0.4 m side to side) but gets no nearer along the path:
+    the progress check looks at what the robot does, not how much it moves."""
+    params = _params()
+    nav = Navigation(params, (0.0, 0.0))
+    nav.set_goal((4.0, 0.0))
+    t, log = _drive(
+        nav,
+        lambda t: (0.0, 0.2 * math.sin(2.0 * t), 0.0),
+        30.0,
+        lambda out: out.state == "recovering",
+    )
+    assert log[-1][1] == "recovering", log[-1]
+    assert t <= params.progress_window + 0.05
+    assert "rung 1/3" in log[-1][3]
+
+
+def test_a_stuck_robot_climbs_the_whole_ladder_in_about_20_s_and_says_why() -> None:
+    """Wheels spinning in place: every rung runs, each named with its reason in the
+    diagnostics while it runs, and the verdict comes within ~24 s of sim time."""
+    params = _params()
+    nav = Navigation(params, (0.0, 0.0))
+    nav.set_goal((4.0, 0.0))
+    t, log = _drive(nav, lambda t: (0.0, 0.0, 0.0), 60.0, lambda out: out.state == "unreachable")
+    assert log[-1][1] == "unreachable", log[-1]
+    assert t <= 24.0
+    assert "no progress after spin, backup, follow" in log[-1][3]
+    rungs = [(stage, reason) for _, state, stage, reason in log if state == "recovering"]
+    assert [s for s, _ in dict.fromkeys(rungs)][:1] == ["spin"]
+    for k, name in enumerate(("spin", "backup", "follow"), 1):
+        reasons = {reason for stage, reason in rungs if stage == name}
+        assert reasons, name
+        assert all(r.startswith(f"{name}: rung {k}/3, ") for r in reasons), reasons
+
+
+def test_the_spin_rung_clears_the_map_around_the_robot() -> None:
+    params = _params()
+    nav = Navigation(params, (0.0, 0.0))
+    nav.set_goal((4.0, 0.0))
+    nav.observe(_segment(0.6, -0.3, 0.6, 0.3))  # a smear just ahead, and a far wall
+    nav.observe(_segment(3.0, 2.0, 3.0, 3.0))
+    far = int(nav.map.occupied.sum())
+    _drive(nav, lambda t: (0.0, 0.0, 0.0), 10.0, lambda out: out.stage == "spin")
+    row, col, _ = nav.map.cell_of(np.array([0.6]), np.array([0.0]))
+    assert not nav.map.occupied[row, col].any()  # the smear is gone
+    assert 0 < int(nav.map.occupied.sum()) < far
