@@ -115,7 +115,7 @@ class NavigationParams:
     replan_period: float = 0.5
     lookahead: float = 0.8
     max_expansions: int = 60_000
-    expansions_per_tick: int = 400
+    expansions_per_tick: int = 600
     clear_range: float = 3.0
     progress_distance: float = 0.3
     progress_window: float = 3.5

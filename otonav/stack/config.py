@@ -134,7 +134,7 @@ class MapConfig(_Section):
     """m, the DWA heads for the path point this far ahead, in (0, 10]."""
     max_expansions: int = Field(60_000, ge=100, le=10_000_000)
     """A* gives up (no proof either way) after this many cells, in [100, 1e7]."""
-    expansions_per_tick: int = Field(400, ge=10, le=10_000_000)
+    expansions_per_tick: int = Field(600, ge=10, le=10_000_000)
     """A* expands at most this many cells per navigator step; a longer search goes on
     at the next step (bounded tick time, ADR 0043), in [10, 1e7]."""
     clear_range: float = Field(3.0, ge=0.0, le=100.0)
