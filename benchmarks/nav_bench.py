@@ -1,21 +1,31 @@
-"""Navigation on generated worlds: success, clearance and the BARN metric per density.
+"""Navigation on generated worlds: success, clearance, planner tick time and the BARN
+metric per family.
 
     python benchmarks/nav_bench.py [--worlds 200] [--walled 50] [--workers 2]
-        [--seed0 0] [--set nav.planner=stop] [--failures DIR] [--json FILE]
+        [--families sparse dense rooms ...] [--seed0 0] [--set nav.planner=stop]
+        [--failures DIR] [--json FILE]
 
-For each density (``sparse``, ``dense``: otonav.scenario.generator presets) it runs
-``--worlds`` generated worlds (seeds seed0 .. seed0 + worlds - 1, each redrawn until a
-path exists for the footprint) and ``--walled`` walled-in worlds of the same density
-(the goal inside a closed ring: the navigator must report ``unreachable``), headless in
-virtual time with the default stack (``--set`` overrides it), on a process pool. Every
-world is rebuilt from its seed in the worker, so results do not depend on the worker
-count. Prints a Markdown table, the failures by kind with a few seeds each, and (with
-``--failures DIR``) re-runs each failure with its recording and plot into DIR, next to
-its scenario YAML (repro: ``otonav run --scenario DIR/NAME.yaml``).
+Families: the box densities ``sparse`` and ``dense`` (otonav.scenario.generator
+presets; each also runs ``--walled`` walled-in worlds of its density) and the indoor
+families of otonav.scenario.generator_indoor (rooms with doors, long walls with the
+start facing them, U traps, dead ends, slaloms down to the passable limit, alcove and
+corner goals, walled-in rooms), ``--worlds`` each (seeds seed0 .. seed0 + worlds - 1),
+headless in virtual time with the default stack (``--set`` overrides it), on a process
+pool. Every world is rebuilt from its seed in the worker, so results do not depend on
+the worker count.
 
-Targets (issue 10): success >= 95 % of the reachable worlds, zero clearance violations,
-walled-in >= 95 % reported unreachable before the budget. Anchor: BARN's DWA baseline,
-88 % success, 4.8 % collisions.
+Prints a Markdown table, one row per family: success on the reachable worlds,
+walled-in worlds reported unreachable within the budget, clearance violations, false
+``reached`` (the navigator said reached, the judge did not), the planner's tick time
+(the navigator's map update and decision per step, wall clock: p99 and max over every
+tick of the family) and the median real-time factor, next to the acceptance
+scenario's RTF measured in the same run. Then the failures by kind with a few seeds
+each; ``--failures DIR`` re-runs them with recordings into DIR next to their scenario
+YAML (repro: ``otonav run --scenario DIR/NAME.yaml``).
+
+Targets (issue 24): >= 97 % success on reachable worlds, >= 98 % of unreachable worlds
+reported, 0 clearance violations, 0 false reached, planner tick p99 <= 5 ms and max
+<= 20 ms on the densest family, its median RTF >= 0.5 x the acceptance scenario's.
 """
 
 from __future__ import annotations
@@ -23,24 +33,50 @@ from __future__ import annotations
 import argparse
 import json
 import multiprocessing
+import statistics
 import sys
 import time
 from collections import Counter, defaultdict
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import Any
 
+import numpy as np
 import yaml
 
+from otonav.nav.navigation import Navigation
 from otonav.scenario import run_scenario
-from otonav.scenario.generator import PRESETS, WorldParams, generate_world, walled_in
+from otonav.scenario.config import ScenarioConfig
+from otonav.scenario.generator import (
+    PRESETS,
+    GeneratedWorld,
+    WorldParams,
+    generate_world,
+    walled_in,
+)
+from otonav.scenario.generator_indoor import INDOOR_FAMILIES, generate_indoor
 from otonav.scenario.generator_report import FamilyRow, RunResult, summarise
 from otonav.stack import StackConfig
 from otonav.stack.overrides import apply_overrides
 
+BOXES = ("sparse", "dense")
+FAMILIES = (*BOXES, *INDOOR_FAMILIES)
+
 Task = tuple[str, int, bool, tuple[str, ...]]
-"""(density, seed, walled_in, --set overrides)"""
+"""(family, seed, walled_in (box families only), --set overrides)"""
+
+
+@dataclass(frozen=True, slots=True)
+class Run:
+    """One run's figures plus what the judge's verdict alone does not say."""
+
+    result: RunResult
+    ticks_ms: tuple[float, ...]
+    """The planner's work per navigator step (map update + decision), ms of wall time."""
+    rtf: float
+    false_reached: bool
 
 
 def _params(density: str, walled: bool) -> WorldParams:
@@ -48,19 +84,64 @@ def _params(density: str, walled: bool) -> WorldParams:
     return walled_in(base) if walled else base
 
 
+def _world(family: str, seed: int, walled: bool) -> GeneratedWorld:
+    if family in BOXES:
+        return generate_world(seed, _params(family, walled))
+    return generate_indoor(seed, family)
+
+
 def _stack(overrides: tuple[str, ...]) -> StackConfig:
     return apply_overrides(StackConfig(), list(overrides)) if overrides else StackConfig()
 
 
-def run_one(task: Task) -> RunResult:
+class _TickClock:
+    """Times Navigation.observe + Navigation.step per navigator step (a benchmark may
+    read the wall clock; robot code may not)."""
+
+    def __init__(self) -> None:
+        self.ticks: list[float] = []
+        self._pending = 0.0
+        self._saved: tuple[Callable[..., Any], Callable[..., Any]] | None = None
+
+    def __enter__(self) -> _TickClock:
+        observe, step = Navigation.observe, Navigation.step
+        self._saved = (observe, step)
+        clock = self
+
+        def timed_observe(nav: Navigation, *a: Any, **k: Any) -> int:
+            t = time.perf_counter()
+            try:
+                return observe(nav, *a, **k)
+            finally:
+                clock._pending += time.perf_counter() - t
+
+        def timed_step(nav: Navigation, *a: Any, **k: Any) -> Any:
+            t = time.perf_counter()
+            try:
+                return step(nav, *a, **k)
+            finally:
+                clock.ticks.append(1e3 * (time.perf_counter() - t + clock._pending))
+                clock._pending = 0.0
+
+        Navigation.observe = timed_observe  # type: ignore[method-assign,assignment]
+        Navigation.step = timed_step  # type: ignore[method-assign,assignment]
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        assert self._saved is not None
+        Navigation.observe, Navigation.step = self._saved  # type: ignore[method-assign]
+
+
+def run_one(task: Task) -> Run:
     """Rebuild the world from its seed and run it (in a worker process)."""
-    density, seed, walled, overrides = task
-    world = generate_world(seed, _params(density, walled))
-    verdict = run_scenario(
-        world.scenario, _stack(overrides), record=False, plot=False, wall_ceiling=900.0
-    )
-    return RunResult.of(
-        density,
+    family, seed, walled, overrides = task
+    world = _world(family, seed, walled)
+    with _TickClock() as clock:
+        verdict = run_scenario(
+            world.scenario, _stack(overrides), record=False, plot=False, wall_ceiling=900.0
+        )
+    result = RunResult.of(
+        family,
         world,
         passed=verdict.passed,
         reached=verdict.reached,
@@ -72,9 +153,15 @@ def run_one(task: Task) -> RunResult:
         wall_time_s=verdict.wall_time_s,
         reason=verdict.reason,
     )
+    return Run(
+        result,
+        tuple(round(t, 4) for t in clock.ticks),
+        verdict.sim_time_s / max(verdict.wall_time_s, 1e-9),
+        verdict.nav_state == "reached" and not verdict.reached,
+    )
 
 
-def _results(tasks: list[Task], workers: int) -> Iterator[RunResult]:
+def _results(tasks: list[Task], workers: int) -> Iterator[Run]:
     if workers <= 1:
         yield from map(run_one, tasks)
         return
@@ -87,29 +174,34 @@ def _fmt(value: float | None, spec: str) -> str:
     return "-" if value is None else format(value, spec)
 
 
-def table(rows: list[FamilyRow]) -> str:
+def table(rows: list[tuple[FamilyRow, list[Run]]]) -> str:
     head = (
-        "| density | worlds | reachable | success (% of reachable) | BARN metric "
-        "| time / optimal (median) "
-        "| timeouts | false unreachable | clearance violations (all runs) "
-        "| walled-in reported unreachable | walled-in timeouts |"
+        "| family | worlds | reachable | success (% of reachable) | BARN metric "
+        "| time / optimal (median) | timeouts | false unreachable "
+        "| unreachable reported | clearance violations | false reached "
+        "| tick p99 / max (ms) | RTF (median) |"
     )
     lines = [head, "|" + "|".join("---" for _ in range(head.count("|") - 1)) + "|"]
-    for r in rows:
+    for r, runs in rows:
+        ticks = np.fromiter((t for run in runs for t in run.ticks_ms), dtype=np.float64)
+        p99 = float(np.percentile(ticks, 99)) if ticks.size else None
+        worst = float(ticks.max()) if ticks.size else None
+        rtf = statistics.median(run.rtf for run in runs) if runs else None
         lines.append(
-            f"| {r.family} | {r.worlds} | {r.reachable} "
+            f"| {r.family} | {r.worlds + r.walled} | {r.reachable} "
             f"| {r.successes} ({_fmt(r.success_pct, '.1f')} %) "
             f"| {_fmt(r.barn_metric, '.3f')} | {_fmt(r.time_ratio_median, '.2f')} "
             f"| {r.timeouts} | {r.gave_up} "
-            f"| {r.clearance_violations} of {r.runs} "
             f"| {r.walled_reported} of {r.walled} ({_fmt(r.walled_reported_pct, '.1f')} %) "
-            f"| {r.walled_timeouts} |"
+            f"| {r.clearance_violations} of {r.runs} "
+            f"| {sum(run.false_reached for run in runs)} "
+            f"| {_fmt(p99, '.2f')} / {_fmt(worst, '.1f')} | {_fmt(rtf, '.1f')} |"
         )
     return "\n".join(lines)
 
 
 def _record_failure(result: RunResult, overrides: tuple[str, ...], out: Path) -> str:
-    world = generate_world(result.seed, _params(result.family, result.expect == "unreachable"))
+    world = _world(result.family, result.seed, result.expect == "unreachable")
     name = world.scenario.name
     path = out / f"{name}.yaml"
     path.write_text(yaml.safe_dump(world.scenario.model_dump(mode="json"), sort_keys=False))
@@ -117,33 +209,40 @@ def _record_failure(result: RunResult, overrides: tuple[str, ...], out: Path) ->
     return f"{path} -> {verdict.recording}"
 
 
+def _acceptance_rtf(overrides: tuple[str, ...]) -> float:
+    """The acceptance scenario's RTF, measured here (the yardstick for the families)."""
+    verdict = run_scenario(ScenarioConfig(), _stack(overrides), record=False, plot=False)
+    return verdict.sim_time_s / max(verdict.wall_time_s, 1e-9)
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--worlds", type=int, default=200, help="per density (default 200)")
-    parser.add_argument("--walled", type=int, default=50, help="walled-in per density (50)")
-    parser.add_argument("--densities", nargs="+", default=["sparse", "dense"])
+    parser.add_argument("--worlds", type=int, default=200, help="per family (default 200)")
+    parser.add_argument("--walled", type=int, default=50, help="walled-in per box density (50)")
+    parser.add_argument("--families", nargs="+", default=list(FAMILIES))
     parser.add_argument("--seed0", type=int, default=0)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--set", dest="overrides", action="append", default=[])
     parser.add_argument("--failures", type=Path, help="re-run failures with recordings here")
     parser.add_argument("--json", type=Path, help="write every run's figures here")
     args = parser.parse_args()
-    unknown = [d for d in args.densities if d not in ("sparse", "dense")]
+    unknown = [f for f in args.families if f not in FAMILIES]
     if unknown:
-        print(f"--densities: {unknown} not valid (sparse, dense)", file=sys.stderr)
+        print(f"--families: {unknown} not valid ({', '.join(FAMILIES)})", file=sys.stderr)
         return 2
     overrides = tuple(args.overrides)
     _stack(overrides)  # a bad --set fails here, before any run
     tasks: list[Task] = [
-        (density, args.seed0 + i, walled, overrides)
-        for density in args.densities
-        for walled, count in ((False, args.worlds), (True, args.walled))
+        (family, args.seed0 + i, walled, overrides)
+        for family in args.families
+        for walled, count in ((False, args.worlds), (True, args.walled if family in BOXES else 0))
         for i in range(count)
     ]
     started = time.perf_counter()
-    by_family: dict[str, list[RunResult]] = defaultdict(list)
-    for done, result in enumerate(_results(tasks, args.workers), 1):
-        by_family[result.family].append(result)
+    acceptance_rtf = _acceptance_rtf(overrides)
+    by_family: dict[str, list[Run]] = defaultdict(list)
+    for done, run in enumerate(_results(tasks, args.workers), 1):
+        by_family[run.result.family].append(run)
         if done % 25 == 0 or done == len(tasks):
             print(
                 f"  {done}/{len(tasks)} runs, {time.perf_counter() - started:.0f} s",
@@ -151,16 +250,19 @@ def main() -> int:
                 flush=True,
             )
     wall = time.perf_counter() - started
-    rows = [summarise(d, by_family[d]) for d in args.densities]
+    rows = [
+        (summarise(f, [run.result for run in by_family[f]]), by_family[f]) for f in args.families
+    ]
     print(
-        f"nav_bench: {args.worlds} worlds + {args.walled} walled-in per density, "
-        f"seeds {args.seed0}.., stack overrides {list(overrides) or 'none'}, "
-        f"{args.workers} workers, {wall:.0f} s wall"
+        f"nav_bench: {args.worlds} worlds per family (+ {args.walled} walled-in per box "
+        f"density), seeds {args.seed0}.., stack overrides {list(overrides) or 'none'}, "
+        f"{args.workers} workers, {wall:.0f} s wall; acceptance scenario RTF "
+        f"{acceptance_rtf:.1f} in this run"
     )
     print()
     print(table(rows))
     print()
-    all_results = [r for d in args.densities for r in by_family[d]]
+    all_results = [run.result for f in args.families for run in by_family[f]]
     failures = [r for r in all_results if r.failure is not None]
     kinds = Counter(f"{r.family}: {r.failure}" for r in failures)
     if failures:
@@ -169,6 +271,7 @@ def main() -> int:
             family, _, what = kind.partition(": ")
             seeds = [r.seed for r in failures if r.family == family and r.failure == what]
             print(f"  {kind}: {n}  seeds {seeds[:8]}")
+    if all_results:
         worst = min(all_results, key=lambda r: r.min_clearance_m)
         print(
             f"closest approach over all runs: {worst.min_clearance_m:.3f} m "

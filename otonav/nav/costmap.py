@@ -79,6 +79,9 @@ class ClearanceMap:
         self._k = k
         kernel = np.hypot(offsets[:, None], offsets[None, :])
         slack = resolution * math.sqrt(2.0)
+        self.slack = slack
+        """m: how far :meth:`clearance` may fall short of the distance between the
+        query point and the return that set it (each may sit anywhere in its cell)."""
         # min over returns of max(d - slack, 0) is max(min d - slack, 0): stamping the
         # slack-reduced disk keeps the lower bound exact under np.minimum.
         self._kernel = np.where(
@@ -179,9 +182,43 @@ class ClearanceMap:
             return 0
         rr, cc = rows[gone], cols[gone]
         self.occupied[rr, cc] = False
-        k, pad = self._k, self._pad
+        k = self._k
         ra, rb = max(int(rr.min()) - k, 0), min(int(rr.max()) + k + 1, n)
         ca, cb = max(int(cc.min()) - k, 0), min(int(cc.max()) + k + 1, n)
+        self._restamp(ra, rb, ca, cb)
+        cleared = int(rr.size)
+        self.cleared += cleared
+        return cleared
+
+    def clear_near(self, x: float, y: float, radius: float) -> int:
+        """Forget every occupied cell within ``radius`` m of ``(x, y)`` (a recovery:
+        the next scans mark what is really there); returns how many."""
+        n, res, k = self.size, self.resolution, self._k
+        inv = 1.0 / res
+        c0 = max(math.floor((x - radius - self.origin_x) * inv), 0)
+        c1 = min(math.floor((x + radius - self.origin_x) * inv) + 1, n)
+        r0 = max(math.floor((y - radius - self.origin_y) * inv), 0)
+        r1 = min(math.floor((y + radius - self.origin_y) * inv) + 1, n)
+        if c0 >= c1 or r0 >= r1:
+            return 0
+        rows, cols = np.nonzero(self.occupied[r0:r1, c0:c1])
+        cx = self.origin_x + (cols + c0 + 0.5) * res - x
+        cy = self.origin_y + (rows + r0 + 0.5) * res - y
+        gone = np.hypot(cx, cy) <= radius
+        if not gone.any():
+            return 0
+        rr, cc = rows[gone] + r0, cols[gone] + c0
+        self.occupied[rr, cc] = False
+        ra, rb = max(int(rr.min()) - k, 0), min(int(rr.max()) + k + 1, n)
+        ca, cb = max(int(cc.min()) - k, 0), min(int(cc.max()) + k + 1, n)
+        self._restamp(ra, rb, ca, cb)
+        self.cleared += int(rr.size)
+        return int(rr.size)
+
+    def _restamp(self, ra: int, rb: int, ca: int, cb: int) -> None:
+        """Recompute the distances in rows ``ra:rb``, columns ``ca:cb`` from the
+        occupied cells that can reach them."""
+        n, k, pad = self.size, self._k, self._pad
         self._lower[ra + pad : rb + pad, ca + pad : cb + pad] = self.max_distance
         sa, sb = max(ra - k, 0), min(rb + k, n)
         ta, tb = max(ca - k, 0), min(cb + k, n)
@@ -190,9 +227,14 @@ class ClearanceMap:
         for r, c in zip((near_r + sa).tolist(), (near_c + ta).tolist(), strict=True):
             window = lower[r + 1 : r + 1 + span, c + 1 : c + 1 + span]
             np.minimum(window, kernel, out=window)
-        cleared = int(rr.size)
-        self.cleared += cleared
-        return cleared
+
+    def interior(self) -> NDArray[np.float32]:
+        """:meth:`clearance` at every map cell (a read-only view, rows = y): the
+        global planner pools it into its coarser grid (:mod:`otonav.nav.plan_grid`)."""
+        pad = self._pad
+        view = self._lower[pad : pad + self.size, pad : pad + self.size]
+        view.flags.writeable = False
+        return view
 
     def coarse(self, stride: int) -> NDArray[np.float32]:
         """clearance() at the centre cell of every ``stride`` x ``stride`` block: the

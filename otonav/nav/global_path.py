@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ("GridPath", "astar")
+__all__ = ("AstarSearch", "GridPath", "astar")
 
 _SQRT2 = math.sqrt(2.0)
 
@@ -55,7 +55,8 @@ def astar(
     *,
     max_expansions: int = 200_000,
 ) -> GridPath:
-    """Shortest 8-connected path of free cells from ``start`` to ``goal``.
+    """Shortest 8-connected path of free cells from ``start`` to ``goal``, in one call
+    (:class:`AstarSearch` run to the end).
 
     The start and goal cells count as free whatever ``free`` says (the robot is where it
     is; a goal on an inflated cell is still the goal). A diagonal step needs both of its
@@ -64,70 +65,113 @@ def astar(
     Raises:
         ValueError: if the shapes differ or ``start``/``goal`` is outside the grid.
     """
-    if free.shape != penalty.shape or free.ndim != 2:
-        raise ValueError(f"free {free.shape} and penalty {penalty.shape} must be one 2-D shape")
-    rows, cols = free.shape
-    for name, (r, c) in (("start", start), ("goal", goal)):
-        if not (0 <= r < rows and 0 <= c < cols):
-            raise ValueError(f"{name} {(r, c)} is outside the {rows} x {cols} grid")
-    # Pad with a blocked border: no bounds checks in the inner loop.
-    w = cols + 2
-    ok = np.zeros((rows + 2, w), dtype=np.bool_)
-    ok[1:-1, 1:-1] = free
-    s = (start[0] + 1) * w + start[1] + 1
-    g = (goal[0] + 1) * w + goal[1] + 1
-    ok[s // w, s % w] = True
-    ok[g // w, g % w] = True
-    # bytes and a float64 memoryview index as fast as lists (~25 ns) but cost ~1 us to
-    # make where tolist() of a 200 x 200 grid cost ~0.8 ms (measured): most searches
-    # expand a few hundred cells, so the conversion was most of a replan.
-    okl = ok.tobytes()
-    pen = np.zeros((rows + 2, w), dtype=np.float64)
-    pen[1:-1, 1:-1] = penalty
-    penl = memoryview(pen.data).cast("B").cast("d")
-    sr, sc = divmod(s, w)
-    straight = (1, -1, w, -w)
-    diagonal = ((w + 1, 1, w), (w - 1, -1, w), (-w + 1, 1, -w), (-w - 1, -1, -w))
-    best: dict[int, float] = {g: 0.0}
-    parent: dict[int, int] = {}
-    closed: set[int] = set()
+    search = AstarSearch(free, penalty, start, goal, max_expansions=max_expansions)
+    result = search.advance(max_expansions)
+    assert result is not None  # the budget is the cap: the search ended
+    return result
 
-    def h(cell: int) -> float:
-        r, c = divmod(cell, w)
-        dr, dc = abs(r - sr), abs(c - sc)
+
+class AstarSearch:
+    """A* that can stop after any number of expansions and go on later (issue 24: a
+    navigator tick must stay short, and proving "no path" on a 200 x 200 grid took
+    up to 240 ms in one tick). The search keeps its own copy of the grid: the map may
+    change meanwhile, and the caller replans when the path it gets is blocked.
+
+    ``advance(budget)`` expands at most ``budget`` more cells and returns the
+    :class:`GridPath`, or None when the search is not over yet. Same semantics as
+    :func:`astar` (which is this class run in one go): the same expansions in the same
+    order, whatever the budgets."""
+
+    def __init__(
+        self,
+        free: NDArray[np.bool_],
+        penalty: NDArray[np.floating[Any]],
+        start: tuple[int, int],
+        goal: tuple[int, int],
+        *,
+        max_expansions: int = 200_000,
+    ) -> None:
+        if free.shape != penalty.shape or free.ndim != 2:
+            raise ValueError(f"free {free.shape} and penalty {penalty.shape} must be one 2-D shape")
+        rows, cols = free.shape
+        for name, (r, c) in (("start", start), ("goal", goal)):
+            if not (0 <= r < rows and 0 <= c < cols):
+                raise ValueError(f"{name} {(r, c)} is outside the {rows} x {cols} grid")
+        # Pad with a blocked border: no bounds checks in the inner loop.
+        w = cols + 2
+        ok = np.zeros((rows + 2, w), dtype=np.bool_)
+        ok[1:-1, 1:-1] = free
+        s = (start[0] + 1) * w + start[1] + 1
+        g = (goal[0] + 1) * w + goal[1] + 1
+        ok[s // w, s % w] = True
+        ok[g // w, g % w] = True
+        # bytes and a float64 memoryview index as fast as lists (~25 ns) but cost ~1 us
+        # to make where tolist() of a 200 x 200 grid cost ~0.8 ms (measured): most
+        # searches expand a few hundred cells, so the conversion was most of a replan.
+        self._ok = ok.tobytes()
+        pen = np.zeros((rows + 2, w), dtype=np.float64)
+        pen[1:-1, 1:-1] = penalty
+        self._pen = memoryview(pen.data).cast("B").cast("d")
+        self._w, self._s, self._g = w, s, g
+        self._sr, self._sc = divmod(s, w)
+        self.max_expansions = max_expansions
+        self.expansions = 0
+        self._best: dict[int, float] = {g: 0.0}
+        self._parent: dict[int, int] = {}
+        self._closed: set[int] = set()
+        self._open: list[tuple[float, float, int]] = [(self._h(g), 0.0, g)]
+        self.result: GridPath | None = None
+
+    def _h(self, cell: int) -> float:
+        r, c = divmod(cell, self._w)
+        dr, dc = abs(r - self._sr), abs(c - self._sc)
         return float((dr + dc) + (_SQRT2 - 2.0) * min(dr, dc))
 
-    open_list: list[tuple[float, float, int]] = [(h(g), 0.0, g)]
-    expansions = 0
-    while open_list:
-        _, cost, cell = heapq.heappop(open_list)
-        if cell in closed:
-            continue
-        closed.add(cell)
-        expansions += 1
-        if cell == s:
-            path = [cell]
-            while cell != g:
-                cell = parent[cell]
-                path.append(cell)
-            cells = tuple(((p // w) - 1, (p % w) - 1) for p in path)
-            return GridPath(cells, cost, expansions, False)
-        if expansions >= max_expansions:
-            return GridPath((), math.inf, expansions, False)
-        for step in straight:
-            n = cell + step
-            if okl[n] and n not in closed:
-                c2 = cost + 1.0 + penl[n]
-                if c2 < best.get(n, math.inf):
-                    best[n] = c2
-                    parent[n] = cell
-                    heapq.heappush(open_list, (c2 + h(n), c2, n))
-        for step, side_a, side_b in diagonal:
-            n = cell + step
-            if okl[n] and okl[cell + side_a] and okl[cell + side_b] and n not in closed:
-                c2 = cost + _SQRT2 + penl[n]
-                if c2 < best.get(n, math.inf):
-                    best[n] = c2
-                    parent[n] = cell
-                    heapq.heappush(open_list, (c2 + h(n), c2, n))
-    return GridPath((), math.inf, expansions, True)
+    def advance(self, budget: int) -> GridPath | None:
+        """Expand up to ``budget`` more cells; the result once the search is over."""
+        if self.result is not None:
+            return self.result
+        w, s, g = self._w, self._s, self._g
+        okl, penl, h = self._ok, self._pen, self._h
+        best, parent, closed, open_list = self._best, self._parent, self._closed, self._open
+        straight = (1, -1, w, -w)
+        diagonal = ((w + 1, 1, w), (w - 1, -1, w), (-w + 1, 1, -w), (-w - 1, -1, -w))
+        heappop, heappush, inf = heapq.heappop, heapq.heappush, math.inf
+        stop_at = self.expansions + budget
+        while open_list:
+            if self.expansions >= stop_at:
+                return None
+            _, cost, cell = heappop(open_list)
+            if cell in closed:
+                continue
+            closed.add(cell)
+            self.expansions += 1
+            if cell == s:
+                path = [cell]
+                while cell != g:
+                    cell = parent[cell]
+                    path.append(cell)
+                cells = tuple(((p // w) - 1, (p % w) - 1) for p in path)
+                self.result = GridPath(cells, cost, self.expansions, False)
+                return self.result
+            if self.expansions >= self.max_expansions:
+                self.result = GridPath((), inf, self.expansions, False)
+                return self.result
+            for step in straight:
+                n = cell + step
+                if okl[n] and n not in closed:
+                    c2 = cost + 1.0 + penl[n]
+                    if c2 < best.get(n, inf):
+                        best[n] = c2
+                        parent[n] = cell
+                        heappush(open_list, (c2 + h(n), c2, n))
+            for step, side_a, side_b in diagonal:
+                n = cell + step
+                if okl[n] and okl[cell + side_a] and okl[cell + side_b] and n not in closed:
+                    c2 = cost + _SQRT2 + penl[n]
+                    if c2 < best.get(n, inf):
+                        best[n] = c2
+                        parent[n] = cell
+                        heappush(open_list, (c2 + h(n), c2, n))
+        self.result = GridPath((), inf, self.expansions, True)
+        return self.result

@@ -42,13 +42,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from otonav.nav.costmap import ClearanceMap
-from otonav.nav.dwa import DwaParams, DwaResult, clear_arc, dwa_step
+from otonav.nav.dwa import ClearanceFn, DwaParams, DwaResult, clear_arc, dwa_step
 from otonav.nav.geometry import wrap_angle
-from otonav.nav.global_path import astar
+from otonav.nav.global_path import AstarSearch, GridPath
+from otonav.nav.local_clearance import local_clearance, nearby
+from otonav.nav.plan_grid import best_points, free_threshold, pooled
 from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
 from otonav.nav.scan import ScanRays
 
-__all__ = ("LADDER", "NavOutput", "Navigation", "NavigationParams", "Points")
+__all__ = ("LADDER", "TURN_CREDIT", "NavOutput", "Navigation", "NavigationParams", "Points")
 
 Points = NDArray[np.float64] | Callable[[], NDArray[np.float64]]
 """Scan returns in base_link, ``(N, 2)`` m, or a function that computes them."""
@@ -57,6 +59,9 @@ Points = NDArray[np.float64] | Callable[[], NDArray[np.float64]]
 def _resolve(points: Points) -> NDArray[np.float64]:
     return points() if callable(points) else points
 
+
+TURN_CREDIT = 0.25
+"""m of progress per radian turned toward the target (a half turn: 0.8 m)."""
 
 LADDER = ("spin", "backup", "follow")
 """The recovery stages, in order."""
@@ -76,12 +81,18 @@ class NavigationParams:
         replan_period: blocked-path check period, s.
         lookahead: the DWA's target is this far along the path, m.
         max_expansions: A* gives up (no proof either way) after this many cells.
+        expansions_per_tick: A* expands at most this many cells per step; a search
+            that needs more goes on at the next step (the robot follows the previous
+            path, or heads for the goal, meanwhile; the DWA keeps it clear).
         clear_range: before a replan, occupied cells within this distance of the laser
             that the last observed scan saw through are cleared (ADR 0026), m; 0: the
             map never clears.
         progress_distance: progress that counts, m.
-        progress_window: time to move ``progress_distance``, s.
+        progress_window: time to shrink the distance to go (along the path) by
+            ``progress_distance``, s (:class:`~otonav.nav.recovery.ProgressChecker`).
         goal_progress_window: time to get ``progress_distance`` closer to the goal, s.
+        clear_radius: the spin rung first clears the map within this distance of the
+            robot, m (0: never).
         spin_angle: the look-around turn, rad.
         spin_speed: its yaw rate, rad/s.
         backup_distance: the back-up distance, m.
@@ -104,17 +115,19 @@ class NavigationParams:
     replan_period: float = 0.5
     lookahead: float = 0.8
     max_expansions: int = 60_000
+    expansions_per_tick: int = 600
     clear_range: float = 3.0
     progress_distance: float = 0.3
-    progress_window: float = 4.0
-    goal_progress_window: float = 15.0
+    progress_window: float = 3.5
+    goal_progress_window: float = 30.0
     spin_angle: float = math.pi / 2
     spin_speed: float = 1.0
     backup_distance: float = 0.3
-    backup_speed: float = 0.1
-    follow_time: float = 8.0
+    backup_speed: float = 0.15
+    follow_time: float = 5.0
     follow_speed: float = 0.2
     follow_distance: float = 0.45
+    clear_radius: float = 1.0
     approach_radius: float = 0.25
     kp_lin: float = 0.8
     kp_ang: float = 2.0
@@ -146,6 +159,7 @@ class _Stage:
     yaw: float
     goal_distance: float
     side: int = 1
+    why: str = ""
 
 
 @dataclass(slots=True)
@@ -165,10 +179,18 @@ class Navigation:
     _looked_around: bool = False
     _ladder: int = 0
     _ladder_best: float = math.inf
+    _ladder_to_go: float | None = None
+    _remaining: NDArray[np.float64] | None = None
+    _new_path: bool = False
     _stage: _Stage | None = None
     _gave_up: str | None = None
     _stride: int = field(init=False)
     _rays: ScanRays | Callable[[], ScanRays] | None = None
+    _returns: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None
+    _search: AstarSearch | None = None
+    expansions: int = 0
+    """A* cells expanded so far, over all searches."""
+    _replan_now: bool = True
     _reached: bool = False
 
     def __post_init__(self) -> None:
@@ -191,11 +213,14 @@ class Navigation:
         if goal != self.goal:
             self.goal = goal
             self.path = None
+            self._search = None
+            self._replan_now = True
             self._gave_up = None
             self._reached = False
             self._stage = None
             self._ladder = 0
             self._ladder_best = math.inf
+            self._ladder_to_go = None
             self._looked_around = False
             self._checker.reset()
 
@@ -211,8 +236,15 @@ class Navigation:
         if rays is not None:
             self._rays = rays
         if isinstance(points_odom, tuple):
+            self._returns = points_odom
             return self.map.mark_xy(*points_odom)
+        self._returns = (points_odom[:, 0], points_odom[:, 1])
         return self.map.mark(points_odom)
+
+    @property
+    def searching(self) -> bool:
+        """A global search is in progress (it goes on at the next step)."""
+        return self._search is not None
 
     # -- the step ----------------------------------------------------------------------
 
@@ -250,36 +282,63 @@ class Navigation:
         due = now - self._checked_at >= self.params.replan_period
         if due:
             self._checked_at = now
-        replan = self.path is None or (due and self._path_blocked(pose))
-        if replan:
-            proven_none = self._plan(now, pose)
+        if self._search is None and (
+            self._replan_now or (due and (self.path is None or self._path_blocked(pose)))
+        ):
+            self._start_search(now, pose)
+        if self._search is not None:
+            search = self._search
+            done = search.expansions
+            planned = search.advance(self.params.expansions_per_tick)
+            self.expansions += search.expansions - done
+            proven_none = planned is not None and self._adopt(planned, pose)
             if proven_none:
                 if not self._looked_around:
                     self._looked_around = True
                     return self._begin(
-                        "spin", now, pose, distance, heading, points, "no path, looking around"
+                        "spin", now, pose, distance, heading, points, "look-around, no path"
                     )
                 return self._give_up("no path to the goal in the observed map", distance, heading)
-        stuck = self._checker.update(now, x, y, distance)
-        if distance <= self._ladder_best - self.params.progress_distance:
-            self._ladder, self._ladder_best = 0, distance
-        if stuck is not None:
+        to_go = self._to_go(pose, distance)
+        target = self._target(pose)
+        # Turning toward the way on counts too (a robot facing away from a new path
+        # turns in place first): TURN_CREDIT m per radian of bearing to the target.
+        bearing = abs(wrap_angle(math.atan2(target[1] - y, target[0] - x) - yaw))
+        measure = to_go + TURN_CREDIT * bearing
+        if self._new_path:  # new knowledge is not progress, and not a lack of it
+            self._new_path = False
+            self._checker.rebase(measure)
+            if self._ladder_to_go is not None and to_go > self._ladder_to_go:
+                self._ladder_to_go = to_go
+        stuck = self._checker.update(now, measure, distance)
+        if self._ladder_to_go is None:
+            self._ladder_to_go = to_go
+        # The ladder starts over after real progress: a progress distance closer to
+        # the goal than where it began, or three along the path since the last rung.
+        if distance <= self._ladder_best - self.params.progress_distance or (
+            to_go <= self._ladder_to_go - 3.0 * self.params.progress_distance
+        ):
+            self._ladder, self._ladder_best, self._ladder_to_go = 0, distance, to_go
+        if stuck is not None and not (self._search is not None and self.path is None):
+            # (while the first search for a path is still running, the robot heads for
+            # the goal and the verdict waits for it: at most max_expansions /
+            # expansions_per_tick steps)
             if self._ladder >= len(LADDER):
                 return self._give_up(
                     f"no progress after {', '.join(LADDER)} ({stuck})", distance, heading
                 )
             stage = LADDER[self._ladder]
             self._ladder += 1
-            return self._begin(stage, now, pose, distance, heading, points, stuck)
+            why = f"rung {self._ladder}/{len(LADDER)}, {stuck}"
+            return self._begin(stage, now, pose, distance, heading, points, why)
         if distance < self.params.approach_radius:
             return self._approach(distance, heading)
-        target = self._target(pose)
         dwa = self.params.dwa
         result = (
             clear_arc(pose, v0, omega0, target, distance, self.map.clearance_at, dwa)
             if dwa.fast_path
             else None
-        ) or dwa_step(pose, v0, omega0, target, distance, self.map.clearance, dwa)
+        ) or dwa_step(pose, v0, omega0, target, distance, self._local_clearance(pose), dwa)
         if result.admissible == 0:
             state = "blocked"
         else:
@@ -328,12 +387,22 @@ class Navigation:
         self._stage = None
         return self._out(0.0, 0.0, "unreachable", reason, distance, heading)
 
+    def _local_clearance(self, pose: tuple[float, float, float]) -> ClearanceFn:
+        """The DWA's distances: exact to the latest scan's returns near the robot, the
+        map's elsewhere (:mod:`otonav.nav.local_clearance`)."""
+        dwa = self.params.dwa
+        if self._returns is None:
+            return self.map.clearance
+        reach = dwa.max_v * dwa.horizon + dwa.radius + 0.1
+        rx, ry = nearby(*self._returns, pose[0], pose[1], reach)
+        return local_clearance(self.map.clearance, self.map.slack, dwa.radius, rx, ry)
+
     def _free_grid(self) -> tuple[NDArray[np.bool_], NDArray[np.float32]]:
         # float32 like the map, np.minimum/np.maximum for np.clip: on the 200 x 200
         # grid the conversions were most of a replan's set-up.
-        coarse = self.map.coarse(self._stride)
+        coarse = pooled(self.map.interior(), self._stride)
         radius = self.params.dwa.radius
-        free = coarse >= radius
+        free = coarse >= np.float32(free_threshold(radius, self.map.resolution))
         room = self.params.dwa.clearance_cap
         gap = np.minimum(np.maximum(np.float32(radius + room) - coarse, 0.0), room)
         penalty = gap * np.float32(self.params.plan_penalty / room)
@@ -343,13 +412,14 @@ class Navigation:
         s, res = self._stride, self.map.resolution
         col = math.floor((x - self.map.origin_x) / (res * s))
         row = math.floor((y - self.map.origin_y) / (res * s))
-        n = self.map.coarse(s).shape[0]
+        n = self.map.size // s
         return min(max(row, 0), n - 1), min(max(col, 0), n - 1)
 
-    def _plan(self, now: float, pose: tuple[float, float, float]) -> bool:
-        """Replan; True when the search proved there is no path."""
+    def _start_search(self, now: float, pose: tuple[float, float, float]) -> None:
+        """Begin a replan (it may take several steps: :meth:`step` advances it)."""
         assert self.goal is not None
         self._planned_at = self._checked_at = now
+        self._replan_now = False
         self.replans += 1
         if self._rays is not None and self.params.clear_range > 0.0:
             rays = self._rays() if callable(self._rays) else self._rays
@@ -358,26 +428,47 @@ class Navigation:
                 rays, reach=self.params.clear_range, margin=2.0 * self.map.resolution
             )
         free, penalty = self._free_grid()
-        result = astar(
+        self._search = AstarSearch(
             free,
             penalty,
             self._coarse_cell(pose[0], pose[1]),
             self._coarse_cell(*self.goal),
             max_expansions=self.params.max_expansions,
         )
+
+    def _adopt(self, result: GridPath, pose: tuple[float, float, float]) -> bool:
+        """Take a finished search's path; True when it proved there is none."""
+        assert self.goal is not None
+        self._search = None
         if not result.found:
             self.path = None
             return result.exhausted
-        s, res = self._stride, self.map.resolution
-        cells = np.asarray(result.cells, dtype=np.float64)
+        cells = np.asarray(result.cells, dtype=np.intp)
+        rows, cols = best_points(self.map.interior(), self._stride, cells[:, 0], cells[:, 1])
+        res = self.map.resolution
         xy = np.empty((cells.shape[0], 2))
-        xy[:, 0] = self.map.origin_x + (cells[:, 1] * s + s // 2 + 0.5) * res
-        xy[:, 1] = self.map.origin_y + (cells[:, 0] * s + s // 2 + 0.5) * res
+        xy[:, 0] = self.map.origin_x + (cols + 0.5) * res
+        xy[:, 1] = self.map.origin_y + (rows + 0.5) * res
         xy[0] = pose[:2]
         xy[-1] = self.goal
         self.path = xy
-        self.path_length = float(np.hypot(*np.diff(xy, axis=0).T).sum())
+        legs = np.hypot(*np.diff(xy, axis=0).T)
+        self.path_length = float(legs.sum())
+        remaining = np.zeros(xy.shape[0])
+        remaining[:-1] = np.cumsum(legs[::-1])[::-1]
+        self._remaining = remaining
+        self._new_path = True
         return False
+
+    def _to_go(self, pose: tuple[float, float, float], distance: float) -> float:
+        """Distance to go, m: along the path from its point nearest the robot, or
+        straight to the goal without a path."""
+        path, remaining = self.path, self._remaining
+        if path is None or remaining is None:
+            return distance
+        d = np.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1])
+        i = int(d.argmin())
+        return float(d[i] + remaining[i])
 
     def _path_blocked(self, pose: tuple[float, float, float]) -> bool:
         if self.path is None:
@@ -386,7 +477,10 @@ class Navigation:
         if ahead.shape[0] == 0:
             return False
         clear = self.map.clearance(ahead[:, 0], ahead[:, 1])
-        return bool((clear[:-1] < self.params.dwa.radius).any()) if clear.size > 1 else False
+        if clear.size <= 1:
+            return False
+        limit = free_threshold(self.params.dwa.radius, self.map.resolution)
+        return bool((clear[:-1] < limit).any())
 
     def _ahead(self, pose: tuple[float, float, float]) -> NDArray[np.float64]:
         assert self.path is not None
@@ -422,23 +516,16 @@ class Navigation:
             side = boundary_side(_resolve(points), heading)
         else:
             side = 1 if heading >= 0 else -1
-        self._stage = _Stage(name, now, pose[0], pose[1], pose[2], distance, side)
+        self._stage = _Stage(name, now, pose[0], pose[1], pose[2], distance, side, why)
         if self._ladder_best == math.inf:
             self._ladder_best = distance
+        if name == "spin" and self.params.clear_radius > 0.0:
+            # Nav2's first recovery: forget the map around the robot (a smeared wall,
+            # a misread), and look around to see it again.
+            self.map.clear_near(pose[0], pose[1], self.params.clear_radius)
         out = self._recover(now, pose, distance, heading, points)
         assert out is not None
-        return NavOutput(
-            out.v,
-            out.omega,
-            out.state,
-            f"{name}: {why}",
-            distance,
-            heading,
-            None,
-            name,
-            out.path_length,
-            out.replans,
-        )
+        return out
 
     def _recover(
         self,
@@ -456,11 +543,11 @@ class Navigation:
         v = omega = 0.0
         if st.name == "spin":
             turned = abs(wrap_angle(pose[2] - st.yaw))
-            done = turned >= p.spin_angle - 0.05 or elapsed > p.spin_angle / p.spin_speed + 2.0
+            done = turned >= p.spin_angle - 0.05 or elapsed > p.spin_angle / p.spin_speed + 0.5
             omega = st.side * p.spin_speed
         elif st.name == "backup":
             moved = math.hypot(pose[0] - st.x, pose[1] - st.y)
-            done = moved >= p.backup_distance or elapsed > p.backup_distance / p.backup_speed + 2.0
+            done = moved >= p.backup_distance or elapsed > p.backup_distance / p.backup_speed + 0.5
             v = -p.backup_speed
         else:
             done = elapsed > p.follow_time or distance <= st.goal_distance - p.progress_distance
@@ -475,5 +562,8 @@ class Navigation:
             self._stage = None
             self._checker.reset()
             self.path = None  # replan from here
+            self._search = None
+            self._replan_now = True
+            self._ladder_to_go = None
             return None
-        return self._out(v, omega, "recovering", st.name, distance, heading)
+        return self._out(v, omega, "recovering", f"{st.name}: {st.why}", distance, heading)

@@ -4,10 +4,9 @@ Units: m, s (sim time), rad; poses in odom. The ladder itself (which behaviour c
 next, when to give up) lives in :mod:`otonav.nav.navigation`; this module holds the
 pieces it is built from.
 
-* :class:`ProgressChecker`: Nav2's "moved at least ``distance`` m within ``window`` s"
-  (a robot dithering on the spot fails it), plus "got at least ``distance`` m closer
-  to the goal than ever before within ``goal_window`` s" (a robot oscillating
-  between two places fails that one).
+* :class:`ProgressChecker`: "the distance to go along the path shrank by at least
+  ``distance`` m within ``window`` s" (a robot creeping, dithering or oscillating
+  fails it), plus "got ``distance`` m closer to the goal within ``goal_window`` s".
 * :func:`follow_boundary`: Bug2-style wall following from the scan: keep the nearest
   return at ``distance`` m on the chosen side, drive along its tangent.
 * :func:`boundary_side`: the side whose tangent heads closer to the goal.
@@ -30,39 +29,51 @@ __all__ = ("ProgressChecker", "boundary_side", "follow_boundary")
 class ProgressChecker:
     """Is the robot getting anywhere? ``update`` returns the reason it is not, or None.
 
+    Progress is judged on what the robot does, not on what the planner says (issue
+    24): the robot's *distance to go* (along the current global path, or straight to
+    the goal without one) must shrink by ``distance`` within ``window`` s. A robot
+    creeping at near-zero speed, dithering on the spot or oscillating across the path
+    fails it, whatever state the planner reports. Moving without getting nearer does
+    not count (Nav2's radius check let an oscillating robot through until the goal
+    window, 15 s, ran out).
+
+    A new path (:meth:`rebase`) that is longer sets the reference to its distance to
+    go, but not the clock: new knowledge of the world is not progress. Within
+    ``goal_window`` s the robot must also get ``distance`` closer to the goal in a
+    straight line (a backstop against paths that keep changing).
+
     Attributes:
         distance: progress that counts, m (> 0).
-        window: time allowed to move ``distance`` from the anchor, s (> 0).
-        goal_window: time allowed to get ``distance`` closer to the goal than ever, s.
+        window: time allowed to shrink the distance to go by ``distance``, s (> 0).
+        goal_window: time allowed to get ``distance`` closer to the goal, s.
     """
 
     distance: float = 0.3
-    window: float = 4.0
-    goal_window: float = 15.0
-    _anchor: tuple[float, float, float] | None = None
+    window: float = 3.5
+    goal_window: float = 30.0
     _best: tuple[float, float] | None = None
+    _goal_best: tuple[float, float] | None = None
 
     def reset(self) -> None:
         """Start over (after a recovery, or for a new goal)."""
-        self._anchor = None
         self._best = None
+        self._goal_best = None
 
-    def update(self, now: float, x: float, y: float, goal_distance: float) -> str | None:
-        if self._anchor is None or math.hypot(x - self._anchor[0], y - self._anchor[1]) >= (
-            self.distance
-        ):
-            self._anchor = (now, x, y)
-        if self._best is None or goal_distance <= self._best[1] - self.distance:
-            self._best = (now, goal_distance)
-        if now - self._anchor[0] >= self.window:
-            return f"moved under {self.distance:g} m in {self.window:g} s"
-        if now - self._best[0] >= self.goal_window:
+    def rebase(self, to_go: float) -> None:
+        """A new path whose distance to go is ``to_go``, m (the clock keeps running)."""
+        if self._best is not None and to_go > self._best[1]:
+            self._best = (self._best[0], to_go)
+
+    def update(self, now: float, to_go: float, goal_distance: float) -> str | None:
+        if self._best is None or to_go <= self._best[1] - self.distance:
+            self._best = (now, to_go)
+        if self._goal_best is None or goal_distance <= self._goal_best[1] - self.distance:
+            self._goal_best = (now, goal_distance)
+        if now - self._best[0] >= self.window:
+            return f"under {self.distance:g} m of progress along the path in {self.window:g} s"
+        if now - self._goal_best[0] >= self.goal_window:
             return f"no {self.distance:g} m closer to the goal in {self.goal_window:g} s"
         return None
-
-    @property
-    def anchor(self) -> tuple[float, float, float] | None:
-        return self._anchor
 
 
 def boundary_side(points: NDArray[np.float64], goal_bearing: float) -> int:

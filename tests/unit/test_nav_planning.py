@@ -213,13 +213,21 @@ def test_navigation_replans_through_a_phantom_once_a_scan_sees_through_it() -> N
     nav = Navigation(NavigationParams(), (0.0, 0.0))
     nav.set_goal((3.0, 0.0))
     nav.observe(_wall(1.5, -3.0, 3.0))  # a wall across the way, long enough to detour
-    nav.step(0.0, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
+    t = 0.0
+    nav.step(t, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
+    while nav.searching:  # a search spans steps (expansions_per_tick)
+        t += 0.05
+        nav.step(t, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
     assert nav.path is not None
     detour = nav.path_length
     assert detour > 4.0
     nav.observe(np.empty((0, 2)), _rays(np.full(360, np.inf)))  # the wall is gone
-    nav.path = None  # next step replans (as after a blocked-path check)
-    nav.step(0.1, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
+    nav.path = None  # the next check replans (as after a blocked-path check)
+    t += 0.5
+    nav.step(t, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
+    while nav.searching:
+        t += 0.05
+        nav.step(t, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
     assert nav.map.cleared > 0
     assert nav.path_length == pytest.approx(3.0, abs=0.2)
 
@@ -486,21 +494,37 @@ def test_dwa_params_validate() -> None:
 
 def test_progress_checker_flags_dithering_and_oscillation() -> None:
     pc = ProgressChecker(distance=0.3, window=4.0, goal_window=10.0)
-    assert pc.update(0.0, 0.0, 0.0, 5.0) is None
-    assert pc.update(3.9, 0.1, 0.0, 4.9) is None
-    assert "in 4 s" in (pc.update(4.0, 0.1, 0.0, 4.9) or "")
+    assert pc.update(0.0, 5.0, 5.0) is None
+    assert pc.update(3.9, 4.9, 4.9) is None
+    assert "in 4 s" in (pc.update(4.0, 4.9, 4.9) or "")
     pc.reset()
-    # Back and forth 1 m: always moving, never closer to the goal.
+    # Back and forth 1 m: always moving, never nearer along the path.
     for i in range(0, 101):
         t = 0.1 * i
-        x = 0.5 * math.sin(t)
-        why = pc.update(t, x, 0.0, 5.0 - 0.05 * math.sin(t))
+        why = pc.update(t, 5.0 - 0.05 * math.sin(t), 5.0)
         if why is not None:
-            assert "closer to the goal" in why
-            assert t >= 10.0
+            assert "along the path" in why
+            assert 4.0 <= t < 4.1
             break
     else:
         pytest.fail("oscillation never flagged")
+    pc.reset()
+    # A longer path is new knowledge, not progress: the clock keeps running.
+    assert pc.update(0.0, 5.0, 5.0) is None
+    pc.rebase(8.0)
+    assert pc.update(2.0, 7.9, 5.0) is None
+    assert pc.update(4.0, 7.9, 5.0) is not None
+    pc.reset()
+    # The straight-line backstop: nearer along ever-changing paths, never to the goal.
+    for i in range(0, 200):
+        t = 0.1 * i
+        why = pc.update(t, 100.0 - t, 5.0)
+        if why is not None:
+            assert "closer to the goal" in why
+            assert t == pytest.approx(10.0)
+            break
+    else:
+        pytest.fail("the goal window never fired")
 
 
 def test_boundary_side_and_follow_keep_the_obstacle_on_that_side() -> None:
