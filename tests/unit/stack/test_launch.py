@@ -135,4 +135,9 @@ def test_recovery_speeds_respect_the_navigators_limits() -> None:
     assert params.follow_speed == 0.0001
     assert params.spin_speed == 0.5
     default = navigation_params(StackConfig(), FakeHardware().geometry)
-    assert (default.backup_speed, default.follow_speed, default.spin_speed) == (0.1, 0.2, 1.0)
+    rec = StackConfig().nav.recovery  # under the limits: the configured speeds, untouched
+    assert (default.backup_speed, default.follow_speed, default.spin_speed) == (
+        rec.backup_speed,
+        rec.follow_speed,
+        rec.spin_speed,
+    )
