@@ -74,8 +74,12 @@ class Ros2Options:
         wait = self.wait_for_peers
         if wait is not None and not (wait > 0 and math.isfinite(wait)):
             raise Ros2Error(f"--ros2-wait {wait}: must be a number of seconds > 0")
-        for name in (*self.inputs, *(self.outputs or ())):
-            dds_topic(name)  # a ROS 2 name, or one line saying it is not
+        for key, names in (("--ros2-in", self.inputs), ("ros2 outputs", self.outputs or ())):
+            for name in names:
+                try:
+                    dds_topic(name)
+                except Ros2Error as exc:
+                    raise Ros2Error(f"{key} {exc}") from None
 
 
 class Ros2Statistics(NamedTuple):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -46,7 +47,7 @@ def test_domain_id_from_the_flag_or_ros_domain_id() -> None:
     assert domain_id(7, {"ROS_DOMAIN_ID": "42"}) == 7
     with pytest.raises(Ros2Error, match=r"^--ros2-domain 233: must be 0\.\.232"):
         domain_id(233, {})
-    with pytest.raises(Ros2Error, match="^ROS_DOMAIN_ID='x'"):
+    with pytest.raises(Ros2Error, match=r"^ROS_DOMAIN_ID='x'"):
         domain_id(None, {"ROS_DOMAIN_ID": "x"})
 
 
@@ -70,3 +71,24 @@ def test_cyclonedds_is_imported_only_when_a_bridge_is_made() -> None:
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+@pytest.mark.parametrize(
+    ("argv", "line"),
+    [
+        (["--ros2", "--ros2-domain", "300"], "--ros2-domain 300: must be 0..232"),
+        (["--ros2-domain", "3"], "--ros2-domain/--ros2-in: only with --ros2"),
+        (["--ros2", "--ros2-in", "odom"], "--ros2-in 'odom': not a ROS 2 topic name"),
+        (["--set", "ros2.domain_id=999"], "ros2.domain_id"),
+    ],
+)
+def test_bad_ros2_input_is_one_line_and_exit_2(
+    argv: list[str], line: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from otonav.cli import main
+
+    code = main(["run", *argv, "--out", str(tmp_path)])
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    assert len(err.splitlines()) == 1, err
+    assert line in err
