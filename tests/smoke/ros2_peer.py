@@ -17,6 +17,7 @@ reads /odom until the robot is within 0.15 m of it, then prints one JSON line.
 # No ``from __future__ import annotations``: cyclonedds reads the field annotations.
 import json
 import math
+import signal
 import sys
 import time
 from dataclasses import dataclass, field
@@ -164,14 +165,17 @@ def main() -> None:
     counts = dict.fromkeys(readers, 0)
     report: dict[str, object] = {"reached": False, "sent_goal": False}
     latencies: list[float] = []
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
+    stop = [time.monotonic() + timeout]
+    signal.signal(signal.SIGTERM, lambda *_: stop.__setitem__(0, 0.0))  # report, then exit
+    while time.monotonic() < stop[0]:
         if not report["sent_goal"] and goal_writer.get_matched_subscriptions():
             goal = PoseStamped(Header(Time(0, 0), "odom"), Pose(Point(gx, gy, 0.0)))
             goal_writer.write(goal)
             report["sent_goal"] = True
         for name, reader in readers.items():
             for sample in reader.take(N=100):
+                if not sample.sample_info.valid_data:
+                    continue  # a writer went away (the bridge closed): no data
                 counts[name] += 1
                 if name == "odom":
                     now = time.time_ns()
