@@ -119,6 +119,30 @@ def add_parser(commands: Any) -> None:
         metavar="S",
         help="hold sim time at the start until a client subscribes (at most S wall seconds)",
     )
+    ros2 = p.add_argument_group("ROS 2 over DDS (needs the otonav[ros2] extra)")
+    ros2.add_argument(
+        "--ros2",
+        action="store_true",
+        help="publish every topic on DDS as a ROS 2 node does (rt/odom ...) and take /goal "
+        "in; the run is paced to the wall clock (as --realtime); stays on this host unless "
+        "ROS_AUTOMATIC_DISCOVERY_RANGE says otherwise",
+    )
+    ros2.add_argument(
+        "--ros2-domain",
+        type=int,
+        default=None,
+        metavar="N",
+        help="DDS domain 0..232 (default: ROS_DOMAIN_ID, else 0)",
+    )
+    ros2.add_argument(
+        "--ros2-in",
+        dest="ros2_inputs",
+        action="append",
+        default=None,
+        metavar="TOPIC",
+        help="a topic ROS 2 nodes may publish into the stack (repeatable; default /goal; "
+        "e.g. /cmd_vel_nav to drive the robot from your own planner)",
+    )
     p.set_defaults(handler=main)
 
 
@@ -192,9 +216,9 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
     from otonav.stack.files import ConfigFileError, describe_validation_error
 
     scale = 1.0 if args.scale is None else args.scale
-    if args.scale is not None and not (args.realtime or args.gui):
+    if args.scale is not None and not (args.realtime or args.gui or args.ros2):
         raise ConfigFileError(
-            f"--scale {args.scale:g}: only with --realtime or --gui "
+            f"--scale {args.scale:g}: only with --realtime, --gui or --ros2 "
             "(a headless run is not paced: it runs as fast as it can)"
         )
     if args.bag and args.no_record:
@@ -228,6 +252,9 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
         guard.attach(loop, task)  # a signal now cancels the run, which then finishes
 
     server, extra = _live_view(args)
+    bridge = _ros2_bridge(args, stack)
+    if bridge is not None:
+        extra = (*extra, bridge)
     console = make_console()
     held: list[Verdict] = []
 
@@ -238,7 +265,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
 
     guard.arm()  # from here a signal stops the run and lets it finish its artifacts
     try:
-        if args.gui or args.realtime:
+        if args.gui or args.realtime or bridge is not None:
             from otonav.scenario.realtime import run_scenario_realtime
 
             verdict = run_scenario_realtime(
@@ -283,6 +310,8 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
             progress.clear()
         if server is not None:
             server.close()
+        if bridge is not None:
+            bridge.close()
     if guard.received is not None:  # the run had ended; the signal came while saving
         return guard.report()
     out.mkdir(parents=True, exist_ok=True)
@@ -330,3 +359,35 @@ def _live_view(args: argparse.Namespace) -> tuple[Any, tuple[Any, ...]]:
         flush=True,
     )
     return server, (LiveView(server),)
+
+
+def _ros2_bridge(args: argparse.Namespace, stack: Any) -> Any:
+    """The ROS 2 bridge when ``--ros2`` or ``ros2.enabled`` (one line, exit 2, when it
+    cannot start); None otherwise."""
+    import sys
+
+    from otonav.stack.files import ConfigFileError
+
+    section = stack.ros2
+    if not (args.ros2 or section.enabled):
+        if args.ros2_domain is not None or args.ros2_inputs:
+            raise ConfigFileError("--ros2-domain/--ros2-in: only with --ros2")
+        return None
+    from otonav.ros2 import Ros2Bridge, Ros2Error, Ros2Options
+
+    try:
+        options = Ros2Options(
+            domain_id=args.ros2_domain if args.ros2_domain is not None else section.domain_id,
+            inputs=tuple(args.ros2_inputs or section.inputs),
+        )
+        bridge = Ros2Bridge(options)
+    except Ros2Error as exc:
+        raise ConfigFileError(str(exc)) from None
+    print(
+        f"ros2: every topic on DDS domain {bridge.domain_id} (rt/odom ...), seen from "
+        f"{bridge.discovery.scope}; taking {', '.join(options.inputs)} in; paced to the "
+        "wall clock",
+        file=sys.stderr,
+        flush=True,
+    )
+    return bridge

@@ -488,6 +488,17 @@ class ActorConfig(_Section):
     )
 
 
+class Ros2Config(_Section):
+    """ROS 2 over DDS (``otonav run --ros2``, the extra ``otonav[ros2]``; ADR 0047)."""
+
+    enabled: bool = False
+    """Mirror every topic on DDS as a ROS 2 node would, and take ``inputs`` in."""
+    domain_id: int | None = Field(None, ge=0, le=232)
+    """DDS domain (null: ``ROS_DOMAIN_ID``, else 0)."""
+    inputs: tuple[Annotated[str, Field(pattern=r"^(/[A-Za-z_][A-Za-z0-9_]*)+$")], ...] = ("/goal",)
+    """Topics ROS 2 nodes may publish into the stack (e.g. add ``/cmd_vel_nav``)."""
+
+
 class StackConfig(_Section):
     """Everything needed to bring the robot stack up."""
 
@@ -499,6 +510,7 @@ class StackConfig(_Section):
     safety: SafetyConfig = SafetyConfig()
     hal: HalConfig = HalConfig()
     robot: RobotConfig = RobotConfig()
+    ros2: Ros2Config = Ros2Config()
     actors: tuple[ActorConfig, ...] = ()
     """Extra nodes, or replacements of built-in ones, in launch order."""
 

@@ -60,7 +60,7 @@ def test_scale_without_realtime_or_gui_is_a_usage_error(
     err = capsys.readouterr().err
     assert code == 2, err
     assert err.strip() == (
-        "otonav: error: --scale 5: only with --realtime or --gui "
+        "otonav: error: --scale 5: only with --realtime, --gui or --ros2 "
         "(a headless run is not paced: it runs as fast as it can)"
     )
     assert not list(tmp_path.iterdir()), "a refused run must not write anything"

@@ -1,0 +1,142 @@
+"""What a ROS 2 node on Cyclone DDS puts on the wire, as plain data (no cyclonedds here).
+
+Each rule is rmw_cyclonedds_cpp's (``rmw_node.cpp``; docs/adr/0047 cites the lines):
+
+- a topic ``/odom`` is the DDS topic ``rt/odom`` (``ROS_TOPIC_PREFIX`` + the name);
+- a type ``nav_msgs/msg/Odometry`` is ``nav_msgs::msg::dds_::Odometry_``;
+- QoS (``create_readwrite_qos``): history keep-last ``depth``; reliable with an infinite
+  max blocking time, or best-effort; transient-local with a durability service keeping
+  the same history; deadline and lifespan unset (infinite); liveliness automatic with an
+  infinite lease; writers do not auto-dispose; ``USER_DATA`` carries
+  ``typehash=RIHS01_...;`` (Iron and later, ``rmw_dds_common``);
+- payloads are XCDR1, little endian, as in the bags (:mod:`otonav.record.cdr`): the
+  data representation a Cyclone writer takes by default for a final type;
+- discovery (``check_create_domain``): ``LOCALHOST`` turns multicast off and lists
+  ``localhost`` as a peer with participant indices ``auto`` (at most 32).
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Final
+
+from otonav.msgs import Message
+from otonav.record.type_hash import rihs01
+from otonav.runtime import Durability, QoS, Reliability
+
+__all__ = (
+    "MAX_DOMAIN_ID",
+    "DdsQos",
+    "Discovery",
+    "Ros2Error",
+    "dds_qos",
+    "dds_topic",
+    "dds_type_name",
+    "discovery",
+    "domain_id",
+)
+
+MAX_DOMAIN_ID: Final = 232
+"""The highest domain id whose RTPS ports fit (7400 + 250 * id + offsets < 65536)."""
+
+TOPIC_PREFIX: Final = "rt"
+_ROS_NAME = re.compile(r"^(/[A-Za-z_][A-Za-z0-9_]*)+$")
+
+LOCALHOST_CONFIG: Final = (
+    "<CycloneDDS><Domain><General><AllowMulticast>false</AllowMulticast></General>"
+    "<Discovery><ParticipantIndex>auto</ParticipantIndex>"
+    "<MaxAutoParticipantIndex>32</MaxAutoParticipantIndex>"
+    '<Peers><Peer address="localhost"/></Peers></Discovery></Domain></CycloneDDS>'
+)
+"""rmw_cyclonedds_cpp's configuration for ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``."""
+
+
+class Ros2Error(ValueError):
+    """The ROS 2 bridge cannot start: one line naming the flag, key or variable."""
+
+
+def dds_topic(name: str) -> str:
+    """``/odom`` -> ``rt/odom`` (a ROS 2 topic on DDS)."""
+    if not _ROS_NAME.match(name):
+        raise Ros2Error(f"{name!r}: not a ROS 2 topic name (like /odom or /nav/state)")
+    return TOPIC_PREFIX + name
+
+
+def dds_type_name(message: type[Message]) -> str:
+    """``nav_msgs/msg/Odometry`` -> ``nav_msgs::msg::dds_::Odometry_``."""
+    package, kind, name = message.ros_type.split("/")
+    return f"{package}::{kind}::dds_::{name}_"
+
+
+@dataclass(frozen=True, slots=True)
+class DdsQos:
+    """The DDS policies of one ROS 2 endpoint (what ``create_readwrite_qos`` sets)."""
+
+    reliable: bool
+    depth: int
+    transient_local: bool
+    user_data: bytes
+    """``typehash=RIHS01_<sha256>;``"""
+
+
+def dds_qos(qos: QoS, message: type[Message]) -> DdsQos:
+    """otonav's QoS of a topic carrying ``message``, as ROS 2 offers it on DDS."""
+    return DdsQos(
+        reliable=qos.reliability is Reliability.RELIABLE,
+        depth=qos.depth,
+        transient_local=qos.durability is Durability.TRANSIENT_LOCAL,
+        user_data=f"typehash={rihs01(message)};".encode(),
+    )
+
+
+def domain_id(value: int | None, env: Mapping[str, str]) -> int:
+    """The DDS domain: ``value`` (a flag or config key) or ``ROS_DOMAIN_ID`` or 0."""
+    if value is None:
+        text = env.get("ROS_DOMAIN_ID", "").strip()
+        if not text:
+            return 0
+        if not text.isdigit():
+            raise Ros2Error(f"ROS_DOMAIN_ID={text!r}: must be a whole number 0..{MAX_DOMAIN_ID}")
+        value, source = int(text), "ROS_DOMAIN_ID"
+    else:
+        source = "--ros2-domain"
+    if not 0 <= value <= MAX_DOMAIN_ID:
+        raise Ros2Error(f"{source} {value}: must be 0..{MAX_DOMAIN_ID} (ROS 2 uses 0..101 safely)")
+    return value
+
+
+@dataclass(frozen=True, slots=True)
+class Discovery:
+    """How far the bridge is seen: a Cyclone configuration and the line that says it."""
+
+    config: str | None
+    """XML given to the domain before ``CYCLONEDDS_URI`` (None: Cyclone's defaults)."""
+    scope: str
+    localhost: bool
+
+
+def discovery(env: Mapping[str, str]) -> Discovery:
+    """ROS 2's discovery range from the environment; localhost unless asked otherwise.
+
+    ``ROS_LOCALHOST_ONLY=1`` or ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` (or neither
+    set: otonav's default, unlike ROS 2 Jazzy's SUBNET) keep it on this host; ``SUBNET``
+    and ``SYSTEM_DEFAULT`` use Cyclone's defaults (multicast on every interface). ``OFF``
+    would make the bridge invisible and is refused. ``CYCLONEDDS_URI`` still applies
+    after ours, as in rmw_cyclonedds.
+    """
+    localhost_only = env.get("ROS_LOCALHOST_ONLY", "").strip() == "1"
+    wanted = env.get("ROS_AUTOMATIC_DISCOVERY_RANGE", "").strip().upper()
+    if localhost_only or wanted in ("", "LOCALHOST"):
+        return Discovery(LOCALHOST_CONFIG, "this host only (localhost)", True)
+    if wanted in ("SUBNET", "SYSTEM_DEFAULT"):
+        return Discovery(None, f"the network (ROS_AUTOMATIC_DISCOVERY_RANGE={wanted})", False)
+    if wanted == "OFF":
+        raise Ros2Error(
+            "ROS_AUTOMATIC_DISCOVERY_RANGE=OFF: no ROS 2 node could see the bridge "
+            "(use LOCALHOST or SUBNET)"
+        )
+    raise Ros2Error(
+        f"ROS_AUTOMATIC_DISCOVERY_RANGE={wanted}: must be LOCALHOST, SUBNET, SYSTEM_DEFAULT or OFF"
+    )
