@@ -20,8 +20,11 @@ true for every box it skips:
    sim time sums 180,000 of them: at most ~4e-8 m of rounding at 2 km driven), and a
    bound that is off by rounding may only check a box it could have skipped.
 
-Cost (measured in issue 30's clutter bench, 1000 boxes): ~0.5 us per sample when no box
-is due, against ~300 us for the loop over every box it replaces.
+Cost on the clutter bench's course (otonav.bench.clutter; CPU, 1720 samples): 0.5 / 2.0
+/ 4.6 us per sample with 0 / 1000 / 3000 boxes, the first sample's pass over every box
+included; the loop over every box it replaced took 0.6 / 89 / 323 us. After the first
+sample, 3000 boxes cost 2.4 us and ~1.4 distances per sample: what grows is the number
+of boxes near the robot, not the number in the world.
 """
 
 from __future__ import annotations
