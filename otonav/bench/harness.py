@@ -34,6 +34,8 @@ class Case:
     """Extra actors subscribed to /scan (scaling with fan-out)."""
     overrides: tuple[str, ...] = ()
     """Stack config ``key.path=value`` overrides (e.g. ``nav.planner=stop``)."""
+    boxes: int = 0
+    """clutter: boxes in the world (otonav.bench.clutter)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -153,6 +155,10 @@ def run_case(case: Case) -> Sample:
         return _fixed_costs()
     if case.kind == "scenario":
         return _scenario()
+    if case.kind == "clutter":
+        from otonav.bench.clutter import run_clutter
+
+        return run_clutter(case)
     scenario = ScenarioConfig()
     stack = StackConfig(world=WorldConfig(lidar_beams=case.beams))  # the obstacle scene
     if case.overrides:

@@ -76,7 +76,18 @@ def _scenario(samples: list[Sample]) -> dict[str, object]:
     }
 
 
-def run_bench(duration: float, reps: int, *, scaling: bool, profile: bool) -> dict[str, object]:
+def run_bench(
+    duration: float,
+    reps: int,
+    *,
+    scaling: bool,
+    profile: bool,
+    clutter: tuple[tuple[int, ...], int] | None = None,
+) -> dict[str, object]:
+    """The stack against bare physics (rows, ratios, fixed costs, the acceptance run),
+    then with ``scaling`` the beams and subscribers tables, with ``clutter`` (counts,
+    reps) the clutter curve (otonav.bench.clutter; profiled per count with ``profile``),
+    all in this one session."""
     kinds = ("bare0", "bare", "stack", "recorded")
     extra = ("fixed", "scenario")
     # Interleave a, b, c, ... a, b, c, ... so slow phases of this shared machine hit all.
@@ -142,6 +153,12 @@ def run_bench(duration: float, reps: int, *, scaling: bool, profile: bool) -> di
             )
             for n in (1, 4, 16)
         }
+    if clutter is not None:
+        from otonav.bench.clutter import clutter_curve
+
+        counts, clutter_reps = clutter
+        curve = clutter_curve(counts, clutter_reps, profile=profile)
+        result["clutter"] = {"reps": clutter_reps, "rows": [asdict(r) for r in curve]}
     return result
 
 
@@ -210,6 +227,18 @@ def format_report(result: dict[str, object]) -> str:
                     f"  {name:>6}: RTF {r['rtf']:>5.0f}x  {r['us_per_10ms_sim']:>6.0f} us/10ms"
                     f"  wall {r['wall_median_s']:.3f} s"
                 )
+    clutter = result.get("clutter")
+    if isinstance(clutter, dict):
+        from otonav.bench.clutter import ClutterRow, format_clutter
+
+        rows = [ClutterRow(**{**r, "top": tuple(map(tuple, r["top"]))}) for r in clutter["rows"]]
+        lines.append(format_clutter(rows, clutter["reps"]))
+        lines.append(
+            f"in this session: (b)/(a) = {result['ratio_b_over_a']:.2f}, "
+            f"(c)/(a) = {result['ratio_c_over_a']:.2f} (wall); "
+            f"(b)/(a) = {result['cpu_ratio_b_over_a']:.2f}, "
+            f"(c)/(a) = {result['cpu_ratio_c_over_a']:.2f} (CPU)"
+        )
     return "\n".join(lines)
 
 

@@ -14,6 +14,12 @@ def add_parser(commands: Any) -> None:
     p.add_argument("--reps", type=int, default=5, help="runs per configuration (default 5)")
     p.add_argument("--json", type=Path, default=Path("out/bench.json"), help="write figures here")
     p.add_argument("--no-scaling", action="store_true", help="skip the beams / subscribers tables")
+    p.add_argument(
+        "--no-clutter",
+        action="store_true",
+        help="skip the clutter curve (RTF with 0 to 3000 boxes, otonav.bench.clutter)",
+    )
+    p.add_argument("--clutter-reps", type=int, default=5, help="runs per box count (default 5)")
     p.add_argument("--quick", action="store_true", help="2 s, 1 run, no scaling: checks it runs")
     p.add_argument(
         "--long",
@@ -26,6 +32,7 @@ def add_parser(commands: Any) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    from otonav.bench.clutter import COUNTS as CLUTTER_COUNTS
     from otonav.bench.report import format_report, run_bench, write_json
     from otonav.stack.files import ConfigFileError
 
@@ -49,9 +56,13 @@ def main(args: argparse.Namespace) -> int:
         raise ConfigFileError(f"--duration {duration:g}: must be in (0, 86400] s of sim time")
     if not 1 <= reps <= 1000:
         raise ConfigFileError(f"--reps {reps}: must be in [1, 1000]")
+    clutter: tuple[tuple[int, ...], int] | None = (CLUTTER_COUNTS, args.clutter_reps)
+    if args.no_clutter:
+        clutter = None
     if args.quick:
         duration, reps, scaling = 2.0, 1, False
-    result = run_bench(duration, reps, scaling=scaling, profile=not args.quick)
+        clutter = None if clutter is None else ((0, 100), 1)
+    result = run_bench(duration, reps, scaling=scaling, profile=not args.quick, clutter=clutter)
     print(format_report(result))
     write_json(result, args.json)
     print(f"figures: {args.json}")

@@ -27,6 +27,8 @@ def test_bench_quick_mode_runs_and_writes_its_figures(
         "ratios (CPU)",
         "fixed cost of a run",
         "acceptance scenario",
+        "clutter curve",
+        "in this session: (b)/(a) =",
     ):
         assert label in out
     data = json.loads(figures.read_text())
@@ -47,6 +49,11 @@ def test_bench_quick_mode_runs_and_writes_its_figures(
     assert abs(sum(walls) - fixed["total_ms"]) < 0.05 * fixed["total_ms"] + 0.5
     # The scenario ran to its verdict (the acceptance goal is reached before 30 s).
     assert 0 < data["acceptance_scenario"]["sim_s"] < 30
+    # The clutter curve's quick form: no boxes and 100, each run to its verdict.
+    curve = data["clutter"]["rows"]
+    assert [row["boxes"] for row in curve] == [0, 100]
+    assert curve[0]["rtf_vs_none"] == 1.0
+    assert all(row["rtf"] > 0 and row["plot_s"] > 0 for row in curve)
 
 
 def test_memory_probe_reads_rss_heap_and_file_at_each_checkpoint() -> None:

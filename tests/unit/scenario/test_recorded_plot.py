@@ -5,15 +5,17 @@ chunks. The figure is checked through its artists, not its pixels."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import pytest
+from matplotlib.path import Path as Path_
 
 from otonav.cli import main
 from otonav.hal import BoxObstacle
 from otonav.msgs import Header, Odometry, Point, Pose, PoseStamped, PoseWithCovariance, Time
 from otonav.record.writer import RecordingWriter
-from otonav.scenario.plot import draw_trajectory
+from otonav.scenario.plot import box_outlines, draw_trajectory
 from otonav.scenario.replay import plot_recording, recorded_plot
 from otonav.stack.worldmeta import WORLD_METADATA
 
@@ -96,7 +98,11 @@ def test_obstacles_and_walls_are_drawn_where_the_recording_says(tmp_path: Path) 
     )
     fig = _figure(recording)
     (ax,) = fig.axes  # type: ignore[attr-defined]
-    assert sum(type(p).__name__ == "Polygon" for p in ax.patches) == 3
+    (boxes,) = [p for p in ax.patches if p.get_label() == "obstacles, walls"]
+    codes = boxes.get_path().codes
+    assert type(boxes).__name__ == "PathPatch"  # one artist for all boxes (issue 30)
+    assert codes is not None
+    assert list(codes).count(Path_.CLOSEPOLY) == 3
     assert "unknown" not in _notes(fig)
 
 
@@ -126,3 +132,18 @@ def test_plot_of_a_cut_off_recording_draws_the_complete_chunks_with_a_warning(
 def test_plot_recording_writes_a_png(tmp_path: Path) -> None:
     png = plot_recording(_recording(tmp_path / "r.mcap"), tmp_path / "out.png")
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_box_outlines_are_the_boxes_corners() -> None:
+    """The vectorised outlines put each corner where the box's own geometry says."""
+    boxes = (BoxObstacle(1.0, 0.5, 0.2, 0.3, 0.7), BoxObstacle(-2.0, 3.0, 1.5, 0.05, -2.0))
+    outlines = box_outlines(boxes)
+    assert outlines.shape == (2, 5, 2)
+    for box, outline in zip(boxes, outlines, strict=True):
+        for x, y in outline[:4]:
+            assert box.distance_to(x, y) == pytest.approx(0.0, abs=1e-12)  # on the box
+            c, s = math.cos(box.yaw), math.sin(box.yaw)
+            lx = c * (x - box.x) + s * (y - box.y)
+            ly = -s * (x - box.x) + c * (y - box.y)
+            assert (abs(lx), abs(ly)) == pytest.approx((box.half_x, box.half_y))  # a corner
+        assert list(outline[4]) == list(outline[0])

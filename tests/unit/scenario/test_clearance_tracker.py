@@ -1,0 +1,160 @@
+"""The judge's clearance (issue 30) against the judge before it: on random worlds and
+random walks, the minimum and where it happened are the same floats as the old per-box
+loop gives and as checking every box at every sample gives; and its work after the
+first sample does not grow with boxes far from the robot."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
+
+from otonav.hal import BoxObstacle
+from otonav.scenario.clearance import ClearanceTracker
+
+pytestmark = pytest.mark.unit
+
+
+class OldJudgeClearance:
+    """The judge's ``_clearance`` as it was before issue 30 (commit 4cfdfe0): every box
+    every sample, skipping a box its distance then minus the path since proves far."""
+
+    def __init__(self, boxes: tuple[BoxObstacle, ...]) -> None:
+        self.math = [
+            (b.x, b.y, b.half_x, b.half_y, math.cos(b.yaw), math.sin(b.yaw)) for b in boxes
+        ]
+        self.seen = [(-math.inf, 0.0)] * len(boxes)
+        self.min_clearance = math.inf
+        self.min_clearance_at = (math.nan, math.nan)
+        self.path = 0.0
+        self.last: tuple[float, float] | None = None
+
+    def update(self, x: float, y: float) -> None:
+        if self.last is not None:
+            self.path += math.hypot(x - self.last[0], y - self.last[1])
+        self.last = (x, y)
+        path, seen = self.path, self.seen
+        for i, (bx, by, hx, hy, c, s) in enumerate(self.math):
+            d_then, path_then = seen[i]
+            if d_then - (path - path_then) > self.min_clearance + 1e-9:
+                continue
+            dx, dy = x - bx, y - by
+            lx = c * dx + s * dy
+            ly = -s * dx + c * dy
+            d = math.hypot(max(abs(lx) - hx, 0.0), max(abs(ly) - hy, 0.0))
+            seen[i] = (d, path)
+            if d < self.min_clearance:
+                self.min_clearance = d
+                self.min_clearance_at = (x, y)
+
+
+coord = st.floats(-6.0, 6.0)
+box = st.builds(
+    BoxObstacle,
+    coord,
+    coord,
+    st.floats(0.01, 1.5),
+    st.floats(0.01, 1.5),
+    st.floats(-math.pi, math.pi),
+)
+wall = st.builds(  # long and thin, like the arena's walls and the courses' barriers
+    BoxObstacle, coord, coord, st.floats(0.02, 0.2), st.floats(0.5, 200.0), st.floats(-3.2, 3.2)
+)
+# A walk of 100 Hz samples: mostly steps of a few mm, now and then a jump (a teleport,
+# a replayed world) or standing still.
+step = st.one_of(
+    st.tuples(st.floats(-0.006, 0.006), st.floats(-0.006, 0.006)),
+    st.tuples(st.floats(-3.0, 3.0), st.floats(-3.0, 3.0)),
+    st.just((0.0, 0.0)),
+)
+
+
+def _walk(
+    boxes: tuple[BoxObstacle, ...],
+    start: tuple[float, float],
+    steps: list[tuple[float, float]],
+    tracker: ClearanceTracker,
+) -> None:
+    old = OldJudgeClearance(boxes)
+    best, best_at = math.inf, (math.nan, math.nan)
+    x, y = start
+    for dx, dy in [(0.0, 0.0), *steps]:
+        x, y = x + dx, y + dy
+        tracker.update(x, y)
+        old.update(x, y)
+        for b in boxes:
+            d = b.distance_to(x, y)
+            if d < best:
+                best, best_at = d, (x, y)
+        assert tracker.min_clearance == old.min_clearance == best
+        assert tracker.min_clearance_at == old.min_clearance_at
+        if boxes:
+            assert tracker.min_clearance_at == best_at
+
+
+# A long thin box turned 0.5 rad, the robot walking at one of its far corners: its
+# bounding rectangle (not its centre line) must put it among the candidates.
+_TOWARDS_CORNER = [(0.005, -0.005)] * 150
+
+
+@settings(max_examples=150, deadline=None)
+@example((BoxObstacle(0.0, 0.0, 0.02, 3.0, 0.5),), (-2.4, 3.6), _TOWARDS_CORNER, 0.05, 0.5)
+@example((BoxObstacle(0.0, 0.0, 3.0, 0.02, 0.5),), (2.0, 2.6), _TOWARDS_CORNER, 0.05, 0.5)
+@given(
+    boxes=st.lists(st.one_of(box, box, wall), max_size=40).map(tuple),
+    start=st.tuples(coord, coord),
+    steps=st.lists(step, max_size=400),
+    cell=st.sampled_from([0.05, 0.5, 4.0]),
+    reach=st.sampled_from([0.01, 0.5, 10.0]),
+)
+def test_same_floats_as_the_old_judge_and_every_box(
+    boxes: tuple[BoxObstacle, ...],
+    start: tuple[float, float],
+    steps: list[tuple[float, float]],
+    cell: float,
+    reach: float,
+) -> None:
+    _walk(boxes, start, steps, ClearanceTracker(boxes, cell=cell, reach=reach))
+
+
+@settings(max_examples=15, deadline=None)
+@given(
+    seed_boxes=st.lists(
+        st.tuples(st.floats(-5.0, 5.0), st.floats(-5.0, 5.0)), min_size=200, max_size=400
+    ),
+    steps=st.lists(st.tuples(st.floats(-0.01, 0.01), st.floats(-0.01, 0.01)), max_size=400),
+)
+def test_same_floats_in_clutter(
+    seed_boxes: list[tuple[float, float]], steps: list[tuple[float, float]]
+) -> None:
+    """Hundreds of 0.1 m boxes, as in the clutter bench: the grid and the heap at work."""
+    boxes = tuple(BoxObstacle(x, y, 0.05, 0.05, 0.3 * x) for x, y in seed_boxes)
+    _walk(boxes, (0.0, 0.0), steps, ClearanceTracker(boxes))
+
+
+def _checks_after_the_first_sample(far_boxes: int) -> int:
+    near = tuple(BoxObstacle(0.5 * k, 0.6 * (-1) ** k, 0.05, 0.05) for k in range(12))
+    far = tuple(BoxObstacle(20.0 + 0.01 * k, 20.0, 0.05, 0.05) for k in range(far_boxes))
+    tracker = ClearanceTracker(near + far)
+    tracker.update(0.0, 0.0)
+    first = tracker.checks
+    for k in range(1, 1001):  # 5 m at 0.5 m/s, sampled at 100 Hz
+        tracker.update(0.005 * k, 0.0)
+    return tracker.checks - first
+
+
+def test_work_does_not_grow_with_boxes_far_away() -> None:
+    """The first sample checks every box (nothing is known yet); after it, 3000 boxes
+    20 m away cost not one distance more than none."""
+    assert _checks_after_the_first_sample(3000) == _checks_after_the_first_sample(0)
+    assert _checks_after_the_first_sample(0) > 0
+
+
+@pytest.mark.parametrize(
+    ("cell", "reach", "field"), [(0.0, 0.5, "cell"), (0.5, -1.0, "reach"), (math.nan, 0.5, "cell")]
+)
+def test_bad_parameters_name_the_field(cell: float, reach: float, field: str) -> None:
+    with pytest.raises(ValueError, match=f"ClearanceTracker.{field} must be"):
+        ClearanceTracker((), cell=cell, reach=reach)
