@@ -17,20 +17,13 @@ import sys
 from collections.abc import Sequence
 from typing import Any
 
+from otonav.errors import UsageError
+
 COMMANDS: tuple[str, ...] = ("run", "info", "inspect", "bench", "sweep", "replay")
 """Modules under ``otonav.cli`` whose ``add_parser`` registers a command, in help order."""
 
 USAGE_ERROR = 2
 
-USAGE_ERRORS: tuple[tuple[str, str], ...] = (
-    ("otonav.stack.files", "ConfigFileError"),
-    ("otonav.record.reader", "RecordingError"),
-    ("otonav.hal.mujoco", "SceneError"),
-    ("otonav.hal.viewer", "NoDisplayError"),
-    ("otonav.record.outlock", "OutputBusyError"),
-)
-"""(module, class) of the errors that mean bad input: one line, exit 2. Named, not
-imported: an exception can only be an instance of a class whose module is loaded."""
 
 EPILOG = """\
 With no command, otonav runs `run` with its defaults (the acceptance scenario);
@@ -80,14 +73,6 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _is_usage_error(exc: BaseException) -> bool:
-    for module_name, class_name in USAGE_ERRORS:
-        module = sys.modules.get(module_name)
-        if module is not None and isinstance(exc, getattr(module, class_name)):
-            return True
-    return False
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     args_list = list(sys.argv[1:] if argv is None else argv)
     if not args_list or (
@@ -105,7 +90,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("otonav: interrupted; the recording was finished and is readable", file=sys.stderr)
         return 130
     except Exception as exc:
-        if _is_usage_error(exc):
+        if isinstance(exc, UsageError):  # bad input: every kind derives from it
             print(f"otonav: error: {exc}", file=sys.stderr)
             return USAGE_ERROR
         if isinstance(exc, OSError):  # an unwritable --out, a directory given as a file

@@ -32,6 +32,7 @@ from otonav.runtime import (
     Subscription,
     System,
 )
+from otonav.runtime.clock import MAX_STEP_BATCH
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.session import StackSession
 
@@ -318,7 +319,7 @@ async def open_live_stack(
     goal: tuple[float, float] | None = None,
     navigator: bool = True,
     extra_actors: Sequence[Actor] = (),
-    max_step_batch: float = 0.05,
+    max_step_batch: float = MAX_STEP_BATCH,
     foxglove: bool | LiveViewOptions = False,
 ) -> AsyncIterator[LiveStack]:
     """Bring the robot stack up on the running (stock asyncio) loop in real-time mode,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from otonav.runtime import RealTimeClock, TimeSource
+from otonav.runtime.clock import MAX_STEP_BATCH
 
 
 class PacedClock(RealTimeClock):
@@ -11,6 +12,6 @@ class PacedClock(RealTimeClock):
     stack also runs :meth:`pace`)."""
 
     def __init__(
-        self, source: TimeSource, *, scale: float = 1.0, max_step_batch: float = 0.05
+        self, source: TimeSource, *, scale: float = 1.0, max_step_batch: float = MAX_STEP_BATCH
     ) -> None:
         super().__init__(source, scale=scale, max_step_batch=max_step_batch)

@@ -43,6 +43,7 @@ from typing import Any, Final, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from otonav.errors import UsageError
 from otonav.hal.description import BUILTIN_ROBOTS, Mount, RobotDescription, builtin_robot
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.types import (
@@ -105,7 +106,7 @@ def _one_line(exc: BaseException) -> str:
     return " ".join(str(exc).split())
 
 
-class SceneError(ValueError):
+class SceneError(UsageError):
     """An MJCF scene that cannot be found, parsed, compiled or used as an otonav world."""
 
 

@@ -15,6 +15,8 @@ import subprocess
 import sys
 from typing import Final
 
+from otonav.errors import UsageError
+
 __all__ = ["NO_DISPLAY_FIX", "NoDisplayError", "check_display"]
 
 NO_DISPLAY_FIX: Final = "run without --gui, or under xvfb-run"
@@ -35,7 +37,7 @@ sys.exit(3)
 """
 
 
-class NoDisplayError(RuntimeError):
+class NoDisplayError(UsageError, RuntimeError):
     """No display the viewer can open; the message is one line: what and the fix."""
 
 

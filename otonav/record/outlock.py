@@ -28,13 +28,15 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
+from otonav.errors import UsageError
+
 try:
     import fcntl
 except ImportError:  # pragma: no cover - Windows: no lock
     fcntl = None  # type: ignore[assignment]
 
 
-class OutputBusyError(Exception):
+class OutputBusyError(UsageError):
     """Another run is writing to the same output: one line naming it and the way out."""
 
 

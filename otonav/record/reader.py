@@ -13,6 +13,7 @@ from mcap.reader import NonSeekingReader, make_reader
 from mcap.records import Channel, Message, Metadata, Schema
 from mcap_ros2.decoder import DecoderFactory
 
+from otonav.errors import UsageError
 from otonav.record.verify import (
     CUT_OFF_ERRORS,
     MAGIC,
@@ -36,7 +37,7 @@ __all__ = [
 ]
 
 
-class RecordingError(ValueError):
+class RecordingError(UsageError):
     """A file that is not a readable recording: one line naming it and why."""
 
 

@@ -22,6 +22,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Final
 
+from otonav.errors import UsageError
 from otonav.msgs import Message
 from otonav.record.type_hash import rihs01
 from otonav.runtime import Durability, QoS, Reliability
@@ -53,7 +54,7 @@ LOCALHOST_CONFIG: Final = (
 """rmw_cyclonedds_cpp's configuration for ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``."""
 
 
-class Ros2Error(ValueError):
+class Ros2Error(UsageError):
     """The ROS 2 bridge cannot start: one line naming the flag, key or variable."""
 
 

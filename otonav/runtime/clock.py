@@ -125,6 +125,11 @@ def _wake(future: asyncio.Future[None]) -> None:
         future.set_result(None)
 
 
+MAX_STEP_BATCH = 0.05
+"""s of sim time: the most a real-time run steps at once after the loop was held up (the
+excess slips); the one value every real-time runner (CLI, embedding, tests) uses."""
+
+
 class RealTimeClock(Clock):
     """Sim time on any loop, paced to the wall clock times ``scale``.
 

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+from otonav.errors import OtonavError
 
-class OtonavRuntimeError(Exception):
+
+class OtonavRuntimeError(OtonavError):
     """Base class of every error the runtime raises on purpose."""
 
 

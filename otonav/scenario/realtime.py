@@ -17,6 +17,7 @@ from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
 from otonav.limits import check_scale
 from otonav.runtime import Actor, RealTimeClock
+from otonav.runtime.clock import MAX_STEP_BATCH
 from otonav.runtime.timesource import tick_rate
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
@@ -41,7 +42,6 @@ VIEWER_HZ = 60.0
 HOLD_POLL_S = 0.05
 """Wall seconds between looks at whether the user closed the held window."""
 
-MAX_STEP_BATCH = 0.05
 """Most sim seconds stepped at once: a machine slower than the scale makes sim time slip
 behind the wall clock (the verdict's RTF shows it) rather than step in bursts."""
 

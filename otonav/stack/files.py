@@ -10,12 +10,13 @@ from typing import TypeVar
 import yaml
 from pydantic import BaseModel, ValidationError
 
+from otonav.errors import UsageError
 from otonav.stack import safe_yaml
 
 _M = TypeVar("_M", bound=BaseModel)
 
 
-class ConfigFileError(ValueError):
+class ConfigFileError(UsageError):
     """A configuration file that cannot be used: one line naming the file, the key path
     and what would be valid."""
 

@@ -36,6 +36,7 @@ from otonav.actors.recorder import Recorder
 from otonav.hal import RobotHardwareInterface
 from otonav.record.writer import RecordingWriter
 from otonav.runtime import Actor, Clock, RealTimeClock, RestartPolicy, System, TimeSource
+from otonav.runtime.clock import MAX_STEP_BATCH
 from otonav.runtime.loop import VirtualTimeLoop
 from otonav.stack.rosout import attach_rosout
 from otonav.stack.worldmeta import WORLD_METADATA, world_metadata
@@ -50,7 +51,7 @@ class RealTime:
     :class:`~otonav.runtime.RealTimeClock`)."""
 
     scale: float = 1.0
-    max_step_batch: float = 0.05
+    max_step_batch: float = MAX_STEP_BATCH
 
     def clock(self, source: TimeSource) -> RealTimeClock:
         return RealTimeClock(source, scale=self.scale, max_step_batch=self.max_step_batch)

@@ -14,7 +14,7 @@ from test_foxglove_live import _free_port
 from test_gui import CLI_GUI_CHILD, _Child, _robot, _screen_of, _screenshot, _start_children
 
 from otonav.replay.recording import load_recording
-from otonav.scenario.realtime import MAX_STEP_BATCH
+from otonav.runtime.clock import MAX_STEP_BATCH
 
 pytestmark = pytest.mark.smoke
 
