@@ -1,16 +1,21 @@
 """otonav: a deterministic, faster-than-real-time robot stack of asyncio actors on MuJoCo.
 
 Layers, top to bottom; imports point down only (import-linter contracts in pyproject.toml):
-    cli, testing       what users touch: ``python -m otonav``, the pytest plugin and fixtures
-    scenario           run a scenario in sim time, judge it from ground truth, plot it
-    stack              the launch file as data: pydantic config -> world + actors
-    actors             bridge, base controller, navigator, recorder: subscribe, compute, publish
-    record             MCAP recordings in ROS 2 CDR: write, read, info, salvage
-    hal                RobotHardwareInterface, FakeHardware; only hal.mujoco imports mujoco;
-                       hal.can (wheels over CAN, only hal.can.bus imports python-can);
-                       hal.sim (the drive emulator: test equipment, never robot code)
-    nav, control       pure math: go-to-goal, obstacle guard, diff-drive kinematics
-    msgs, runtime      ROS 2-shaped messages; virtual-time loop, actors, topics, QoS, waits
+    cli, testing, embed  what users touch: ``python -m otonav``, the pytest plugin and
+                         fixtures, a live stack and fast runs inside an asyncio service
+    sweep, replay, ros2  families of runs on a pool or Ray; re-simulating actors against a
+                         recording; the ROS 2 bridge over DDS (only ros2.dds imports cyclonedds)
+    scenario             run a scenario in sim time, judge it from ground truth, plot it
+    stack                the launch file as data: robot description + actors -> world + actors
+    actors               bridge, base controller, navigator, safety layer, recorder, live view
+    record               MCAP recordings in ROS 2 CDR: write, read, info, salvage, bags
+    hal                  RobotHardwareInterface, FakeHardware, robot descriptions; only
+                         hal.mujoco imports mujoco; hal.can (wheels over CAN, only hal.can.bus
+                         imports python-can); hal.sim (the drive emulator: test equipment)
+    nav, control         pure math: planning, the safety limit, diff-drive kinematics
+    msgs, runtime        ROS 2-shaped messages; virtual-time loop, actors, topics, QoS, waits
+    errors               OtonavError and UsageError (bad input: one line, exit 2)
+Beside them: bench (the stack's own benchmarks), limits (every bound and why).
 """
 
 from otonav._version import __version__

@@ -164,7 +164,8 @@ class Bridge(Actor):
     /tf_static base_link->laser once; writes /wheel_cmd to the hardware.
 
     Odometry: wheel encoders for distance, the gyro for heading (it does not scrub
-    in turns; notes/mujoco-model.md: ~2 cm and 0.2 deg over a circle vs 7 cm and 8 deg).
+    in turns; measured when the model was tuned: ~2 cm and 0.2 deg over a circle against
+    7 cm and 8 deg from the wheels alone).
 
     Hardware health (:meth:`RobotHardwareInterface.health`, whatever the HAL): checked at
     every publishing instant; a change is published on /hardware/status (latched, for

@@ -1,5 +1,5 @@
 """Writing one MCAP file: profile ``ros2``, ``ros2msg`` schemas, CDR payloads, sim-time
-stamps. Crash-safe by construction (notes/recording.md):
+stamps. Crash-safe by construction (ADR 0004):
 
 - chunks of 64 KiB (a 1 MiB chunk held the longest ``add_message`` pause at 8.4 ms vs
   0.9 ms, and a kill loses at most one chunk);

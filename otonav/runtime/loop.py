@@ -1,11 +1,12 @@
 """The virtual-time asyncio loop: the world is the clock.
 
-``loop.time()`` is simulated time, kept as an integer tick count (pitfall 1 of
-notes/virtual-time.md: float time stalls). When no callback is ready, the loop asks its
-:class:`~otonav.runtime.timesource.TimeSource` to advance to the earliest due timer and
-runs what woke. Equal deadlines wake in FIFO order (asyncio's heap alone scrambles
-them). It also watches for the two ways a simulation hangs: a deadlock (nothing can ever
-wake) and a livelock (sim time runs on, the run never ends: a wall-clock ceiling).
+``loop.time()`` is simulated time, kept as an integer tick count (a float
+time stalls once the tick is below its resolution: ADR 0001). When no callback is
+ready, the loop asks its :class:`~otonav.runtime.timesource.TimeSource` to advance to
+the earliest due timer and runs what woke. Equal deadlines wake in FIFO order
+(asyncio's heap alone scrambles them). It also watches for the two ways a simulation
+hangs: a deadlock (nothing can ever wake) and a livelock (sim time runs on, the run
+never ends: a wall-clock ceiling).
 
 The hook is the selector: asyncio's ``_run_once`` calls ``select(timeout)`` exactly
 once per iteration with the time to the next timer, or 0 when callbacks are ready;

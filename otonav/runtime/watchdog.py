@@ -3,8 +3,9 @@
 The virtual-time loop checks its wall-clock ceiling in its own idle path and every 256
 passes (``otonav.runtime.loop``). A callback that never yields (an actor computing in a
 ``while True``) never returns to either: it ran 698 s past an 8 s ceiling, and a SIGTERM,
-whose cancellation is a callback too, was never handled (issue 27; pitfall 9 of
-notes/virtual-time.md). This thread watches the loop instead:
+whose cancellation is a callback too, was never handled (issue 27; a
+callback that never yields holds every timer, the ceiling's too: ADR 0039). This thread
+watches the loop instead:
 
 - the loop counts its passes (``beats``) and says when it is waiting in its selector;
 - once the ceiling has passed, or a stop was asked for (:meth:`LoopWatchdog.expect_progress`:

@@ -3,7 +3,7 @@
 A :class:`CanEndpoint` wraps one python-can bus and speaks :class:`RawFrame` (id, data,
 flags) to the rest of otonav. It never starts a thread: :meth:`CanEndpoint.poll`
 drains what arrived with ``recv(timeout=0)``, called from sim time (no ``Notifier``,
-whose reader thread would run on the wall clock, notes/can-odrive.md).
+whose reader thread would run on the wall clock: ADR 0016).
 
 On the ``virtual`` interface every endpoint opened on the same channel in this process
 hears every other one, so a stack and its drive emulator meet there. Error frames use
