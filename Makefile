@@ -53,8 +53,9 @@ test-image: image $(STAMP)
 
 ## the unit and SIL layers under every CPython >= 3.11 on this machine (pyenv's too), each
 ## in its own venv under .venvs/; the acceptance recording must be byte-identical on all
+## (.ci/run passes TEST_VERSIONS_ARGS="--gate-venv .venv": make test just ran .venv's layers)
 test-versions:
-	$(PYTHON) scripts/test_versions.py
+	$(PYTHON) scripts/test_versions.py $(TEST_VERSIONS_ARGS)
 
 clean:
 	rm -rf $(VENV) .venvs .mypy_cache .ruff_cache .pytest_cache .hypothesis

@@ -10,9 +10,15 @@ version, pyenv's first, the newest patch release first. An interpreter without t
 
 Each version gets `.venvs/py3.N` with otonav and its dev extras pinned by constraints.txt
 (what `make test` installs), made again when pyproject.toml, constraints.txt or the
-interpreter change. In it, `scripts/gate.py unit sil` runs the two layers, then
+interpreter change. The venvs are made one after the other on a background thread while
+the layers run in those that are ready (an install mostly waits on downloads, the layers
+on the CPU). In each, `scripts/gate.py unit sil` runs the two layers, then
 `otonav run --scenario acceptance` writes a recording whose sha256 is compared across
 versions: same config, same seed, so the same bytes on every version.
+
+`--gate-venv .venv` (what .ci/run passes, right after `make test`): the gate has just
+run every layer in that venv, so for its version the venv is used as it is, its layers
+are not run a second time, and only its recording is taken.
 Standard library only: it runs before any venv exists.
 """
 
@@ -26,6 +32,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -57,7 +64,12 @@ class Result:
     layers_passed: bool
     seconds: float
     sha256: str | None
+    run_passed: bool = False
     note: str = ""
+
+    @property
+    def passed(self) -> bool:
+        return self.layers_passed and self.run_passed and self.sha256 is not None
 
 
 def _pyenv_candidates() -> list[Path]:
@@ -123,34 +135,52 @@ def _stamp(interp: Interpreter) -> str:
     return digest.hexdigest()
 
 
+class VenvError(Exception):
+    pass
+
+
 def ensure_venv(interp: Interpreter) -> Path:
+    """The version's venv, made (quietly: its output is shown only if it fails) unless an
+    up-to-date one exists."""
     venv = VENVS / f"py{interp.minor}"
     stamp = venv / ".installed"
     wanted = _stamp(interp)
     if stamp.exists() and stamp.read_text() == wanted:
         return venv
     shutil.rmtree(venv, ignore_errors=True)
-    print(f"--- {interp.minor}: making {venv.relative_to(ROOT)} from {interp.path}", flush=True)
-    subprocess.run([str(interp.path), "-m", "venv", str(venv)], check=True)
+    start = time.monotonic()
     pip = [str(venv / "bin" / "python"), "-m", "pip", "install", "--quiet"]
-    subprocess.run(
+    for argv in (
+        [str(interp.path), "-m", "venv", str(venv)],
         [*pip, "-c", "constraints.txt", "-e", ".[dev]"],
-        cwd=ROOT,
-        check=True,
-    )
+    ):
+        done = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, check=False)
+        if done.returncode != 0:
+            tail = "\n".join((done.stdout + done.stderr).strip().splitlines()[-15:])
+            raise VenvError(f"{' '.join(argv)}: exit {done.returncode}\n{tail}")
     stamp.write_text(wanted)
+    print(f"--- made {venv.relative_to(ROOT)} in {time.monotonic() - start:.0f} s", flush=True)
     return venv
 
 
-def run_version(interp: Interpreter, out: Path) -> Result:
+def run_version(
+    interp: Interpreter, venv_ready: Future[Path], out: Path, layers: bool = True
+) -> Result:
     start = time.monotonic()
-    print(f"\n=== CPython {'.'.join(map(str, interp.version))} ({interp.path}) ===", flush=True)
+    full = ".".join(map(str, interp.version))
+    print(f"\n=== CPython {full} ({interp.path}): waiting for its venv ===", flush=True)
     try:
-        venv = ensure_venv(interp)
-    except subprocess.CalledProcessError as exc:
-        return Result(interp, False, time.monotonic() - start, None, f"venv: {exc}")
+        venv = venv_ready.result()
+    except VenvError as exc:
+        print(f"FAILED to make the venv: {exc}", flush=True)
+        return Result(interp, False, time.monotonic() - start, None, note="no venv")
     python = str(venv / "bin" / "python")
-    gate = subprocess.call([python, "scripts/gate.py", "unit", "sil"], cwd=ROOT)
+    if layers:
+        print(f"=== CPython {full}: unit and sil layers ===", flush=True)
+        gate = subprocess.call([python, "scripts/gate.py", "unit", "sil"], cwd=ROOT)
+    else:
+        print(f"=== CPython {full}: layers run by the gate in {venv}; recording only ===")
+        gate = 0
     recording_dir = out / f"py{interp.minor}"
     run = subprocess.run(
         [python, "-m", "otonav", "run", "--scenario", SCENARIO, "--out", str(recording_dir)],
@@ -161,16 +191,32 @@ def run_version(interp: Interpreter, out: Path) -> Result:
     )
     recording = recording_dir / "recording.mcap"
     sha = hashlib.sha256(recording.read_bytes()).hexdigest() if recording.exists() else None
-    note = "" if run.returncode == 0 else f"{SCENARIO} run: exit {run.returncode}"
-    return Result(interp, gate == 0, time.monotonic() - start, sha, note)
+    note = "" if layers else f"(layers: make test, in {venv.name})"
+    if run.returncode != 0:
+        note = f"{SCENARIO} run: exit {run.returncode}"
+    return Result(interp, gate == 0, time.monotonic() - start, sha, run.returncode == 0, note)
 
 
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--list", action="store_true", help="only list the interpreters found")
+    parser.add_argument(
+        "--gate-venv",
+        type=Path,
+        help="a venv in which `make test` has just passed: its version's layers are not rerun",
+    )
     args = parser.parse_args(argv)
 
     interpreters, notes = find_interpreters()
+    gate_venv: tuple[tuple[int, int], Path] | None = None
+    if args.gate_venv is not None:
+        probed = _probe(args.gate_venv / "bin" / "python", "gate")
+        if probed is None:
+            print(f"test-versions: --gate-venv {args.gate_venv}: no CPython in it")
+            return 1
+        gate_venv = (probed[0].version[:2], args.gate_venv.resolve())
+        if gate_venv[0] not in {i.version[:2] for i in interpreters}:
+            interpreters = sorted([*interpreters, probed[0]], key=lambda i: i.version)
     for note in notes:
         print(f"test-versions: {note}")
     print("test-versions: " + ", ".join(f"{i.minor} ({i.source}: {i.path})" for i in interpreters))
@@ -180,19 +226,33 @@ def main(argv: list[str]) -> int:
         print(f"test-versions: no CPython >= {MINIMUM[0]}.{MINIMUM[1]} with venv found")
         return 1
 
-    with tempfile.TemporaryDirectory(prefix="otonav-versions-") as tmp:
-        results = [run_version(interp, Path(tmp)) for interp in interpreters]
+    with (
+        tempfile.TemporaryDirectory(prefix="otonav-versions-") as tmp,
+        ThreadPoolExecutor(max_workers=1) as builder,  # one install at a time, in order
+    ):
+        ready: list[Future[Path]] = []
+        for interp in interpreters:
+            if gate_venv is not None and interp.version[:2] == gate_venv[0]:
+                done: Future[Path] = Future()
+                done.set_result(gate_venv[1])
+                ready.append(done)
+            else:
+                ready.append(builder.submit(ensure_venv, interp))
+        results = [
+            run_version(i, f, Path(tmp), layers=gate_venv is None or i.version[:2] != gate_venv[0])
+            for i, f in zip(interpreters, ready, strict=True)
+        ]
 
     shas = {r.sha256 for r in results}
     identical = len(shas) == 1 and None not in shas
     print(f"\n=== test-versions: unit + sil layers, {SCENARIO} recording sha256 ===")
     for r in results:
-        verdict = "passed" if r.layers_passed and not r.note else "FAILED"
+        verdict = "passed" if r.passed else "FAILED"
         full = ".".join(map(str, r.interpreter.version))
         print(f"{full:<8} {verdict:<7} {r.seconds:6.0f} s  {r.sha256 or '-'}  {r.note}")
     if not identical:
         print(f"FAILED: the {SCENARIO} recordings differ across versions (or one is missing)")
-    failed = sum(1 for r in results if not (r.layers_passed and not r.note))
+    failed = sum(1 for r in results if not r.passed)
     print(f"{len(results) - failed} passed, {failed} failed")
     return 0 if failed == 0 and identical else 1
 
