@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: run test lint bench docs test-docs clean
+.PHONY: run test lint bench docs test-docs clean image test-image test-versions
 
 $(STAMP): pyproject.toml constraints.txt
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -42,5 +42,31 @@ test-docs: docs
 	@sh scripts/ensure_chromium.sh
 	$(PY) scripts/docs_screenshots.py site out/docs-screenshots
 
+## the container image (Containerfile). BASE_IMAGE defaults to one made here from Debian's
+## archive (no registry reachable); elsewhere: make image BASE_IMAGE=docker.io/library/python:3.11-slim-bookworm
+IMAGE ?= localhost/otonav:dev
+BASE_IMAGE ?= localhost/otonav-base:bookworm
+# Debian's podman on these machines: runc (crun fails on the hybrid cgroups) and explicit
+# ulimits (podman's defaults are above the hard limits and setrlimit is refused).
+PODMAN ?= podman --runtime runc
+PODMAN_ULIMITS ?= --ulimit nofile=1024:1024 --ulimit nproc=1024:1024
+image:
+	@sh scripts/ensure_podman.sh
+	@case "$(BASE_IMAGE)" in localhost/otonav-base:*) \
+		PODMAN="$(PODMAN)" sh scripts/make_base_image.sh "$(BASE_IMAGE)" ;; esac
+	$(PODMAN) build $(PODMAN_ULIMITS) --network host --build-arg BASE_IMAGE=$(BASE_IMAGE) \
+		-f Containerfile -t $(IMAGE) .
+
+## build the image, run the acceptance scenario in it (and stop runs with SIGTERM and
+## Ctrl-C), check the recordings on the host
+test-image: image $(STAMP)
+	$(PY) scripts/test_image.py --image $(IMAGE) --podman "$(PODMAN)" --run-options "$(PODMAN_ULIMITS)"
+
+## the unit and SIL layers under every CPython >= 3.11 on this machine (pyenv's too), each
+## in its own venv under .venvs/; the acceptance recording must be byte-identical on all
+## (.ci/run passes TEST_VERSIONS_ARGS="--gate-venv .venv": make test just ran .venv's layers)
+test-versions:
+	$(PYTHON) scripts/test_versions.py $(TEST_VERSIONS_ARGS)
+
 clean:
-	rm -rf $(VENV) site .mypy_cache .ruff_cache .pytest_cache .hypothesis
+	rm -rf $(VENV) .venvs site .mypy_cache .ruff_cache .pytest_cache .hypothesis

@@ -1,4 +1,4 @@
-"""Is MuJoCo's ray cast limited to the geoms a beam can hit? (issue 30, ADR 0039)
+"""Is MuJoCo's ray cast limited to the geoms a beam can hit? (issue 30, ADR 0048)
 
 Measures one 360-beam scan (``mj_multiRay`` as ``MujocoInterface.read_scan`` calls it) in
 the clutter bench's worlds (otonav.bench.clutter: N boxes of 0.1 m off the robot's lane),

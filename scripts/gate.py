@@ -16,13 +16,21 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 PY = sys.executable
+BIN = Path(PY).parent
+# The shell the project runs: its scripts, CI's entry point (and, through actionlint,
+# the workflow's run: steps).
+SHELL_SCRIPTS = [*sorted(str(p.relative_to(ROOT)) for p in ROOT.glob("scripts/*.sh")), ".ci/run"]
 
 LAYERS: dict[str, list[list[str]]] = {
     "static": [
         [PY, "-m", "ruff", "check", "."],
         [PY, "-m", "ruff", "format", "--check", "."],
         [PY, "-m", "mypy"],
-        [str(Path(PY).parent / "lint-imports")],
+        [str(BIN / "lint-imports")],
+        # delivery: the Containerfile, the CI workflow, the shell scripts (docs/adr/0049)
+        [str(BIN / "hadolint"), "Containerfile"],
+        [str(BIN / "actionlint"), "-shellcheck", str(BIN / "shellcheck")],
+        [str(BIN / "shellcheck"), *SHELL_SCRIPTS],
         [PY, "-m", "pytest", "tests/static", "-q"],
     ],
     "unit": [[PY, "-m", "pytest", "tests/unit", "-q"]],
