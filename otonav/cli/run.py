@@ -373,19 +373,15 @@ def _ros2_bridge(args: argparse.Namespace, stack: Any) -> Any:
         if args.ros2_domain is not None or args.ros2_inputs:
             raise ConfigFileError("--ros2-domain/--ros2-in: only with --ros2")
         return None
-    from otonav.ros2 import Ros2Bridge, Ros2Error, Ros2Options
+    from otonav.ros2 import Ros2Error, bridge_for
 
     try:
-        options = Ros2Options(
-            domain_id=args.ros2_domain if args.ros2_domain is not None else section.domain_id,
-            inputs=tuple(args.ros2_inputs or section.inputs),
-        )
-        bridge = Ros2Bridge(options)
+        bridge = bridge_for(section, domain_id=args.ros2_domain, inputs=args.ros2_inputs or ())
     except Ros2Error as exc:
         raise ConfigFileError(str(exc)) from None
     print(
         f"ros2: every topic on DDS domain {bridge.domain_id} (rt/odom ...), seen from "
-        f"{bridge.discovery.scope}; taking {', '.join(options.inputs)} in; paced to the "
+        f"{bridge.discovery.scope}; taking {', '.join(bridge.options.inputs)} in; paced to the "
         "wall clock",
         file=sys.stderr,
         flush=True,

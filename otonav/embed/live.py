@@ -154,6 +154,8 @@ class LiveStack:
         self._close_done: asyncio.Future[None] | None = None
         self._failure: BaseException | None = None
         self.foxglove: FoxgloveServer | None = None
+        self.ros2: Actor | None = None
+        """The ROS 2 bridge (``open_live_stack(ros2=True)``), else None."""
         """The Foxglove live view's server, when asked for (``foxglove=True``)."""
 
     # -- what a host reads
@@ -321,6 +323,7 @@ async def open_live_stack(
     extra_actors: Sequence[Actor] = (),
     max_step_batch: float = MAX_STEP_BATCH,
     foxglove: bool | LiveViewOptions = False,
+    ros2: bool = False,
 ) -> AsyncIterator[LiveStack]:
     """Bring the robot stack up on the running (stock asyncio) loop in real-time mode,
     the world stepped to follow the wall clock times ``scale``; yield a
@@ -337,6 +340,10 @@ async def open_live_stack(
     ``foxglove=True`` (or :class:`~otonav.actors.live_view.LiveViewOptions`) also serves
     every topic to Foxglove over WebSocket (127.0.0.1:8765 by default; ``live.foxglove``
     is the server, stopped on exit).
+
+    ``ros2=True`` (or ``ros2.enabled`` in ``stack``) also mirrors every topic on DDS as a
+    ROS 2 node does and takes the section's ``inputs`` in (the ``otonav[ros2]`` extra;
+    ADR 0047): ``live.ros2`` is the bridge.
     """
     problem = check_scale(scale, "scale")
     if problem is not None:
@@ -355,6 +362,12 @@ async def open_live_stack(
             actors = [*build_actors(stack, hal, navigator=navigator, goal=goal), *extra_actors]
             if server is not None:
                 actors.append(LiveView(server))
+            bridge = None
+            if ros2 or stack.ros2.enabled:
+                from otonav.ros2 import bridge_for
+
+                bridge = bridge_for(stack.ros2)
+                actors.append(bridge)
         except BaseException:
             hal.close()
             if server is not None:
@@ -365,6 +378,7 @@ async def open_live_stack(
             session.add_cleanup(server.close)
         live = LiveStack(session, clock)
         live.foxglove = server
+        live.ros2 = bridge
         live._start()
         yield live
     finally:

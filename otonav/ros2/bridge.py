@@ -24,7 +24,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -48,8 +48,9 @@ from otonav.runtime.mailbox import Endpoint, Publisher, Subscription, Topic
 
 if TYPE_CHECKING:
     from otonav.ros2.dds import Participant, RawReader, RawWriter
+    from otonav.stack.config import Ros2Config
 
-__all__ = ("Ros2Bridge", "Ros2Options", "Ros2Statistics")
+__all__ = ("Ros2Bridge", "Ros2Options", "Ros2Statistics", "bridge_for")
 
 
 @dataclass(frozen=True, slots=True)
@@ -292,3 +293,19 @@ class Ros2Bridge(Actor):
             received=self.received,
             rejected=self.rejected,
         )
+
+
+def bridge_for(
+    section: Ros2Config,
+    *,
+    domain_id: int | None = None,
+    inputs: Sequence[str] = (),
+    env: Mapping[str, str] | None = None,
+) -> Ros2Bridge:
+    """The bridge the stack config's ``ros2`` section asks for (``domain_id`` and
+    ``inputs`` override it: the CLI's flags). The one way every surface makes it."""
+    options = Ros2Options(
+        domain_id=domain_id if domain_id is not None else section.domain_id,
+        inputs=tuple(inputs or section.inputs),
+    )
+    return Ros2Bridge(options, env=env)

@@ -34,8 +34,9 @@ def _domain() -> int:
     return 100 + os.getpid() % 100
 
 
+@pytest.mark.parametrize("way", ["extra_actor", "embedding_option"])
 @pytest.mark.asyncio
-async def test_a_ros2_node_reads_odom_and_sends_a_goal_that_is_reached() -> None:
+async def test_a_ros2_node_reads_odom_and_sends_a_goal_that_is_reached(way: str) -> None:
     domain = _domain()
     env = {k: v for k, v in os.environ.items() if not k.startswith(("ROS_", "CYCLONEDDS"))}
     peer = subprocess.Popen(  # noqa: ASYNC220 (started once, before the stack; not awaited)
@@ -46,11 +47,23 @@ async def test_a_ros2_node_reads_odom_and_sends_a_goal_that_is_reached() -> None
         env=env,
     )
     try:
-        bridge = Ros2Bridge(Ros2Options(domain_id=domain), env=env)
-        assert bridge.discovery.localhost
         stack = StackConfig.model_validate({"nav": {"planner": "stop"}})
+        if way == "extra_actor":
+            bridge = Ros2Bridge(Ros2Options(domain_id=domain), env=env)
+            extra: tuple[Ros2Bridge, ...] = (bridge,)
+        else:  # the embedding API's own option, from the stack config's ros2 section
+            stack = stack.model_copy(
+                update={"ros2": stack.ros2.model_copy(update={"domain_id": domain})}
+            )
+            extra = ()
         with anyio.fail_after(CEILING):
-            async with open_live_stack(stack, scale=4.0, extra_actors=(bridge,)) as live:
+            async with open_live_stack(
+                stack, scale=4.0, extra_actors=extra, ros2=way == "embedding_option"
+            ) as live:
+                if way == "embedding_option":
+                    assert isinstance(live.ros2, Ros2Bridge)
+                    bridge = live.ros2
+                assert bridge.discovery.localhost
 
                 def distance() -> float:
                     truth = live.hal.ground_truth()
