@@ -34,6 +34,7 @@ from otonav.runtime.clock import (
     set_current_clock,
 )
 from otonav.runtime.errors import ActorCrashedError, OtonavRuntimeError, WiringError
+from otonav.runtime.events import ActorStatus, EventKind, SystemEvent
 from otonav.runtime.graph import Graph, build_graph
 from otonav.runtime.loop import VirtualTimeLoop
 from otonav.runtime.mailbox import Bus, Endpoint, Publisher, Subscription
@@ -58,23 +59,13 @@ class RestartPolicy:
             )
 
 
-@dataclass(frozen=True, slots=True)
-class SystemEvent:
-    """A lifecycle event: started, crashed, restarted, stopped, finished."""
-
-    sim_time: float
-    actor: str
-    kind: str
-    detail: str = ""
-
-
 @dataclass(slots=True)
 class _ActorState:
     actor: Actor
     policy: RestartPolicy | None
     restarts: int = 0
     crash_times: list[float] = field(default_factory=list)
-    status: str = "created"
+    status: ActorStatus = ActorStatus.CREATED
     scope: anyio.CancelScope | None = None
     stop_requested: bool = False
     done: anyio.Event | None = None  # set when its supervisor has returned
@@ -182,14 +173,14 @@ class System:
 
     # -- running ------------------------------------------------------------------------
 
-    def _event(self, actor: str, kind: str, detail: str = "") -> None:
+    def _event(self, actor: str, kind: EventKind, detail: str = "") -> None:
         now = self._clock.now() if self._clock is not None else 0.0
         event = SystemEvent(now, actor, kind, detail)
         self.events.append(event)
         for listener in self._event_listeners:
             listener(event)
         log.log(
-            logging.ERROR if kind == "crashed" else logging.INFO,
+            logging.ERROR if kind is EventKind.CRASHED else logging.INFO,
             "[%.3f] %s %s %s",
             now,
             actor,
@@ -224,36 +215,36 @@ class System:
                 try:
                     await actor.on_start()
                     started = True
-                    state.status = "running"
-                    self._event(actor.name, "started")
+                    state.status = ActorStatus.RUNNING
+                    self._event(actor.name, EventKind.STARTED)
                     await _unrequested_cancel_is_a_crash(actor.run())
-                    state.status = "finished"
-                    self._event(actor.name, "finished")
+                    state.status = ActorStatus.FINISHED
+                    self._event(actor.name, EventKind.FINISHED)
                     return
                 except Exception as exc:
                     text = "".join(traceback.format_exception(exc))
                     now = self.clock.now()
-                    self._event(actor.name, "crashed", text)
+                    self._event(actor.name, EventKind.CRASHED, text)
                     if self._may_restart(state, now):
                         state.restarts += 1
-                        self._event(actor.name, "restarted", f"restart {state.restarts}")
+                        self._event(actor.name, EventKind.RESTARTED, f"restart {state.restarts}")
                         await self._stop_actor(state)
                         continue
-                    state.status = "crashed"
+                    state.status = ActorStatus.CRASHED
                     if self._failure is None:
                         self._failure = ActorCrashedError(actor.name, now, text)
                         self._failure.__cause__ = exc
                     self.stop()
                     return
         finally:
-            if started or state.status == "crashed":
+            if started or state.status is ActorStatus.CRASHED:
                 await self._stop_actor(state)
 
     def _clock_failed(self, error: BaseException) -> None:
         """The real-time clock's world (or a watcher) raised inside someone's ``now()``:
         stop the system with it rather than crash the actor that asked for the time."""
         text = "".join(traceback.format_exception(error))
-        self._event("clock", "crashed", text)
+        self._event("clock", EventKind.CRASHED, text)
         if self._failure is None:
             if isinstance(error, OtonavRuntimeError):
                 self._failure = error
@@ -277,12 +268,12 @@ class System:
             except Exception as exc:
                 self._event(
                     state.actor.name,
-                    "crashed",
+                    EventKind.CRASHED,
                     "in on_stop: " + "".join(traceback.format_exception(exc)),
                 )
-        if state.status == "running":
-            state.status = "stopped"
-        self._event(state.actor.name, "stopped")
+        if state.status is ActorStatus.RUNNING:
+            state.status = ActorStatus.STOPPED
+        self._event(state.actor.name, EventKind.STOPPED)
 
     async def __aenter__(self) -> System:
         self._clock_token = set_current_clock(self.clock)
