@@ -15,6 +15,7 @@ from otonav.runtime.actor import Actor, Input, Output
 from otonav.runtime.clock import Clock, Rate, RealTimeClock, VirtualClock, current_clock
 from otonav.runtime.errors import (
     ActorCrashedError,
+    ActorDefinitionError,
     DeadlockError,
     LoopHeldError,
     OtonavRuntimeError,
@@ -47,6 +48,7 @@ __all__ = (
     "SENSOR_DATA_QOS",
     "Actor",
     "ActorCrashedError",
+    "ActorDefinitionError",
     "ActorStatus",
     "Bus",
     "Clock",

@@ -25,7 +25,7 @@ from typing import Any
 import anyio
 from anyio.abc import TaskGroup
 
-from otonav.runtime.actor import Actor
+from otonav.runtime.actor import Actor, check_wirable
 from otonav.runtime.clock import (
     Clock,
     RealTimeClock,
@@ -95,6 +95,7 @@ class System:
         self._stopped: anyio.Event | None = None
         self._clock_token: contextvars.Token[Clock] | None = None
         for actor in actors:
+            check_wirable(actor)
             if actor.name in self._states:
                 raise WiringError(
                     f"two actors are named '{actor.name}'; give each a unique name= "
