@@ -109,11 +109,29 @@ FRAMEWORK_ATTRIBUTES: Final[Mapping[str, str]] = {
 
 
 class Actor:
-    """Base class of every actor. Override ``on_start``, ``run`` and ``on_stop``.
+    """Base class of every actor. Override ``on_start``, ``run``, ``on_failure`` and
+    ``on_stop``.
 
     ``run`` is the actor's body; when it returns, the actor is done (the others go
     on). ``on_stop`` always runs, also when the system stops because another actor
-    crashed.
+    crashed: once for every ``on_start`` that returned or raised.
+
+    The life of an actor under its System's supervision (ADR 0051)::
+
+        on_start -> run -> (returns: finished) ------------------------> on_stop
+                        -> (raises: crashed) -> on_failure(exc) -> policy:
+                               stop:    the system stops ----------------> on_stop
+                               restart: on_stop -> on_start -> run ...   (same instance)
+
+    A restart keeps the instance: the System holds the object it was given, so the
+    restarted ``on_start`` and ``run`` see the attributes the crashed run left (and the
+    messages still queued in its input mailboxes, which a restart does not drop).
+    Whatever must start fresh is reset in ``on_start`` (or ``on_failure``), the way a
+    ROS 2 lifecycle node resets in ``on_configure``.
+
+    An exception in ``on_stop`` or ``on_failure`` is reported like a crash of the
+    actor: the system stops with :class:`~otonav.runtime.errors.ActorCrashedError`
+    (the first failure wins) and is not restarted.
     """
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
@@ -172,13 +190,22 @@ class Actor:
         for actors that attach to topics dynamically (a recorder)."""
 
     async def on_start(self) -> None:
-        """Called once before ``run`` (and again before each restart)."""
+        """Called once before ``run``, and again before each restart, on the same
+        instance: reset here what a restarted run must not inherit from the crashed one."""
 
     async def run(self) -> None:
         """The actor's body. The default does nothing (a purely passive actor)."""
 
+    async def on_failure(self, exc: Exception) -> None:
+        """Called when ``on_start`` or ``run`` raised ``exc``, after the crash is reported
+        and before supervision decides (restart, or stop the system), shielded from
+        cancellation. The ports still work: publish a last status, release a device.
+        ``on_stop`` follows either way. If this raises, that is reported as a crash too
+        and the actor is not restarted."""
+
     async def on_stop(self) -> None:
-        """Called when the actor stops, however it stops (shielded from cancellation)."""
+        """Called when the actor stops, however it stops (shielded from cancellation).
+        If it raises, that is a crash: the system stops and its verdict names it."""
 
 
 #: The lifecycle hooks: subclasses override them with methods; a port may not take their

@@ -209,13 +209,17 @@ class System:
                 self._all_done.set()
 
     async def _supervise_in_scope(self, state: _ActorState) -> None:
+        """One actor's life: ``on_start``, ``run``; on a crash ``on_failure``, then the
+        policy (restart: ``on_stop`` and round again on the same instance; else stop
+        the system); ``on_stop`` once for every ``on_start`` that returned or raised (one
+        cancelled by a stop has nothing to stop)."""
         actor = state.actor
-        started = False
+        stop_due = False
         try:
             while not state.stop_requested:
                 try:
                     await actor.on_start()
-                    started = True
+                    stop_due = True
                     state.status = ActorStatus.RUNNING
                     self._event(actor.name, EventKind.STARTED)
                     await _unrequested_cancel_is_a_crash(actor.run())
@@ -223,28 +227,51 @@ class System:
                     self._event(actor.name, EventKind.FINISHED)
                     return
                 except Exception as exc:
-                    text = "".join(traceback.format_exception(exc))
+                    stop_due = True
+                    text = _format(exc)
                     now = self.clock.now()
                     self._event(actor.name, EventKind.CRASHED, text)
-                    if self._may_restart(state, now):
+                    hook_error = await self._on_failure(actor, exc)
+                    if hook_error is None and self._may_restart(state, now):
                         state.restarts += 1
                         self._event(actor.name, EventKind.RESTARTED, f"restart {state.restarts}")
-                        await self._stop_actor(state)
+                        stop_due = False
+                        if not await self._stop_actor(state):
+                            return  # on_stop raised: reported as a crash, the system stops
                         continue
+                    if hook_error is not None:
+                        text += f"\nand then in on_failure: {hook_error}"
                     state.status = ActorStatus.CRASHED
-                    if self._failure is None:
-                        self._failure = ActorCrashedError(actor.name, now, text)
-                        self._failure.__cause__ = exc
-                    self.stop()
+                    self._fail(actor.name, now, text, exc)
                     return
         finally:
-            if started or state.status is ActorStatus.CRASHED:
+            if stop_due:
                 await self._stop_actor(state)
+
+    async def _on_failure(self, actor: Actor, exc: Exception) -> str | None:
+        """Call ``actor.on_failure(exc)`` (shielded, like ``on_stop``); if it raises,
+        report that as a crash and return its traceback (the actor is then not
+        restarted: its own clean-up is broken)."""
+        with anyio.CancelScope(shield=True):
+            try:
+                await actor.on_failure(exc)
+            except Exception as hook_exc:
+                text = _format(hook_exc)
+                self._event(actor.name, EventKind.CRASHED, "in on_failure: " + text)
+                return text
+        return None
+
+    def _fail(self, actor: str, now: float, text: str, exc: BaseException) -> None:
+        """Stop the system because ``actor`` crashed; the first failure is the verdict."""
+        if self._failure is None:
+            self._failure = ActorCrashedError(actor, now, text)
+            self._failure.__cause__ = exc
+        self.stop()
 
     def _clock_failed(self, error: BaseException) -> None:
         """The real-time clock's world (or a watcher) raised inside someone's ``now()``:
         stop the system with it rather than crash the actor that asked for the time."""
-        text = "".join(traceback.format_exception(error))
+        text = _format(error)
         self._event("clock", EventKind.CRASHED, text)
         if self._failure is None:
             if isinstance(error, OtonavRuntimeError):
@@ -262,19 +289,25 @@ class System:
         state.crash_times.append(now)
         return len(state.crash_times) <= policy.max_restarts
 
-    async def _stop_actor(self, state: _ActorState) -> None:
+    async def _stop_actor(self, state: _ActorState) -> bool:
+        """Run ``on_stop`` (shielded). If it raises, that is a crash like any other: it is
+        reported, the actor's status is crashed and the system stops with
+        :class:`ActorCrashedError` (unless an earlier failure already is the verdict).
+        Returns whether ``on_stop`` returned normally."""
+        ok = True
         with anyio.CancelScope(shield=True):
             try:
                 await state.actor.on_stop()
             except Exception as exc:
-                self._event(
-                    state.actor.name,
-                    EventKind.CRASHED,
-                    "in on_stop: " + "".join(traceback.format_exception(exc)),
-                )
+                ok = False
+                text = "in on_stop: " + _format(exc)
+                self._event(state.actor.name, EventKind.CRASHED, text)
+                state.status = ActorStatus.CRASHED
+                self._fail(state.actor.name, self.clock.now(), text, exc)
         if state.status is ActorStatus.RUNNING:
             state.status = ActorStatus.STOPPED
         self._event(state.actor.name, EventKind.STOPPED)
+        return ok
 
     async def __aenter__(self) -> System:
         self._clock_token = set_current_clock(self.clock)
@@ -389,6 +422,10 @@ async def _unrequested_cancel_is_a_crash(body: Coroutine[Any, Any, None]) -> Non
             f"run() raised CancelledError ({exc or 'no message'}) but nothing cancelled "
             "it; an actor that wants to end returns from run()"
         ) from exc
+
+
+def _format(exc: BaseException) -> str:
+    return "".join(traceback.format_exception(exc))
 
 
 def _reset_clock(token: contextvars.Token[Clock] | None) -> None:

@@ -52,7 +52,7 @@ def test_any_attribute_named_like_a_framework_attribute_fails(attr: str) -> None
         _define(attr, lambda self: None)
 
 
-@pytest.mark.parametrize("hook", ["on_wired", "on_start", "run", "on_stop"])
+@pytest.mark.parametrize("hook", ["on_wired", "on_start", "run", "on_failure", "on_stop"])
 def test_a_port_named_like_a_hook_fails_but_overriding_the_hook_is_the_point(hook: str) -> None:
     with pytest.raises(ActorDefinitionError, match=f"Shadowing.{hook}.*hook"):
         _define(hook, Input("/tick", Tick))
