@@ -5,7 +5,8 @@
 - ``timesource``: what advances time (a physics world, or ``JumpSource``).
 - ``clock``: sim time for actors in virtual or real-time mode; ``Rate``.
 - ``qos`` / ``mailbox``: QoS with ROS 2 matching, typed topics, publishers, mailboxes.
-- ``actor`` / ``system``: actors with typed ports, wired and supervised by a ``System``.
+- ``actor`` / ``system``: actors with typed ports, wired and supervised by a ``System``;
+  ``events``: what the system reports about them (``SystemEvent``, ``EventKind``).
 - ``waits``: ``until`` and ``next_message``, awaitables on sim time.
 - ``graph``: the wiring and statistics as data.
 """
@@ -14,6 +15,7 @@ from otonav.runtime.actor import Actor, Input, Output
 from otonav.runtime.clock import Clock, Rate, RealTimeClock, VirtualClock, current_clock
 from otonav.runtime.errors import (
     ActorCrashedError,
+    ActorDefinitionError,
     DeadlockError,
     LoopHeldError,
     OtonavRuntimeError,
@@ -24,6 +26,7 @@ from otonav.runtime.errors import (
     WallClockCeilingError,
     WiringError,
 )
+from otonav.runtime.events import ActorStatus, EventKind, SystemEvent
 from otonav.runtime.graph import Graph
 from otonav.runtime.loop import VirtualTimeLoop, run_blocking, virtual_loop_factory
 from otonav.runtime.mailbox import Bus, MailboxStatistics, Publisher, Subscription
@@ -35,7 +38,7 @@ from otonav.runtime.qos import (
     QoS,
     Reliability,
 )
-from otonav.runtime.system import RestartPolicy, System, SystemEvent
+from otonav.runtime.system import RestartPolicy, System
 from otonav.runtime.timesource import JumpSource, TimeSource
 from otonav.runtime.waits import next_message, until
 
@@ -45,10 +48,13 @@ __all__ = (
     "SENSOR_DATA_QOS",
     "Actor",
     "ActorCrashedError",
+    "ActorDefinitionError",
+    "ActorStatus",
     "Bus",
     "Clock",
     "DeadlockError",
     "Durability",
+    "EventKind",
     "Graph",
     "Input",
     "JumpSource",

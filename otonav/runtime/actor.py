@@ -10,16 +10,26 @@
 
 Ports are declared on the class and bound when a :class:`~otonav.runtime.system.System`
 wires the actor; ``remap`` renames topics per instance, as ROS 2 remapping does.
-Framework state lives in ``_otonav_*`` attributes so subclasses cannot clash with it.
+
+Names. Framework state lives in ``_otonav_*`` attributes. The public framework names
+(:data:`FRAMEWORK_ATTRIBUTES`: ``name``, ``clock``, ``ports``, ``topic_of``,
+``parameters``) share the subclass's namespace, as rclpy's ``Node`` methods do, because
+users' nodes call ``self.clock`` and ``self.name``; so shadowing one is an
+:class:`~otonav.runtime.errors.ActorDefinitionError`, never silent: a port or attribute
+of that name when the class is defined, a port named like a hook (``run``), or an
+instance attribute that the wiring would overwrite (a port's name) or that hides a
+framework method, when the System wires the instance. (That is why the bridge's /clock
+port is called ``clock_out``.) ADR 0051.
 """
 
 from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from typing import Any, Generic, TypeVar, overload
+from typing import Any, Final, Generic, TypeVar, overload
 
 from otonav.runtime.clock import Clock
+from otonav.runtime.errors import ActorDefinitionError
 from otonav.runtime.mailbox import Bus, Publisher, Subscription
 from otonav.runtime.qos import DEFAULT_QOS, QoS
 
@@ -37,6 +47,9 @@ class _Port(Generic[M]):
 
     def __set_name__(self, owner: type[Any], name: str) -> None:
         self.name = name
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.topic!r}, {self.msg_type.__name__})"
 
     def _bound(self, instance: Actor) -> Any:
         try:
@@ -84,13 +97,59 @@ def _snake(name: str) -> str:
     return re.sub(r"(?<!^)(?=[A-Z])", "_", name).lower()
 
 
+#: The framework's public names on every actor, with what each is. A subclass may not
+#: define them (as a port or anything else), nor an instance shadow them.
+FRAMEWORK_ATTRIBUTES: Final[Mapping[str, str]] = {
+    "name": "the actor's name, set by Actor.__init__(name)",
+    "clock": "the actor's sim-time clock",
+    "ports": "the declared ports, read by the wiring",
+    "topic_of": "a port's topic after remapping, read by the wiring",
+    "parameters": "the parameters the actor was launched with",
+}
+
+
 class Actor:
-    """Base class of every actor. Override ``on_start``, ``run`` and ``on_stop``.
+    """Base class of every actor. Override ``on_start``, ``run``, ``on_failure`` and
+    ``on_stop``.
 
     ``run`` is the actor's body; when it returns, the actor is done (the others go
     on). ``on_stop`` always runs, also when the system stops because another actor
-    crashed.
+    crashed: once for every ``on_start`` that returned or raised.
+
+    The life of an actor under its System's supervision (ADR 0051)::
+
+        on_start -> run -> (returns: finished) ------------------------> on_stop
+                        -> (raises: crashed) -> on_failure(exc) -> policy:
+                               stop:    the system stops ----------------> on_stop
+                               restart: on_stop -> on_start -> run ...   (same instance)
+
+    A restart keeps the instance: the System holds the object it was given, so the
+    restarted ``on_start`` and ``run`` see the attributes the crashed run left (and the
+    messages still queued in its input mailboxes, which a restart does not drop).
+    Whatever must start fresh is reset in ``on_start`` (or ``on_failure``), the way a
+    ROS 2 lifecycle node resets in ``on_configure``.
+
+    An exception in ``on_stop`` or ``on_failure`` is reported like a crash of the
+    actor: the system stops with :class:`~otonav.runtime.errors.ActorCrashedError`
+    (the first failure wins) and is not restarted.
     """
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        for attr, value in vars(cls).items():
+            if attr in FRAMEWORK_ATTRIBUTES:
+                what = f"the port {value!r}" if isinstance(value, _Port) else "an attribute"
+                raise ActorDefinitionError(
+                    f"{cls.__qualname__}.{attr} ({what}) shadows the framework's "
+                    f"Actor.{attr} ({FRAMEWORK_ATTRIBUTES[attr]}); rename it (the bridge's "
+                    f"/clock port is clock_out). Reserved: {', '.join(FRAMEWORK_ATTRIBUTES)}"
+                )
+            if attr in _HOOKS and isinstance(value, _Port):
+                raise ActorDefinitionError(
+                    f"{cls.__qualname__}.{attr} is the port {value!r}, but Actor.{attr} is "
+                    f"a lifecycle hook the System calls; rename the port (hooks: "
+                    f"{', '.join(sorted(_HOOKS))})"
+                )
 
     def __init__(self, name: str | None = None, *, remap: Mapping[str, str] | None = None) -> None:
         self.name = name or _snake(type(self).__name__)
@@ -131,10 +190,55 @@ class Actor:
         for actors that attach to topics dynamically (a recorder)."""
 
     async def on_start(self) -> None:
-        """Called once before ``run`` (and again before each restart)."""
+        """Called once before ``run``, and again before each restart, on the same
+        instance: reset here what a restarted run must not inherit from the crashed one."""
 
     async def run(self) -> None:
         """The actor's body. The default does nothing (a purely passive actor)."""
 
+    async def on_failure(self, exc: Exception) -> None:
+        """Called when ``on_start`` or ``run`` raised ``exc``, after the crash is reported
+        and before supervision decides (restart, or stop the system), shielded from
+        cancellation. The ports still work: publish a last status, release a device.
+        ``on_stop`` follows either way. If this raises, that is reported as a crash too
+        and the actor is not restarted."""
+
     async def on_stop(self) -> None:
-        """Called when the actor stops, however it stops (shielded from cancellation)."""
+        """Called when the actor stops, however it stops (shielded from cancellation).
+        If it raises, that is a crash: the system stops and its verdict names it."""
+
+
+#: The lifecycle hooks: subclasses override them with methods; a port may not take their
+#: names (the System would call the mailbox).
+_HOOKS: Final = frozenset(
+    attr
+    for attr, value in vars(Actor).items()
+    if not attr.startswith("_") and attr not in FRAMEWORK_ATTRIBUTES and callable(value)
+)
+
+
+def check_wirable(actor: Actor) -> None:
+    """Raise :class:`ActorDefinitionError` if wiring ``actor`` would overwrite one of its
+    own attributes (a port's name), or an instance attribute hides a framework name, or
+    its ``__init__`` skipped ``Actor.__init__``. The System calls this before wiring."""
+    cls = type(actor).__qualname__
+    own = vars(actor)
+    if "_otonav_ports" not in own:
+        raise ActorDefinitionError(
+            f"{cls}.__init__ did not call super().__init__(): the actor has no name, ports "
+            "or clock yet; call super().__init__(name, remap=remap) first in __init__"
+        )
+    for attr in FRAMEWORK_ATTRIBUTES.keys() - {"name"}:
+        if attr in own:
+            raise ActorDefinitionError(
+                f"actor '{actor.name}': the instance attribute {cls}.{attr} hides the "
+                f"framework's Actor.{attr} ({FRAMEWORK_ATTRIBUTES[attr]}); rename it"
+            )
+    bound = actor._otonav_ports
+    for port in type(actor).ports():
+        if port.name in own and (port.name not in bound or own[port.name] is not bound[port.name]):
+            raise ActorDefinitionError(
+                f"actor '{actor.name}': {cls}.{port.name} is the port {port!r} and also an "
+                f"instance attribute ({type(own[port.name]).__name__}) that wiring would "
+                "overwrite with the port's mailbox; rename one of them"
+            )

@@ -13,6 +13,13 @@ class WiringError(OtonavRuntimeError):
     """Ports, topics or QoS that cannot be connected; raised at wiring time, never later."""
 
 
+class ActorDefinitionError(WiringError, TypeError):
+    """An actor that shadows a name of the framework (a port or attribute called
+    ``clock``, a port called ``run``, an attribute a port would overwrite): raised when
+    the class is defined, or when the instance is wired, naming the attribute and the
+    class."""
+
+
 class TopicTypeError(WiringError, TypeError):
     """A port or a message whose type differs from its topic's type."""
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from otonav.runtime.events import ActorStatus
 from otonav.runtime.mailbox import Bus, MailboxStatistics
 
 
@@ -37,7 +38,7 @@ class TopicInfo:
 class ActorInfo:
     name: str
     kind: str
-    status: str
+    status: ActorStatus
     restarts: int
     inputs: tuple[str, ...]
     outputs: tuple[str, ...]
@@ -57,7 +58,7 @@ class Graph:
         raise KeyError(f"no topic '{name}'; topics: {[t.name for t in self.topics]}")
 
 
-def build_graph(bus: Bus, actors: dict[str, tuple[str, str, int]]) -> Graph:
+def build_graph(bus: Bus, actors: dict[str, tuple[str, ActorStatus, int]]) -> Graph:
     topics: list[TopicInfo] = []
     inputs: dict[str, list[str]] = {name: [] for name in actors}
     outputs: dict[str, list[str]] = {name: [] for name in actors}

@@ -25,7 +25,7 @@ from typing import Any
 import anyio
 from anyio.abc import TaskGroup
 
-from otonav.runtime.actor import Actor
+from otonav.runtime.actor import Actor, check_wirable
 from otonav.runtime.clock import (
     Clock,
     RealTimeClock,
@@ -34,6 +34,7 @@ from otonav.runtime.clock import (
     set_current_clock,
 )
 from otonav.runtime.errors import ActorCrashedError, OtonavRuntimeError, WiringError
+from otonav.runtime.events import ActorStatus, EventKind, SystemEvent
 from otonav.runtime.graph import Graph, build_graph
 from otonav.runtime.loop import VirtualTimeLoop
 from otonav.runtime.mailbox import Bus, Endpoint, Publisher, Subscription
@@ -58,23 +59,13 @@ class RestartPolicy:
             )
 
 
-@dataclass(frozen=True, slots=True)
-class SystemEvent:
-    """A lifecycle event: started, crashed, restarted, stopped, finished."""
-
-    sim_time: float
-    actor: str
-    kind: str
-    detail: str = ""
-
-
 @dataclass(slots=True)
 class _ActorState:
     actor: Actor
     policy: RestartPolicy | None
     restarts: int = 0
     crash_times: list[float] = field(default_factory=list)
-    status: str = "created"
+    status: ActorStatus = ActorStatus.CREATED
     scope: anyio.CancelScope | None = None
     stop_requested: bool = False
     done: anyio.Event | None = None  # set when its supervisor has returned
@@ -104,6 +95,7 @@ class System:
         self._stopped: anyio.Event | None = None
         self._clock_token: contextvars.Token[Clock] | None = None
         for actor in actors:
+            check_wirable(actor)
             if actor.name in self._states:
                 raise WiringError(
                     f"two actors are named '{actor.name}'; give each a unique name= "
@@ -182,14 +174,14 @@ class System:
 
     # -- running ------------------------------------------------------------------------
 
-    def _event(self, actor: str, kind: str, detail: str = "") -> None:
+    def _event(self, actor: str, kind: EventKind, detail: str = "") -> None:
         now = self._clock.now() if self._clock is not None else 0.0
         event = SystemEvent(now, actor, kind, detail)
         self.events.append(event)
         for listener in self._event_listeners:
             listener(event)
         log.log(
-            logging.ERROR if kind == "crashed" else logging.INFO,
+            logging.ERROR if kind is EventKind.CRASHED else logging.INFO,
             "[%.3f] %s %s %s",
             now,
             actor,
@@ -217,43 +209,70 @@ class System:
                 self._all_done.set()
 
     async def _supervise_in_scope(self, state: _ActorState) -> None:
+        """One actor's life: ``on_start``, ``run``; on a crash ``on_failure``, then the
+        policy (restart: ``on_stop`` and round again on the same instance; else stop
+        the system); ``on_stop`` once for every ``on_start`` that returned or raised (one
+        cancelled by a stop has nothing to stop)."""
         actor = state.actor
-        started = False
+        stop_due = False
         try:
             while not state.stop_requested:
                 try:
                     await actor.on_start()
-                    started = True
-                    state.status = "running"
-                    self._event(actor.name, "started")
+                    stop_due = True
+                    state.status = ActorStatus.RUNNING
+                    self._event(actor.name, EventKind.STARTED)
                     await _unrequested_cancel_is_a_crash(actor.run())
-                    state.status = "finished"
-                    self._event(actor.name, "finished")
+                    state.status = ActorStatus.FINISHED
+                    self._event(actor.name, EventKind.FINISHED)
                     return
                 except Exception as exc:
-                    text = "".join(traceback.format_exception(exc))
+                    stop_due = True
+                    text = _format(exc)
                     now = self.clock.now()
-                    self._event(actor.name, "crashed", text)
-                    if self._may_restart(state, now):
+                    self._event(actor.name, EventKind.CRASHED, text)
+                    hook_error = await self._on_failure(actor, exc)
+                    if hook_error is None and self._may_restart(state, now):
                         state.restarts += 1
-                        self._event(actor.name, "restarted", f"restart {state.restarts}")
-                        await self._stop_actor(state)
+                        self._event(actor.name, EventKind.RESTARTED, f"restart {state.restarts}")
+                        stop_due = False
+                        if not await self._stop_actor(state):
+                            return  # on_stop raised: reported as a crash, the system stops
                         continue
-                    state.status = "crashed"
-                    if self._failure is None:
-                        self._failure = ActorCrashedError(actor.name, now, text)
-                        self._failure.__cause__ = exc
-                    self.stop()
+                    if hook_error is not None:
+                        text += f"\nand then in on_failure: {hook_error}"
+                    state.status = ActorStatus.CRASHED
+                    self._fail(actor.name, now, text, exc)
                     return
         finally:
-            if started or state.status == "crashed":
+            if stop_due:
                 await self._stop_actor(state)
+
+    async def _on_failure(self, actor: Actor, exc: Exception) -> str | None:
+        """Call ``actor.on_failure(exc)`` (shielded, like ``on_stop``); if it raises,
+        report that as a crash and return its traceback (the actor is then not
+        restarted: its own clean-up is broken)."""
+        with anyio.CancelScope(shield=True):
+            try:
+                await actor.on_failure(exc)
+            except Exception as hook_exc:
+                text = _format(hook_exc)
+                self._event(actor.name, EventKind.CRASHED, "in on_failure: " + text)
+                return text
+        return None
+
+    def _fail(self, actor: str, now: float, text: str, exc: BaseException) -> None:
+        """Stop the system because ``actor`` crashed; the first failure is the verdict."""
+        if self._failure is None:
+            self._failure = ActorCrashedError(actor, now, text)
+            self._failure.__cause__ = exc
+        self.stop()
 
     def _clock_failed(self, error: BaseException) -> None:
         """The real-time clock's world (or a watcher) raised inside someone's ``now()``:
         stop the system with it rather than crash the actor that asked for the time."""
-        text = "".join(traceback.format_exception(error))
-        self._event("clock", "crashed", text)
+        text = _format(error)
+        self._event("clock", EventKind.CRASHED, text)
         if self._failure is None:
             if isinstance(error, OtonavRuntimeError):
                 self._failure = error
@@ -270,19 +289,25 @@ class System:
         state.crash_times.append(now)
         return len(state.crash_times) <= policy.max_restarts
 
-    async def _stop_actor(self, state: _ActorState) -> None:
+    async def _stop_actor(self, state: _ActorState) -> bool:
+        """Run ``on_stop`` (shielded). If it raises, that is a crash like any other: it is
+        reported, the actor's status is crashed and the system stops with
+        :class:`ActorCrashedError` (unless an earlier failure already is the verdict).
+        Returns whether ``on_stop`` returned normally."""
+        ok = True
         with anyio.CancelScope(shield=True):
             try:
                 await state.actor.on_stop()
             except Exception as exc:
-                self._event(
-                    state.actor.name,
-                    "crashed",
-                    "in on_stop: " + "".join(traceback.format_exception(exc)),
-                )
-        if state.status == "running":
-            state.status = "stopped"
-        self._event(state.actor.name, "stopped")
+                ok = False
+                text = "in on_stop: " + _format(exc)
+                self._event(state.actor.name, EventKind.CRASHED, text)
+                state.status = ActorStatus.CRASHED
+                self._fail(state.actor.name, self.clock.now(), text, exc)
+        if state.status is ActorStatus.RUNNING:
+            state.status = ActorStatus.STOPPED
+        self._event(state.actor.name, EventKind.STOPPED)
+        return ok
 
     async def __aenter__(self) -> System:
         self._clock_token = set_current_clock(self.clock)
@@ -397,6 +422,10 @@ async def _unrequested_cancel_is_a_crash(body: Coroutine[Any, Any, None]) -> Non
             f"run() raised CancelledError ({exc or 'no message'}) but nothing cancelled "
             "it; an actor that wants to end returns from run()"
         ) from exc
+
+
+def _format(exc: BaseException) -> str:
+    return "".join(traceback.format_exception(exc))
 
 
 def _reset_clock(token: contextvars.Token[Clock] | None) -> None:

@@ -10,11 +10,11 @@ import anyio
 from otonav.actors import topics
 from otonav.actors.topics import ROSOUT_QOS
 from otonav.msgs import Log, Time
-from otonav.runtime import System, SystemEvent
+from otonav.runtime import EventKind, System, SystemEvent
 
 __all__ = ["ROSOUT_QOS", "attach_rosout"]
 
-_LEVELS = {"crashed": Log.ERROR, "restarted": Log.WARN}
+_LEVELS = {EventKind.CRASHED: Log.ERROR, EventKind.RESTARTED: Log.WARN}
 
 
 def attach_rosout(system: System) -> None:
@@ -22,7 +22,7 @@ def attach_rosout(system: System) -> None:
     publisher = system.publisher(topics.ROSOUT, Log, ROSOUT_QOS, name="rosout")
 
     def publish(event: SystemEvent) -> None:
-        text = event.kind if not event.detail else f"{event.kind}: {event.detail}"
+        text = str(event.kind) if not event.detail else f"{event.kind}: {event.detail}"
         message = Log.fast(
             stamp=Time.from_seconds(event.sim_time),
             level=_LEVELS.get(event.kind, Log.INFO),

@@ -28,7 +28,15 @@ from otonav.hal.sim import AxisParams, DriveEmulator, DriveMount
 from otonav.msgs import DiagnosticArray, Frame, Log, NavState, Point, Pose, PoseStamped
 from otonav.msgs import WheelCommand as WheelCommandMsg
 from otonav.record.reader import read_messages, summarize
-from otonav.runtime import LATCHED_QOS, QoS, Reliability, RestartPolicy, Subscription, until
+from otonav.runtime import (
+    LATCHED_QOS,
+    EventKind,
+    QoS,
+    Reliability,
+    RestartPolicy,
+    Subscription,
+    until,
+)
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.stack import StackConfig, StackSession
 from otonav.stack.build import build_actors, build_world
@@ -161,7 +169,8 @@ async def test_a_tap_that_crashes_and_restarts_leaves_the_drives_running() -> No
     session = StackSession(hal, build_actors(CAN, hal), restart={"can_tap": RestartPolicy()})
     async with session.running() as system:
         await system.clock.sleep(1.0)
-        assert [e.kind for e in system.events if e.actor == "can_tap"].count("restarted") == 1
+        kinds = [e.kind for e in system.events if e.actor == "can_tap"]
+        assert kinds.count(EventKind.RESTARTED) == 1
         emulator = emulator_of(hal)
         assert emulator.drive(0).state == p.AxisState.CLOSED_LOOP_CONTROL
         assert hal.health().drivable

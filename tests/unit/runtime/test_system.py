@@ -111,7 +111,9 @@ def test_restart_policy_restarts_up_to_its_cap_then_stops() -> None:
         assert anyio.current_time() == pytest.approx(0.8)
 
     _run(main)
-    kinds = [(e.actor, e.kind) for e in system.events if e.actor == "crasher"]
+    kinds: list[tuple[str, str]] = [
+        (e.actor, e.kind) for e in system.events if e.actor == "crasher"
+    ]
     assert kinds.count(("crasher", "restarted")) == 3
     assert kinds.count(("crasher", "crashed")) == 4
     assert crasher.starts == 4
