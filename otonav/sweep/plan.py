@@ -56,6 +56,8 @@ class RunTask:
     """The base stack config file, for the repro command."""
     world: tuple[str, int] | None = None
     """A generated world: (generator parameters as JSON, world seed)."""
+    actors: tuple[str, ...] = ()
+    """The nodes ``--actor`` launched in every run (``module:Class``), for the repro."""
 
     @property
     def label(self) -> str:
@@ -224,8 +226,10 @@ def _iter_runs(spec: SweepSpec, base: Path, where: str, actors: Sequence[str]) -
     stack = StackConfig()
     if config_path:
         stack = load_stack_file(config_path)
+    configured = len(stack.actors)
     if actors:
         stack = add_actors(stack, actors)
+    launched = tuple(entry.class_ for entry in stack.actors[configured:])
     scenarios = _resolve_scenarios(spec, base, where)
     combos = override_combinations(spec)
     overridden = [
@@ -266,5 +270,6 @@ def _iter_runs(spec: SweepSpec, base: Path, where: str, actors: Sequence[str]) -
                     wall_ceiling_s=spec.wall_ceiling_s,
                     config=_display(Path(config_path)) if config_path else None,
                     world=sc.world,
+                    actors=launched,
                 )
                 index += 1

@@ -47,6 +47,8 @@ def repro_command(task: RunTask, scenario_file: str | None) -> str | None:
     parts = ["otonav", "run", "--scenario", source, "--seed", str(task.seed)]
     if task.config:
         parts += ["--config", task.config]
+    for spec in task.actors:
+        parts += ["--actor", spec]
     for key, value in task.overrides:
         parts += ["--set", f"{key}={format_value(value)}"]
     return shlex.join(parts)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import logging
+import shlex
 from pathlib import Path
 
 import pytest
@@ -86,6 +87,12 @@ def test_a_users_node_in_a_sweep_with_its_parameter_varied(tmp_path: Path) -> No
     assert all(r["status"] == "passed" for r in records)
     slow, fast = sorted(records, key=lambda r: r["overrides"]["actors.straight_to_goal.max_v"])
     assert slow["time_to_goal_s"] > fast["time_to_goal_s"]  # the parameter reached the node
+    # the repro line launches the node too, so it reruns the run alone
+    assert f"--actor {MY_NODES / 'simple_planner.py'}:StraightToGoal" in slow["repro"]
+    repro = shlex.split(slow["repro"])[2:]
+    assert main(["run", *repro, "--out", str(tmp_path / "repro"), "--no-record"]) == 0
+    again = json.loads((tmp_path / "repro" / "summary.json").read_text())
+    assert again["time_to_goal_s"] == slow["time_to_goal_s"]
 
 
 @pytest.mark.sim(wall_ceiling=60)
