@@ -933,6 +933,12 @@ class MujocoInterface(RobotHardwareInterface):
             # The scene has the robot in it already (a scene that includes robot.xml).
             robot_spec, robot_file, prefix = spec, label, ""
         else:
+            included = builtin_robot("otonav").base
+            if spec.body(included) is not None:  # an old scene with our robot in it
+                raise SceneError(
+                    f"MJCF file {label} includes otonav's robot (body {included!r}); remove "
+                    f'its <include file="robot.xml"/> to run robot.model: {robot.label}'
+                )
             robot_spec, robot_file = _load_robot(robot)
             prefix = ROBOT_PREFIX
         if variant == "no_caster_unlimited_torque":

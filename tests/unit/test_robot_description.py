@@ -270,3 +270,15 @@ def test_a_wheel_with_two_actuators_is_refused(tmp_path: Path) -> None:
     with pytest.raises(SceneError, match=r"^robot\.left_wheel: joint 'left_wheel_hinge' has 2 "
                        r"actuators \(left_drive, extra\); give it one$"):  # fmt: skip
         MujocoInterface("empty", robot=robot)
+
+
+def test_an_old_scene_with_our_robot_in_it_refuses_another_robot(tmp_path: Path) -> None:
+    assets = Path(MujocoInterface("empty").scene_file).parent
+    shutil.copy(assets / "robot.xml", tmp_path / "robot.xml")
+    text = (assets / "empty.xml").read_text()
+    old = '<compiler angle="radian"/>\n  <option timestep="0.002" integrator="implicitfast"/>'
+    (tmp_path / "old.xml").write_text(text.replace(old, '<include file="robot.xml"/>'))
+    MujocoInterface(tmp_path / "old.xml")  # its own robot: used as it is
+    with pytest.raises(SceneError, match=r"old\.xml includes otonav's robot \(body 'chassis'\); "
+                       r"remove its <include"):  # fmt: skip
+        MujocoInterface(tmp_path / "old.xml", robot=builtin_robot("burger"))
