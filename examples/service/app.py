@@ -28,6 +28,12 @@ live.1.mcap (older ones move up; ``--live-record-keep`` of them stay, default 2)
 use stays under about (keep + 1) x the cap. The server binds to 127.0.0.1 unless told
 otherwise.
 
+Bounds (issue 27 item 7; ADR 0050): at most ``--max-runs`` simulations run at once and
+``--max-queued`` more wait for a slot; past that, POST /runs is answered 503 with a
+``Retry-After`` (s) instead of queueing without limit. A finished run is forgotten (404,
+its files stay in OUT/runs/ID) ``--keep-finished-s`` seconds after it ended, or sooner
+when more than ``--keep-finished`` finished runs are known (oldest first).
+
 What a client may ask is narrower than the CLI (issue 17): built-in scenes and scenarios
 only, so the server reads no file a client names and its errors never say whether a path
 exists; no hardware (a CAN run is the emulated bus); bodies of at most 1 MiB of UTF-8
@@ -48,6 +54,7 @@ import signal
 import socket
 import sys
 import threading
+import time
 import uuid
 from collections.abc import AsyncIterator, Awaitable, Callable, Iterator
 from contextlib import AsyncExitStack, asynccontextmanager
@@ -89,6 +96,12 @@ MAX_WAIT_S = 60.0
 MAX_BODY_BYTES = 1 << 20
 """A request body: a run request is a few hundred bytes, an inline scenario a few kB."""
 SHOWN_CHARS = 200
+MAX_QUEUED = 64
+"""Runs that may wait for a simulation slot (``--max-queued``): beyond, 503."""
+KEEP_FINISHED = 256
+"""Finished runs the service remembers (``--keep-finished``); the oldest go first."""
+KEEP_FINISHED_S = 3600.0
+"""Seconds a finished run is remembered (``--keep-finished-s``); its files stay."""
 """How much of a client's string an error quotes (a path fits; 10 MB does not)."""
 
 
@@ -101,9 +114,10 @@ def _short(value: str) -> str:
 class BadRequest(Exception):
     """A 4xx with a one-line message."""
 
-    def __init__(self, message: str, status: int = 400) -> None:
+    def __init__(self, message: str, status: int = 400, retry_after: int | None = None) -> None:
         super().__init__(message)
         self.status = status
+        self.retry_after = retry_after
 
 
 # -- requests ----------------------------------------------------------------------------
@@ -222,6 +236,7 @@ class Run:
     sim_time: float | None = None  # where it ended
     task: asyncio.Task[None] | None = None
     done: asyncio.Event = field(default_factory=asyncio.Event)
+    finished_at: float | None = None  # Runs.clock() when it ended
 
     def as_dict(self) -> dict[str, Any]:
         recording = self.out_dir / "recording.mcap"
@@ -249,23 +264,77 @@ class Run:
 
 
 class Runs:
-    """Simulation runs: each an asyncio task awaiting ``run_scenario_async``."""
+    """Simulation runs: each an asyncio task awaiting ``run_scenario_async``. At most
+    ``max_runs + max_queued`` unfinished ones (:meth:`start` refuses more); finished ones
+    are forgotten after ``keep_finished_s`` of ``clock`` or beyond ``keep_finished``."""
 
-    def __init__(self, out_root: Path, max_runs: int) -> None:
+    def __init__(
+        self,
+        out_root: Path,
+        max_runs: int,
+        *,
+        max_queued: int = MAX_QUEUED,
+        keep_finished: int = KEEP_FINISHED,
+        keep_finished_s: float = KEEP_FINISHED_S,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
         self.out_root = out_root
         self.max_runs = max_runs
+        self.max_queued = max_queued
+        self.keep_finished = keep_finished
+        self.keep_finished_s = keep_finished_s
+        self.clock = clock
         self.limiter: anyio.CapacityLimiter | None = None
         self.runs: dict[str, Run] = {}
+        self._run_walls: list[float] = []  # wall s of the last runs: Retry-After's estimate
+
+    def forget_finished(self) -> None:
+        """Drop finished runs past their time, then the oldest beyond the count (their
+        files stay on disk). Called whenever the runs are looked at: no timer needed."""
+        now = self.clock()
+        done = sorted(
+            (r for r in self.runs.values() if r.finished_at is not None),
+            key=lambda r: r.finished_at or 0.0,
+        )
+        expired = [r for r in done if now - (r.finished_at or 0.0) >= self.keep_finished_s]
+        kept = [r for r in done if r not in expired]
+        for run in expired + kept[: max(0, len(kept) - self.keep_finished)]:
+            del self.runs[run.id]
+
+    def unfinished(self) -> int:
+        return sum(1 for r in self.runs.values() if not r.done.is_set())
+
+    def retry_after(self) -> int:
+        """Seconds until a queue slot is likely free: a run's recent mean wall time times
+        the queue's depth per slot (at least 1)."""
+        mean = sum(self._run_walls) / len(self._run_walls) if self._run_walls else 1.0
+        return max(1, math.ceil(mean * self.unfinished() / self.max_runs))
 
     def start(self, scenario: ScenarioConfig, stack: StackConfig, source: str) -> Run:
         assert self.limiter is not None, "runs start once the app has started"
+        self.forget_finished()
+        if self.unfinished() >= self.max_runs + self.max_queued:
+            raise BadRequest(
+                f"busy: {self.max_runs} runs running and {self.max_queued} waiting "
+                "(the most --max-runs and --max-queued allow); retry later",
+                503,
+                retry_after=self.retry_after(),
+            )
         run_id = uuid.uuid4().hex[:12]
         run = Run(run_id, scenario.name, self.out_root / run_id)
         self.runs[run_id] = run
         run.task = asyncio.get_running_loop().create_task(
             self._execute(run, scenario, stack, source), name=f"run:{run_id}"
         )
+        run.task.add_done_callback(lambda _task: self._cancelled_unstarted(run))
         return run
+
+    def _cancelled_unstarted(self, run: Run) -> None:
+        """A task cancelled before it first ran never enters ``_execute`` (a DELETE
+        right after the POST): end the run here, or its waiters would wait forever."""
+        if not run.done.is_set():
+            run.status, run.finished_at = "cancelled", self.clock()
+            run.done.set()
 
     async def _execute(
         self, run: Run, scenario: ScenarioConfig, stack: StackConfig, source: str
@@ -295,10 +364,12 @@ class Runs:
         else:
             run.verdict = verdict
             run.status = "passed" if verdict.passed else "failed"
+            self._run_walls = [*self._run_walls[-15:], verdict.wall_time_s]
         finally:
             if run.sim_loop is not None:
                 run.sim_time = run.verdict.sim_time_s if run.verdict else run.sim_loop.time()
                 run.sim_loop = None
+            run.finished_at = self.clock()
             run.done.set()
 
     async def cancel(self, run: Run) -> None:
@@ -349,7 +420,10 @@ def _errors_as_4xx(handler: Handler) -> Handler:
         try:
             return await handler(request)
         except BadRequest as exc:
-            return _json({"error": str(exc)}, exc.status)
+            response = _json({"error": str(exc)}, exc.status)
+            if exc.retry_after is not None:
+                response.headers["Retry-After"] = str(exc.retry_after)
+            return response
         except (ConfigFileError, SceneError) as exc:
             return _json({"error": str(exc)}, 400)
 
@@ -368,6 +442,10 @@ class Service:
         live_record_bytes: int = 64 * 2**20,
         live_record_keep: int = 2,
         max_runs: int = 2,
+        max_queued: int = MAX_QUEUED,
+        keep_finished: int = KEEP_FINISHED,
+        keep_finished_s: float = KEEP_FINISHED_S,
+        clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.stack = stack
         self.live_enabled = live
@@ -375,7 +453,14 @@ class Service:
         self.live_record = live_record
         self.live_record_bytes = live_record_bytes
         self.live_record_keep = live_record_keep
-        self.runs = Runs(out_root, max_runs)
+        self.runs = Runs(
+            out_root,
+            max_runs,
+            max_queued=max_queued,
+            keep_finished=keep_finished,
+            keep_finished_s=keep_finished_s,
+            clock=clock,
+        )
         self.live: LiveStack | None = None
         self.closing: asyncio.Event | None = None
         """Set when the server stops: waits and pose streams end at once."""
@@ -439,7 +524,8 @@ class Service:
 
     async def health(self, _request: Request) -> Response:
         live = self.live
-        active = sum(1 for r in self.runs.runs.values() if not r.done.is_set())
+        self.runs.forget_finished()
+        active = self.runs.unfinished()
         return _json(
             {
                 "status": "ok",
@@ -463,13 +549,20 @@ class Service:
         return _json(run.as_dict(), 202)
 
     async def list_runs(self, _request: Request) -> Response:
+        self.runs.forget_finished()
         return _json([r.as_dict() for r in self.runs.runs.values()])
 
     def _run(self, request: Request) -> Run:
         run_id = request.path_params["run_id"]
+        self.runs.forget_finished()
         run = self.runs.runs.get(run_id)
         if run is None:
-            raise BadRequest(f"no run {_short(run_id)}", 404)
+            raise BadRequest(
+                f"no run {_short(run_id)} (finished runs are forgotten after "
+                f"{self.runs.keep_finished_s:g} s or beyond {self.runs.keep_finished}; "
+                "their files stay under the service's out directory)",
+                404,
+            )
         return run
 
     async def get_run(self, request: Request) -> Response:
@@ -689,6 +782,24 @@ def main(argv: list[str] | None = None) -> int:
         help="finished live recordings kept as live.1.mcap, live.2.mcap, ... (default 2)",
     )
     parser.add_argument("--max-runs", type=int, default=2, help="simulations at once")
+    parser.add_argument(
+        "--max-queued",
+        type=int,
+        default=MAX_QUEUED,
+        help=f"runs waiting for a slot; beyond, POST /runs gets 503 (default {MAX_QUEUED})",
+    )
+    parser.add_argument(
+        "--keep-finished",
+        type=int,
+        default=KEEP_FINISHED,
+        help=f"finished runs remembered, oldest forgotten first (default {KEEP_FINISHED})",
+    )
+    parser.add_argument(
+        "--keep-finished-s",
+        type=float,
+        default=KEEP_FINISHED_S,
+        help=f"seconds a finished run is remembered (default {KEEP_FINISHED_S:g})",
+    )
     args = parser.parse_args(argv)
     try:
         stack = load_stack(args.config, args.overrides)
@@ -697,6 +808,12 @@ def main(argv: list[str] | None = None) -> int:
             raise ConfigFileError(problem)
         if not 1 <= args.max_runs <= 64:
             raise ConfigFileError(f"--max-runs {args.max_runs}: must be in [1, 64]")
+        if not 0 <= args.max_queued <= 100_000:
+            raise ConfigFileError(f"--max-queued {args.max_queued}: must be in [0, 100000]")
+        if not 0 <= args.keep_finished <= 1_000_000:
+            raise ConfigFileError(f"--keep-finished {args.keep_finished}: must be in [0, 1e6]")
+        if not (math.isfinite(args.keep_finished_s) and args.keep_finished_s >= 0):
+            raise ConfigFileError(f"--keep-finished-s {args.keep_finished_s:g}: must be >= 0")
         if not args.live_record_mb >= 0.1:
             raise ConfigFileError(f"--live-record-mb {args.live_record_mb:g}: must be >= 0.1")
         if args.live_record_keep < 0:
@@ -714,6 +831,9 @@ def main(argv: list[str] | None = None) -> int:
         live_record_bytes=round(args.live_record_mb * 2**20),
         live_record_keep=args.live_record_keep,
         max_runs=args.max_runs,
+        max_queued=args.max_queued,
+        keep_finished=args.keep_finished,
+        keep_finished_s=args.keep_finished_s,
     )
     # Bind first, so the address is known (port 0) before the server starts accepting.
     # proto=IPPROTO_TCP matters: asyncio sets TCP_NODELAY only on sockets that say they

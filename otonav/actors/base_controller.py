@@ -135,6 +135,20 @@ class BaseController(Actor):
             if not self.wheel_cmd.try_publish(command):
                 await self.wheel_cmd.publish(command)
 
+    async def on_stop(self) -> None:
+        """Command zero as the base stops, whatever stopped it (the end of a run, any
+        actor's crash, a signal): the wheels must not keep turning at the last setpoint
+        (issue 27 item 8: a MuJoCo run's recording ended at 7.7 and 8.3 rad/s). The
+        bridge, which stops after the base, applies it; the recording shows it. The CAN
+        path also sets the drives IDLE after that (``CanFrameTap.on_stop``)."""
+        sec, nanosec = split_seconds(self.clock.now())
+        command = WHEEL_COMMAND(sec, nanosec, 0.0, 0.0)
+        if not self.wheel_cmd.try_publish(command):
+            # A full reliable mailbox: wait for room, at most one period of sim time
+            # (the bridge zeroes the hardware on its own stop in any case).
+            with anyio.move_on_after(1.0 / self.rate_hz):
+                await self.wheel_cmd.publish(command)
+
     def _reject(self, command: Twist, now: float) -> None:
         self.rejected_commands += 1
         if now - self._logged_at < self.LOG_EVERY - 1e-9:

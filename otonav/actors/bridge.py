@@ -253,6 +253,12 @@ class Bridge(Actor):
             tg.start_soon(self._apply_commands)
             await self._publish_loop()
 
+    async def on_stop(self) -> None:
+        """Zero the wheels as the bridge stops (after every actor that commands them):
+        on any crash or stop, the hardware must not keep the last setpoint (issue 27
+        item 8). The base's own zero on /wheel_cmd is what the recording shows."""
+        self.hal.write(HalWheelCommand(0.0, 0.0))
+
     async def _apply_commands(self) -> None:
         async for cmd in self.wheel_cmd:
             self.hal.write(HalWheelCommand(*_read_wheel_command(cmd)))

@@ -27,13 +27,30 @@ class OneLineFormatter(logging.Formatter):
         return f"otonav: {head}: {lines[-1].strip()} (traceback on /rosout in the recording)"
 
 
+class _StderrHandler(logging.StreamHandler):  # type: ignore[type-arg]
+    """Writes to whatever ``sys.stderr`` is when a record comes, not the one it was
+    installed with: a host (pytest's capture) that swaps and closes it later would get
+    "--- Logging error ---" and a traceback instead of the line."""
+
+    def __init__(self) -> None:
+        super().__init__(sys.stderr)
+
+    @property
+    def stream(self) -> object:
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, _value: object) -> None:
+        pass
+
+
 def install() -> None:
     """Route the ``otonav`` loggers' warnings and errors to stderr, one line each (once
     per process; the library itself configures no logging)."""
     logger = logging.getLogger("otonav")
     if any(getattr(h, _MARK, False) for h in logger.handlers):
         return
-    handler = logging.StreamHandler(sys.stderr)
+    handler = _StderrHandler()
     handler.setLevel(logging.WARNING)
     handler.setFormatter(OneLineFormatter())
     setattr(handler, _MARK, True)

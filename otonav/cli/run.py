@@ -212,6 +212,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
     from otonav.runtime import WallClockCeilingError
     from otonav.scenario import ScenarioConfig, run_scenario
     from otonav.scenario.builtin import BUILTIN
+    from otonav.scenario.crash import RunCrashedError
     from otonav.scenario.run import finite_figures
     from otonav.stack.files import ConfigFileError, describe_validation_error
 
@@ -290,6 +291,10 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
                 on_start=on_start,
                 extra_actors=extra,
             )
+    except RunCrashedError as crash:
+        # An actor crashed (one line on stderr from the log; the traceback is on
+        # /rosout): a failed run with its verdict and artifacts, not a raw traceback.
+        verdict = crash.verdict
     except asyncio.CancelledError:
         if guard.received is not None:
             return guard.report()

@@ -16,10 +16,11 @@ import anyio
 from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
 from otonav.limits import check_scale
-from otonav.runtime import Actor, RealTimeClock
+from otonav.runtime import Actor, ActorCrashedError, RealTimeClock
 from otonav.runtime.clock import MAX_STEP_BATCH
 from otonav.runtime.timesource import tick_rate
 from otonav.scenario.config import ScenarioConfig
+from otonav.scenario.crash import RunCrashedError, crash_reason
 from otonav.scenario.judge import Judge
 from otonav.scenario.run import (
     Verdict,
@@ -151,9 +152,12 @@ def run_scenario_realtime(
     closed_at: list[float] = []
     wall_start = time.perf_counter()
     ended = "completed"
+    crash: ActorCrashedError | None = None
     try:
         with asyncio.Runner(loop_factory=loop_factory) as runner:
             runner.run(_main(scenario, session, judge, viewer, closed_at, on_start))
+    except ActorCrashedError as exc:  # a verdict still, raised with it (as run_scenario)
+        crash, ended = exc, f"ActorCrashedError: {crash_reason(exc)}"
     except BaseException as exc:
         sim = hal.ticks / tick_rate(hal.tick)
         ended = f"{type(exc).__name__} at sim time {sim:.3f} s: {exc}".strip().rstrip(":")
@@ -181,4 +185,6 @@ def run_scenario_realtime(
             verdict = save_artifacts(verdict, scenario, stack, judge, session, out_dir, plot)
         finally:
             session.close()  # idempotent: the viewer, then the world, on every path
+    if crash is not None:
+        raise RunCrashedError(crash, verdict) from crash.__cause__
     return verdict

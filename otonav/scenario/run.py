@@ -27,6 +27,7 @@ from otonav.record.writer import RecordingWriter
 from otonav.runtime import (
     LATCHED_QOS,
     Actor,
+    ActorCrashedError,
     Clock,
     RealTimeClock,
     SimTimeoutError,
@@ -35,6 +36,7 @@ from otonav.runtime import (
     virtual_loop_factory,
 )
 from otonav.scenario.config import ScenarioConfig
+from otonav.scenario.crash import RunCrashedError, crash_reason
 from otonav.scenario.judge import Judge
 from otonav.scenario.plot import plot_trajectory
 from otonav.scenario.validate import check_cost, check_goal
@@ -296,7 +298,9 @@ def run_scenario(
     thread cancels the run with ``loop.call_soon_threadsafe(task.cancel)``. A goal
     outside the arena or on an obstacle raises ``ConfigFileError`` naming ``source``.
     Another run writing to ``out_dir`` raises :class:`~otonav.record.outlock.OutputBusyError`
-    before anything is touched."""
+    before anything is touched. An actor's crash raises
+    :class:`~otonav.scenario.crash.RunCrashedError` once the artifacts are written: an
+    ``ActorCrashedError`` carrying the failed verdict."""
     with lock_output(out_dir) if out_dir is not None else contextlib.nullcontext():
         # one run per out_dir (issue 27): a second is refused before it touches a file
         scenario, stack, hal = scenario_world(scenario, stack, source=source)
@@ -316,6 +320,7 @@ def run_scenario(
         wall_start = time.perf_counter()
         sim_time = 0.0
         ended = "completed"
+        crash: ActorCrashedError | None = None
         try:
             # The session makes the world the loop's time source when the run starts.
             factory = virtual_loop_factory(wall_ceiling=wall_ceiling)
@@ -324,6 +329,8 @@ def run_scenario(
                     runner.run(_main(scenario, session, judge, on_start))
                 finally:
                     sim_time = runner.get_loop().time()
+        except ActorCrashedError as exc:  # a verdict still (below), raised with it
+            crash, ended = exc, f"ActorCrashedError: {crash_reason(exc)}"
         except BaseException as exc:
             ended = f"{type(exc).__name__} at sim time {sim_time:.3f} s: {exc}".strip().rstrip(":")
             raise
@@ -341,6 +348,8 @@ def run_scenario(
                 verdict = save_artifacts(verdict, scenario, stack, judge, session, out_dir, plot)
             finally:
                 session.close()  # idempotent: reached even if the verdict or plot failed
+        if crash is not None:
+            raise RunCrashedError(crash, verdict) from crash.__cause__
         return verdict
 
 

@@ -54,7 +54,7 @@ def test_actor_exception_leaves_an_indexed_file_with_the_crash_logged(tmp_path: 
     proc = _start(tmp_path, "raise")
     _out, err = proc.communicate(timeout=60)
     assert proc.returncode != 0
-    assert "ActorCrashedError" in err
+    assert "RunCrashedError" in err  # an ActorCrashedError that carries the verdict
     assert "injected fault" in err
     recording = tmp_path / "recording.mcap"
     last = _assert_complete_up_to_the_stop(recording)
