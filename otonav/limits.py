@@ -14,6 +14,7 @@ Costs quoted below were measured on the 2-core development machine (2026-11-23,
 from __future__ import annotations
 
 import math
+import unicodedata
 
 # -- world -------------------------------------------------------------------------------
 
@@ -205,3 +206,20 @@ def check_scale(scale: float, source: str = "--scale") -> str | None:
             "(sim seconds per wall second)"
         )
     return None
+
+
+def one_printable_line(text: str) -> str:
+    """No control, format (bidi overrides such as U+202E, zero-width marks), surrogate or
+    private-use characters: a name must print as what it is, on one line, in every
+    one-line message that quotes it."""
+    bad = sorted({f"U+{ord(c):04X}" for c in text if unicodedata.category(c) in _HIDDEN})
+    if bad:
+        raise ValueError(
+            f"must be one line of printable text (no control or invisible characters: "
+            f"{', '.join(bad[:5])})"
+        )
+    return text
+
+
+_HIDDEN = frozenset({"Cc", "Cf", "Cs", "Co"})
+"""Unicode categories that do not print as themselves: control, format, surrogate, private."""

@@ -23,13 +23,6 @@ Distance = Annotated[float, Field(gt=0.0, le=limits.MAX_DISTANCE_M)]
 """m, a tolerance or clearance."""
 
 
-def _one_printable_line(text: str) -> str:
-    """No control characters: a newline would break every one-line message naming it."""
-    if any(ord(c) < 0x20 or ord(c) == 0x7F for c in text):
-        raise ValueError("must be one line of printable text (no control characters)")
-    return text
-
-
 class BoxSpec(BaseModel):
     """An extra box obstacle: centre (m), full size (m), yaw (rad)."""
 
@@ -72,7 +65,7 @@ class ScenarioConfig(BaseModel):
     name: Annotated[
         str,
         Field(min_length=1, max_length=limits.MAX_NAME_CHARS),
-        AfterValidator(_one_printable_line),
+        AfterValidator(limits.one_printable_line),
     ] = "acceptance"
     """One line of printable text, at most 128 characters: a title and a label."""
     scene: str | None = Field(None, min_length=1, max_length=limits.MAX_PATH_CHARS)

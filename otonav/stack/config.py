@@ -411,7 +411,11 @@ class HalConfig(_Section):
     sim: DriveSimConfig = DriveSimConfig()
 
 
-_Name = Annotated[str, Field(min_length=1, max_length=limits.MAX_NAME_CHARS)]
+_Name = Annotated[
+    str,
+    Field(min_length=1, max_length=limits.MAX_NAME_CHARS),
+    AfterValidator(limits.one_printable_line),
+]
 """A name in the robot model (a body, joint or site) or of an actor."""
 _Vec3 = tuple[float, float, float]
 
