@@ -22,6 +22,7 @@ import sys
 import time
 from dataclasses import dataclass, field
 
+from cyclonedds.core import InstanceState, ReadCondition, SampleState, ViewState, WaitSet
 from cyclonedds.domain import Domain, DomainParticipant
 from cyclonedds.idl import IdlStruct
 from cyclonedds.idl import types as t
@@ -29,6 +30,7 @@ from cyclonedds.pub import DataWriter
 from cyclonedds.qos import Policy, Qos
 from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
+from cyclonedds.util import duration
 
 LOCALHOST = (
     "<CycloneDDS><Domain><General><AllowMulticast>false</AllowMulticast></General>"
@@ -152,6 +154,10 @@ ANY = Qos(Policy.Reliability.BestEffort, Policy.History.KeepLast(10), XCDR1)
 GOAL_QOS = Qos(Policy.Reliability.Reliable(10**9), Policy.History.KeepLast(1), XCDR1)
 
 
+WAKE = duration(milliseconds=50)
+"""The longest the peer blocks on its readers before it looks for a goal reader again."""
+
+
 def main() -> None:
     domain, gx, gy, timeout = int(sys.argv[1]), *map(float, sys.argv[2:5])
     _domain = Domain(domain, LOCALHOST)
@@ -162,6 +168,12 @@ def main() -> None:
     }
     readers["clock"] = DataReader(dp, Topic(dp, "rt/clock", Clock), qos=ANY)
     goal_writer = DataWriter(dp, Topic(dp, "rt/goal", PoseStamped), qos=GOAL_QOS)
+    # Block on the readers (a DDS wait set), not on the wall clock: woken when a sample
+    # arrives, or after WAKE to look for the bridge's goal reader.
+    arrivals = WaitSet(dp)
+    for reader in readers.values():
+        mask = SampleState.NotRead | ViewState.Any | InstanceState.Any
+        arrivals.attach(ReadCondition(reader, mask))
     counts = dict.fromkeys(readers, 0)
     report: dict[str, object] = {"reached": False, "sent_goal": False}
     latencies: list[float] = []
@@ -199,7 +211,7 @@ def main() -> None:
                     report["clock"] = sample.clock.sec + sample.clock.nanosec * 1e-9
         if report["reached"] and all(counts.values()):
             break
-        time.sleep(0.005)
+        arrivals.wait(WAKE)
     report["counts"] = counts
     latencies.sort()
     if latencies:
