@@ -54,6 +54,18 @@ def variant(tmp_path: Path, old: str, new: str) -> RobotDescription:
     return pathfinder(path)
 
 
+def old_scene(tmp_path: Path, scene: str) -> Path:
+    """A built-in scene as scenes were written before: including robot.xml."""
+    assets = Path(MujocoInterface("empty").scene_file).parent
+    shutil.copy(assets / "robot.xml", tmp_path / "robot.xml")
+    text = (assets / f"{scene}.xml").read_text()
+    attached = '<compiler angle="radian"/>\n  <option timestep="0.002" integrator="implicitfast"/>'
+    assert attached in text
+    path = tmp_path / "old.xml"
+    path.write_text(text.replace(attached, '<include file="robot.xml"/>'))
+    return path
+
+
 def drive(world: MujocoInterface, speed: float = 3.0, seconds: float = 1.0) -> None:
     world.write(WheelCommand(speed, speed))
     world.advance(round(seconds / world.tick))
@@ -215,22 +227,35 @@ def test_bad_robot_descriptions_are_one_line_naming_the_key(
     assert "\n" not in str(caught.value)
 
 
-def test_a_wheel_without_a_collision_geom_is_refused(tmp_path: Path) -> None:
-    robot = variant(
-        tmp_path,
-        '<geom name="left_tyre" class="pf_tyre"/>',
-        '<geom name="left_tyre" class="pf_tyre" contype="0" conaffinity="0"/>',
-    )
-    with pytest.raises(SceneError, match=r"^robot\.left_wheel: joint 'left_wheel_hinge' moves "
-                       r"body 'left_wheel_link', which has no collision geom"):  # fmt: skip
-        MujocoInterface("empty", robot=robot)
-
-
-def test_a_wheel_turning_about_the_wrong_axis_is_refused(tmp_path: Path) -> None:
-    robot = variant(tmp_path, 'pos="0 0.15 0" euler="-90 0 0"', 'pos="0 0.15 0"')
-    with pytest.raises(SceneError, match=r"^robot\.left_wheel: joint 'left_wheel_hinge' turns "
-                       r"about an axis that is not the robot's left-right"):  # fmt: skip
-        MujocoInterface("empty", robot=robot)
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        (
+            '<geom name="left_tyre" class="pf_tyre"/>',
+            '<geom name="left_tyre" class="pf_tyre" contype="0" conaffinity="0"/>',
+            r"^robot\.left_wheel: joint 'left_wheel_hinge' moves body 'left_wheel_link', "
+            r"which has no collision geom",
+        ),
+        (
+            'pos="0 0.15 0" euler="-90 0 0"',
+            'pos="0 0.15 0"',
+            r"^robot\.left_wheel: joint 'left_wheel_hinge' turns about an axis that is not "
+            r"the robot's left-right",
+        ),
+        (
+            "</actuator>",
+            '  <motor name="extra" joint="left_wheel_hinge"/>\n  </actuator>',
+            r"^robot\.left_wheel: joint 'left_wheel_hinge' has 2 actuators "
+            r"\(left_drive, extra\); give it one$",
+        ),
+    ],
+    ids=["no-collision-geom", "wrong-axis", "two-actuators"],
+)
+def test_a_wheel_the_robot_cannot_drive_is_refused(
+    tmp_path: Path, old: str, new: str, message: str
+) -> None:
+    with pytest.raises(SceneError, match=message):
+        MujocoInterface("empty", robot=variant(tmp_path, old, new))
 
 
 def test_a_urdf_whose_meshes_are_missing_names_the_model(tmp_path: Path) -> None:
@@ -244,13 +269,7 @@ def test_a_urdf_whose_meshes_are_missing_names_the_model(tmp_path: Path) -> None
 def test_the_default_robot_attached_moves_as_the_old_included_one(tmp_path: Path) -> None:
     """A scene that includes robot.xml (as scenes did) and the built-in scene with the
     robot attached are the same world, step for step."""
-    assets = Path(MujocoInterface("empty").scene_file).parent
-    shutil.copy(assets / "robot.xml", tmp_path / "robot.xml")
-    text = (assets / "obstacles.xml").read_text()
-    old = '<compiler angle="radian"/>\n  <option timestep="0.002" integrator="implicitfast"/>'
-    assert old in text
-    (tmp_path / "old.xml").write_text(text.replace(old, '<include file="robot.xml"/>'))
-    old_world = MujocoInterface(tmp_path / "old.xml")
+    old_world = MujocoInterface(old_scene(tmp_path, "obstacles"))
     new_world = MujocoInterface("obstacles")
     for world in (old_world, new_world):
         world.write(WheelCommand(4.0, 6.0))
@@ -261,24 +280,9 @@ def test_the_default_robot_attached_moves_as_the_old_included_one(tmp_path: Path
     assert math.isfinite(new_world.ground_truth().x)
 
 
-def test_a_wheel_with_two_actuators_is_refused(tmp_path: Path) -> None:
-    robot = variant(
-        tmp_path,
-        "</actuator>",
-        '  <motor name="extra" joint="left_wheel_hinge"/>\n  </actuator>',
-    )
-    with pytest.raises(SceneError, match=r"^robot\.left_wheel: joint 'left_wheel_hinge' has 2 "
-                       r"actuators \(left_drive, extra\); give it one$"):  # fmt: skip
-        MujocoInterface("empty", robot=robot)
-
-
 def test_an_old_scene_with_our_robot_in_it_refuses_another_robot(tmp_path: Path) -> None:
-    assets = Path(MujocoInterface("empty").scene_file).parent
-    shutil.copy(assets / "robot.xml", tmp_path / "robot.xml")
-    text = (assets / "empty.xml").read_text()
-    old = '<compiler angle="radian"/>\n  <option timestep="0.002" integrator="implicitfast"/>'
-    (tmp_path / "old.xml").write_text(text.replace(old, '<include file="robot.xml"/>'))
-    MujocoInterface(tmp_path / "old.xml")  # its own robot: used as it is
+    scene = old_scene(tmp_path, "empty")
+    MujocoInterface(scene)  # its own robot: used as it is
     with pytest.raises(SceneError, match=r"old\.xml includes otonav's robot \(body 'chassis'\); "
                        r"remove its <include"):  # fmt: skip
-        MujocoInterface(tmp_path / "old.xml", robot=builtin_robot("burger"))
+        MujocoInterface(scene, robot=builtin_robot("burger"))
