@@ -132,7 +132,9 @@ class BaseController(Actor):
             left, right = twist_to_wheels(v, omega, self.geometry)
             sec, nanosec = split_seconds(now)
             command = WHEEL_COMMAND(sec, nanosec, left, right)
-            if not self.wheel_cmd.try_publish(command):
+            try:
+                self.wheel_cmd.publish_nowait(command)
+            except anyio.WouldBlock:
                 await self.wheel_cmd.publish(command)
 
     async def on_stop(self) -> None:
@@ -143,7 +145,9 @@ class BaseController(Actor):
         path also sets the drives IDLE after that (``CanFrameTap.on_stop``)."""
         sec, nanosec = split_seconds(self.clock.now())
         command = WHEEL_COMMAND(sec, nanosec, 0.0, 0.0)
-        if not self.wheel_cmd.try_publish(command):
+        try:
+            self.wheel_cmd.publish_nowait(command)
+        except anyio.WouldBlock:
             # A full reliable mailbox: wait for room, at most one period of sim time
             # (the bridge zeroes the hardware on its own stop in any case).
             with anyio.move_on_after(1.0 / self.rate_hz):

@@ -311,10 +311,16 @@ class Bridge(Actor):
             await publisher.publish(message)
 
     def _send(self, publisher: Publisher[Any], message: Any) -> None:
-        """Publish without a coroutine (:meth:`Publisher.try_publish`); once a mailbox is
-        full, this and every later message of the instant wait in order (in the loop)."""
-        if self._pending or not publisher.try_publish(message):
-            self._pending.append((publisher, message))
+        """Publish without a coroutine (:meth:`Publisher.publish_nowait`); once a mailbox
+        is full, this and every later message of the instant wait in order (in the loop)."""
+        if not self._pending:
+            try:
+                publisher.publish_nowait(message)
+            except anyio.WouldBlock:
+                pass
+            else:
+                return
+        self._pending.append((publisher, message))
 
     def _publish_clock(self, sec: int, nanosec: int, _now: float) -> None:
         self._send(self.clock_out, CLOCK(sec, nanosec))

@@ -10,7 +10,7 @@ Two shapes, one entry point each:
 
       async with open_live_stack(record_to=Path("live.mcap")) as live:
           await live.publish_goal(4.0, 1.5)
-          async with live.subscribe("/odom", Odometry) as odom:
+          async with live.subscribe("/odom", Odometry, HOST_QOS) as odom:
               async for message in odom:
                   ...
 

@@ -38,8 +38,10 @@ from otonav.stack.session import StackSession
 
 M = TypeVar("M")
 
-#: What a host subscription requests by default: best-effort, keep the newest 10. A slow
-#: host (a web client) then drops its oldest messages and never holds the robot back.
+#: The profile for a host that must never hold the robot back: best-effort, keep the
+#: newest 10; a slow host (a web client) drops its oldest messages. Pass it for sensor
+#: topics (/odom, /scan: their publishers are best-effort). Not the default: a host
+#: subscription defaults to reliable, as ``System.subscribe`` and ROS 2 do (ADR 0056).
 HOST_QOS = QoS(Reliability.BEST_EFFORT, depth=10)
 
 _HOST = "host"
@@ -203,10 +205,14 @@ class LiveStack:
 
     # -- subscribing and publishing
 
-    def subscribe(self, topic: str, msg_type: type[M], qos: QoS = HOST_QOS) -> LiveSubscription[M]:
+    def subscribe(
+        self, topic: str, msg_type: type[M], qos: QoS = DEFAULT_QOS
+    ) -> LiveSubscription[M]:
         """A mailbox on ``topic`` for the host; QoS and type are checked like a port's
-        (a mismatch raises here, naming both ends). Close it (or use ``async with``)
-        when done: a reliable one left unread would hold its publishers back."""
+        (a mismatch raises here, naming both ends). ``qos`` defaults to reliable, as
+        everywhere (ADR 0056): a best-effort sensor topic wants :data:`HOST_QOS`. Close
+        it (or use ``async with``) when done: a reliable one left unread would hold its
+        publishers back."""
         self._check_open()
         sub = self._system.subscribe(topic, msg_type, qos, name=_HOST)
         live = LiveSubscription(self, sub)

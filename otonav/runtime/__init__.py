@@ -29,7 +29,7 @@ from otonav.runtime.errors import (
 from otonav.runtime.events import ActorStatus, EventKind, SystemEvent
 from otonav.runtime.graph import Graph
 from otonav.runtime.loop import VirtualTimeLoop, run_blocking, virtual_loop_factory
-from otonav.runtime.mailbox import Bus, MailboxStatistics, Publisher, Subscription
+from otonav.runtime.mailbox import Bus, Endpoint, MailboxStatistics, Publisher, Subscription
 from otonav.runtime.qos import (
     DEFAULT_QOS,
     LATCHED_QOS,
@@ -54,6 +54,7 @@ __all__ = (
     "Clock",
     "DeadlockError",
     "Durability",
+    "Endpoint",
     "EventKind",
     "Graph",
     "Input",

@@ -9,6 +9,7 @@ their last ``depth`` messages for subscribers that join late.
 from __future__ import annotations
 
 import asyncio
+import warnings
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -295,25 +296,23 @@ class Publisher(Generic[M]):
                 await subscription._wait_for_room()
 
     def try_publish(self, message: M) -> bool:
-        """Deliver ``message`` now, as :meth:`publish` would without waiting, and return
-        True; when a reliable mailbox is full, deliver nothing and return False (then
-        ``await publish(message)``). For a publisher that sends several messages per
-        wake: no coroutine per message (0.3-0.4 us each, ADR 0033)."""
-        if type(message) is not self.msg_type and type(message) is not self._accepted:
-            self._check_type(message)
-        subscriptions = self._topic.subscriptions
-        for subscription in subscriptions:
-            if subscription._full():
-                return False
-        self.published += 1
-        if self._history is not None:
-            self._history.append(message)
-        for subscription in subscriptions:
-            subscription._offer(message)
+        """Deprecated (ADR 0056): :meth:`publish_nowait`, which raises
+        ``anyio.WouldBlock`` where this returned False. Kept one round for callers
+        outside otonav; warns."""
+        warnings.warn(
+            "Publisher.try_publish is deprecated: use publish_nowait, which raises "
+            "anyio.WouldBlock where try_publish returned False (ADR 0056)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        try:
+            self.publish_nowait(message)
+        except anyio.WouldBlock:
+            return False
         return True
 
     def try_publish_all(self, messages: Sequence[M]) -> bool:
-        """Deliver all of ``messages`` now, in order, as one :meth:`try_publish` after
+        """Deliver all of ``messages`` now, in order, as one :meth:`publish_nowait` after
         another would, and return True; when a reliable mailbox has no room for all of
         them, deliver none and return False (then publish them one by one). For a
         publisher with a batch per wake (the CAN tap: ~15 frames per flush): one
@@ -337,7 +336,11 @@ class Publisher(Generic[M]):
 
     def publish_nowait(self, message: M) -> None:
         """Like :meth:`publish` for callers that cannot wait: raises ``anyio.WouldBlock``
-        rather than wait when a reliable mailbox is full (no subscriber receives it)."""
+        rather than wait when a reliable mailbox is full (no subscriber receives it).
+        The one non-waiting publish (ADR 0056), as ``send_nowait``/``put_nowait`` are in
+        anyio and asyncio. For a publisher that sends several messages per wake it is
+        also the fast path: no coroutine per message (0.3-0.4 us each, ADR 0033);
+        ``except anyio.WouldBlock: await publish(message)`` when it must not drop."""
         if type(message) is not self.msg_type and type(message) is not self._accepted:
             self._check_type(message)
         for subscription in self._topic.subscriptions:

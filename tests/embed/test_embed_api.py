@@ -14,6 +14,7 @@ import pytest
 
 from otonav.actors import topics
 from otonav.embed import (
+    HOST_QOS,
     LiveStack,
     PacedClock,
     check_run,
@@ -23,7 +24,6 @@ from otonav.embed import (
 from otonav.msgs import Odometry, PoseStamped
 from otonav.record.reader import read_messages, summarize
 from otonav.runtime import (
-    DEFAULT_QOS,
     LATCHED_QOS,
     Actor,
     ActorCrashedError,
@@ -56,13 +56,15 @@ async def test_live_stack_on_the_host_loop(tmp_path: Path) -> None:
     record = tmp_path / "live.mcap"
     with anyio.fail_after(WALL_CEILING):
         async with open_live_stack(record_to=record, scale=2.0) as live:
-            odom = live.subscribe(topics.ODOM, Odometry)
+            odom = live.subscribe(topics.ODOM, Odometry, HOST_QOS)
             first = await anext(odom)
             assert isinstance(first, Odometry)
             assert _host_subscribers(live, topics.ODOM) == 1
             # Wiring checks hold for the host too: QoS and type, at subscribe time.
-            with pytest.raises(QoSIncompatibleError, match="/odom"):
-                live.subscribe(topics.ODOM, Odometry, DEFAULT_QOS)
+            # The default is reliable, as System.subscribe's (ADR 0056): refused on
+            # best-effort /odom, naming the fix.
+            with pytest.raises(QoSIncompatibleError, match=r"/odom.*SENSOR_DATA_QOS"):
+                live.subscribe(topics.ODOM, Odometry)
             with pytest.raises(TopicTypeError, match="/odom"):
                 live.subscribe(topics.ODOM, PoseStamped)
 
@@ -108,7 +110,7 @@ async def test_host_cancellation_closes_the_stack_and_its_recording(
 
     async def host() -> None:
         async with open_live_stack(record_to=record) as live:
-            async for _ in live.subscribe(topics.ODOM, Odometry):
+            async for _ in live.subscribe(topics.ODOM, Odometry, HOST_QOS):
                 opened.set()
 
     with anyio.fail_after(WALL_CEILING):
@@ -141,7 +143,7 @@ async def test_a_crashing_actor_stops_the_stack_not_the_host(tmp_path: Path) -> 
 
     async def host() -> None:
         async with open_live_stack(record_to=record, extra_actors=[_Boom("boom")]) as live:
-            async for _ in live.subscribe(topics.ODOM, Odometry):
+            async for _ in live.subscribe(topics.ODOM, Odometry, HOST_QOS):
                 pass  # ends when the stack stops
             # The host's code goes on; the stack says why it stopped.
             seen.append(live.failure)

@@ -19,7 +19,7 @@ from websockets.typing import Subprotocol
 
 from otonav.actors import topics
 from otonav.actors.live_view import FoxgloveServer, LiveView, LiveViewOptions
-from otonav.embed import open_live_stack
+from otonav.embed import HOST_QOS, open_live_stack
 from otonav.msgs import Odometry, PoseStamped
 from otonav.record.reader import read_messages
 from otonav.record.schemas import schema_for
@@ -111,7 +111,7 @@ async def test_a_client_sets_a_parameter_and_sends_a_goal_that_is_reached(
                 )
                 channel = {"id": 7, "topic": topics.GOAL, "encoding": "cdr", "schemaName": name}
                 await ws.send(json.dumps({"op": "advertise", "channels": [channel]}))
-                odom = live.subscribe(topics.ODOM, Odometry)
+                odom = live.subscribe(topics.ODOM, Odometry, HOST_QOS)
 
                 async def watch() -> None:
                     async for message in odom:

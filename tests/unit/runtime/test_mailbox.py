@@ -14,6 +14,7 @@ from otonav.runtime import (
     Actor,
     Bus,
     Durability,
+    Endpoint,
     Input,
     Output,
     QoS,
@@ -23,7 +24,6 @@ from otonav.runtime import (
     TopicTypeError,
     virtual_loop_factory,
 )
-from otonav.runtime.mailbox import Endpoint
 
 pytestmark = pytest.mark.unit
 
@@ -358,21 +358,35 @@ def test_a_late_transient_local_joiner_mid_delivery_gets_the_message_once(late: 
     _run(main)
 
 
-def test_try_publish_delivers_to_all_or_to_none() -> None:
+def test_publish_nowait_delivers_to_all_or_to_none() -> None:
     bus = Bus()
     pub = bus.publisher("/data", Ping, endpoint=Endpoint("p", "out"))
     loose = bus.subscribe(
         "/data", Ping, QoS(Reliability.BEST_EFFORT, depth=1), endpoint=Endpoint("a", "in")
     )
     strict = bus.subscribe("/data", Ping, QoS(depth=2), endpoint=Endpoint("b", "in"))
-    assert pub.try_publish(Ping(0))
-    assert pub.try_publish(Ping(1))
+    pub.publish_nowait(Ping(0))
+    pub.publish_nowait(Ping(1))
     # The reliable mailbox is full: nothing is delivered, to anyone, and nothing counted.
-    assert not pub.try_publish(Ping(2))
+    with pytest.raises(anyio.WouldBlock, match=r"b\.in"):
+        pub.publish_nowait(Ping(2))
     assert pub.published == 2
     assert [m.n for m in loose.drain()] == [1]  # best effort kept the newest
     assert [m.n for m in strict.drain()] == [0, 1]
-    assert pub.try_publish(Ping(3))
+    pub.publish_nowait(Ping(3))
     assert [m.n for m in strict.drain()] == [3]
     with pytest.raises(TopicTypeError):
-        pub.try_publish("not a ping")  # type: ignore[arg-type]
+        pub.publish_nowait("not a ping")  # type: ignore[arg-type]
+
+
+def test_try_publish_is_a_deprecated_spelling_of_publish_nowait() -> None:
+    """One non-waiting publish (ADR 0056): the old bool-returning name warns and does
+    what publish_nowait does."""
+    bus = Bus()
+    pub = bus.publisher("/data", Ping, endpoint=Endpoint("p", "out"))
+    strict = bus.subscribe("/data", Ping, QoS(depth=1), endpoint=Endpoint("b", "in"))
+    with pytest.warns(DeprecationWarning, match="publish_nowait"):
+        assert pub.try_publish(Ping(0))
+    with pytest.warns(DeprecationWarning, match="publish_nowait"):
+        assert not pub.try_publish(Ping(1))
+    assert [m.n for m in strict.drain()] == [0]

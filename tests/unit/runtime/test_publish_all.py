@@ -1,5 +1,5 @@
 """``Publisher.try_publish_all``: a batch goes into every mailbox (and a recorder's funnel)
-exactly as one ``try_publish`` after another would put it, or, when a reliable mailbox
+exactly as one ``publish_nowait`` after another would put it, or, when a reliable mailbox
 has no room for all of it, nowhere."""
 
 from __future__ import annotations
@@ -83,7 +83,7 @@ class World:
             )
             other = self.bus.publisher("/other", Ping, endpoint=Endpoint("o", "out"))
             for k in range(queued):
-                assert other.try_publish(Ping(-100 - k))
+                other.publish_nowait(Ping(-100 - k))
             self.funnel.wake_at_high_water(self.wake)
             if case.blocked:
                 self.funnel.taps["/t"]._blocked_at = 0.25
@@ -118,7 +118,9 @@ def test_a_batch_goes_in_as_one_message_after_another_or_not_at_all(case: Case) 
     before = at_once.state()
     delivered = 0
     for message in batch:
-        if not one_by_one.pub.try_publish(message):
+        try:
+            one_by_one.pub.publish_nowait(message)
+        except anyio.WouldBlock:
             break
         delivered += 1
     if at_once.pub.try_publish_all(batch):
