@@ -15,8 +15,7 @@ import numpy as np
 
 from otonav.actors import topics
 from otonav.control import Pose2D, integrate_odometry
-from otonav.hal import HardwareHealth, HealthLevel, ImuSample, RobotHardwareInterface
-from otonav.hal import WheelCommand as HalWheelCommand
+from otonav.hal import HardwareHealth, HealthLevel, ImuSample, RobotHardwareInterface, WheelSetpoint
 from otonav.msgs import (
     Clock,
     DiagnosticArray,
@@ -257,11 +256,11 @@ class Bridge(Actor):
         """Zero the wheels as the bridge stops (after every actor that commands them):
         on any crash or stop, the hardware must not keep the last setpoint (issue 27
         item 8). The base's own zero on /wheel_cmd is what the recording shows."""
-        self.hal.write(HalWheelCommand(0.0, 0.0))
+        self.hal.write(WheelSetpoint(0.0, 0.0))
 
     async def _apply_commands(self) -> None:
         async for cmd in self.wheel_cmd:
-            self.hal.write(HalWheelCommand(*_read_wheel_command(cmd)))
+            self.hal.write(WheelSetpoint(*_read_wheel_command(cmd)))
 
     async def _publish_loop(self) -> None:
         """One timer for all streams: wake at the earliest due instant, publish every

@@ -25,7 +25,7 @@ from otonav.control import (
     limit_twist,
     twist_to_wheels,
 )
-from otonav.hal import RobotHardwareInterface, WheelCommand
+from otonav.hal import RobotHardwareInterface, WheelSetpoint
 from otonav.nav import GoToGoalParams, GuardParams, go_to_goal, guard_blocked
 from otonav.nav.navigation import Navigation
 from otonav.nav.safety import safe_command
@@ -58,7 +58,7 @@ def _drive(
         max_alpha=base.max_alpha,
     )
     left, right = twist_to_wheels(v, omega, kin)
-    hal.write(WheelCommand(left, right))
+    hal.write(WheelSetpoint(left, right))
     return v, omega
 
 

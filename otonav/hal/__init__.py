@@ -4,6 +4,8 @@
 types, interface and fake does not load MuJoCo.
 """
 
+import warnings as _warnings
+
 from otonav.hal.fake import FakeHardware
 from otonav.hal.health import HardwareHealth, HealthLevel
 from otonav.hal.interface import RobotHardwareInterface
@@ -13,7 +15,7 @@ from otonav.hal.types import (
     ImuSample,
     RangeScan,
     RobotGeometry,
-    WheelCommand,
+    WheelSetpoint,
     WheelState,
 )
 
@@ -27,6 +29,18 @@ __all__ = (
     "RangeScan",
     "RobotGeometry",
     "RobotHardwareInterface",
-    "WheelCommand",
+    "WheelSetpoint",
     "WheelState",
 )
+
+
+def __getattr__(name: str) -> object:
+    if name == "WheelCommand":  # renamed (ADR 0056): msgs.WheelCommand is the message
+        _warnings.warn(
+            "otonav.hal.WheelCommand is now otonav.hal.WheelSetpoint "
+            "(otonav.msgs.WheelCommand is the stamped message on /wheel_cmd)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return WheelSetpoint
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -21,7 +21,7 @@ from otonav.hal.types import (
     ImuSample,
     RangeScan,
     RobotGeometry,
-    WheelCommand,
+    WheelSetpoint,
     WheelState,
 )
 
@@ -137,7 +137,7 @@ class FakeHardware(RobotHardwareInterface):
 
         self._ticks = 0
         self._x, self._y, self._yaw = start
-        self._cmd = WheelCommand(0.0, 0.0)
+        self._cmd = WheelSetpoint(0.0, 0.0)
         self._wl = self._wr = 0.0  # wheel angular velocities, rad/s
         self._ql = self._qr = 0.0  # wheel angles, rad
         self._accel = 0.0  # forward acceleration over the last tick, m/s^2
@@ -204,7 +204,7 @@ class FakeHardware(RobotHardwareInterface):
 
     # -- I/O ----------------------------------------------------------------------------
 
-    def write(self, cmd: WheelCommand) -> None:
+    def write(self, cmd: WheelSetpoint) -> None:
         self._check_open()
         if not (math.isfinite(cmd.left) and math.isfinite(cmd.right)):
             raise ValueError(f"wheel command must be finite, got {cmd}")

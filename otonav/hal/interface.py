@@ -19,7 +19,7 @@ from otonav.hal.types import (
     ImuSample,
     RangeScan,
     RobotGeometry,
-    WheelCommand,
+    WheelSetpoint,
     WheelState,
 )
 
@@ -54,7 +54,7 @@ class RobotHardwareInterface(abc.ABC):
         """Step the world ``n`` ticks (``n >= 0``) holding the current wheel command."""
 
     @abc.abstractmethod
-    def write(self, cmd: WheelCommand) -> None:
+    def write(self, cmd: WheelSetpoint) -> None:
         """Set the wheel angular velocity setpoints (rad/s); takes effect on next advance."""
 
     @abc.abstractmethod

@@ -52,7 +52,7 @@ from otonav.hal.types import (
     ImuSample,
     RangeScan,
     RobotGeometry,
-    WheelCommand,
+    WheelSetpoint,
     WheelState,
 )
 from otonav.hal.viewer import NoDisplayError, check_display
@@ -1140,7 +1140,7 @@ class MujocoInterface(RobotHardwareInterface):
 
     # -- I/O ------------------------------------------------------------------------------
 
-    def write(self, cmd: WheelCommand) -> None:
+    def write(self, cmd: WheelSetpoint) -> None:
         self._check_open()
         if not (math.isfinite(cmd.left) and math.isfinite(cmd.right)):
             raise ValueError(f"wheel command must be finite, got {cmd}")

@@ -18,17 +18,23 @@ __all__ = [
     "ImuSample",
     "RangeScan",
     "RobotGeometry",
-    "WheelCommand",
+    "WheelSetpoint",
     "WheelState",
 ]
 
 
 @dataclass(frozen=True, slots=True)
-class WheelCommand:
+class WheelSetpoint:
     """Wheel angular velocity setpoints, rad/s. Positive drives the robot forward."""
 
     left: float
     right: float
+
+
+WheelCommand = WheelSetpoint
+"""The old name of :class:`WheelSetpoint`, which clashed with the stamped message
+``otonav.msgs.WheelCommand`` on /wheel_cmd (ADR 0056). Kept one round, unexported, so
+code written against it still runs; ``otonav.hal.WheelCommand`` warns."""
 
 
 @dataclass(frozen=True, slots=True)

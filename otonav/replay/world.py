@@ -22,7 +22,7 @@ from otonav.hal import (
     RangeScan,
     RobotGeometry,
     RobotHardwareInterface,
-    WheelCommand,
+    WheelSetpoint,
     WheelState,
 )
 from otonav.replay.recording import Recording
@@ -84,7 +84,7 @@ class RecordedRobot(RobotHardwareInterface):
     def advance(self, n: int) -> None:
         self.world().advance(n)
 
-    def write(self, cmd: WheelCommand) -> None:
+    def write(self, cmd: WheelSetpoint) -> None:
         self.world().write(cmd)
 
     def read_wheels(self) -> WheelState:

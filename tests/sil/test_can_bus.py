@@ -19,14 +19,22 @@ from typing import Any, TypeVar
 import pytest
 
 from otonav.actors import topics
-from otonav.hal import HealthLevel, RobotHardwareInterface, WheelCommand
+from otonav.hal import HealthLevel, RobotHardwareInterface, WheelSetpoint
 from otonav.hal.can import CanBusInterface, MonitorLimits, RawFrame, WheelAxis, open_endpoint
 from otonav.hal.can import protocol as p
 from otonav.hal.can.tap import FRAMES_TOPIC
 from otonav.hal.mujoco import MujocoInterface
 from otonav.hal.sim import AxisParams, DriveEmulator, DriveMount
-from otonav.msgs import DiagnosticArray, Frame, Log, NavState, Point, Pose, PoseStamped
-from otonav.msgs import WheelCommand as WheelCommandMsg
+from otonav.msgs import (
+    DiagnosticArray,
+    Frame,
+    Log,
+    NavState,
+    Point,
+    Pose,
+    PoseStamped,
+    WheelCommand,
+)
 from otonav.record.reader import read_messages, summarize
 from otonav.runtime import (
     LATCHED_QOS,
@@ -236,7 +244,7 @@ class _SensorsOnly(RobotHardwareInterface):
     def advance(self, n: int) -> None:
         self.world.advance(n)
 
-    def write(self, cmd: WheelCommand) -> None:
+    def write(self, cmd: WheelSetpoint) -> None:
         raise AssertionError("the CAN interface wrote the world's wheels directly")
 
     def read_wheels(self) -> Any:
@@ -302,13 +310,13 @@ def test_the_configured_input_mode_reaches_the_drives(mode: str) -> None:
         emulator = emulator_of(hal)
         ten_ms = round(0.01 / hal.tick)
         for _ in range(20):  # 0.2 s at rest, feeding the drives' watchdog: closed loop
-            hal.write(WheelCommand(0.0, 0.0))
+            hal.write(WheelSetpoint(0.0, 0.0))
             hal.advance(ten_ms)
         assert hal.health().drivable
         axis = emulator.drive(config.hal.sim.right_node_id)
         assert axis.input_mode == p.InputMode[mode.upper()]
         target = 5.0  # turns/s of the right motor (sign +1, gear 1)
-        hal.write(WheelCommand(-target * 2 * math.pi, target * 2 * math.pi))
+        hal.write(WheelSetpoint(-target * 2 * math.pi, target * 2 * math.pi))
         hal.advance(0)  # the frames cross the bus at this instant
         setpoints = [axis.setpoint]
         for _ in range(3):
@@ -331,7 +339,7 @@ def test_startup_waits_for_closed_loop_in_sim_time_and_shutdown_sets_idle() -> N
         assert hal.health().drivable
         assert hal.health().since == pytest.approx(0.1)
         for _ in range(50):
-            hal.write(WheelCommand(6.0, 6.0))
+            hal.write(WheelSetpoint(6.0, 6.0))
             hal.advance(5)
         wheels, truth = hal.read_wheels(), world.read_wheels()
         # Wheel angles from the last encoder frames (float32 turns): the world's, rounded.
@@ -356,10 +364,10 @@ def test_an_unchanged_setpoint_is_resent_only_after_the_keepalive(
         assert hal.health().drivable
         hal.take_frames()
         for _ in range(50):  # 0.5 s of the same setpoint, written every 10 ms
-            hal.write(WheelCommand(6.0, 6.0))
+            hal.write(WheelSetpoint(6.0, 6.0))
             hal.advance(5)
         frames = [f for _t, f in hal.take_frames()]
-        hal.write(WheelCommand(5.0, 6.0))  # a change goes out at once
+        hal.write(WheelSetpoint(5.0, 6.0))  # a change goes out at once
         changed = [f for _t, f in hal.take_frames()]
         # The drives were fed all along: the 0.2 s watchdog never expired.
         assert emulator.drive(0).state == p.AxisState.CLOSED_LOOP_CONTROL
@@ -380,7 +388,7 @@ def test_short_payloads_on_the_bus_are_ignored_not_fatal() -> None:
     with hal:
         hal.advance(50)
         assert hal.health().drivable
-        hal.write(WheelCommand(6.0, 6.0))
+        hal.write(WheelSetpoint(6.0, 6.0))
         hal.advance(5)
         for ident in (
             p.arbitration_id(1, p.CMD_GET_ENCODER_ESTIMATES),
@@ -392,7 +400,7 @@ def test_short_payloads_on_the_bus_are_ignored_not_fatal() -> None:
         hal.advance(1)  # an instant between the drives' frames: only the rogue ones
         assert hal.read_wheels() == before
         for _ in range(20):
-            hal.write(WheelCommand(6.0, 6.0))
+            hal.write(WheelSetpoint(6.0, 6.0))
             hal.advance(5)
         assert hal.health().drivable
         assert emulator.drive(0).state == p.AxisState.CLOSED_LOOP_CONTROL
@@ -407,7 +415,7 @@ def test_a_wrong_direction_sign_drives_the_wheel_backwards() -> None:
     with hal:
         hal.advance(50)
         for _ in range(50):
-            hal.write(WheelCommand(6.0, 6.0))
+            hal.write(WheelSetpoint(6.0, 6.0))
             hal.advance(5)
         truth = hal.ground_truth()
         assert abs(truth.x) < 0.02
@@ -432,7 +440,7 @@ async def _fault_scenario(
     async with running_stack(config) as stack:
         system, hal = stack.system, stack.hal
         emulator = emulator_of(hal)
-        wheel = system.subscribe(topics.WHEEL_CMD, WheelCommandMsg, WATCH)
+        wheel = system.subscribe(topics.WHEEL_CMD, WheelCommand, WATCH)
         state = system.subscribe(topics.NAV_STATE, NavState, WATCH)
         rosout = system.subscribe(topics.ROSOUT, Log, WATCH)
         diagnostics = system.subscribe(topics.DIAGNOSTICS, DiagnosticArray, WATCH)

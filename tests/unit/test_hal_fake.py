@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from otonav.hal import BoxObstacle, FakeHardware, WheelCommand
+from otonav.hal import BoxObstacle, FakeHardware, WheelSetpoint
 from otonav.hal.fake import cast_rays_2d
 
 pytestmark = pytest.mark.unit
@@ -18,7 +18,7 @@ B = 0.22  # wheel separation, m
 
 def test_straight_drive_moves_v_times_t() -> None:
     hw = FakeHardware(wheel_radius=R, wheel_separation=B)
-    hw.write(WheelCommand(6.0, 6.0))  # 0.3 m/s
+    hw.write(WheelSetpoint(6.0, 6.0))  # 0.3 m/s
     hw.advance(1000)
     gt = hw.ground_truth()
     assert hw.ticks == 1000
@@ -34,7 +34,7 @@ def test_straight_drive_moves_v_times_t() -> None:
 
 def test_pure_rotation_turns_in_place() -> None:
     hw = FakeHardware(wheel_radius=R, wheel_separation=B)
-    hw.write(WheelCommand(-2.0, 2.0))
+    hw.write(WheelSetpoint(-2.0, 2.0))
     hw.advance(500)  # 1 s
     gt = hw.ground_truth()
     expected = R * 4.0 / B  # rad/s
@@ -50,7 +50,7 @@ def test_pure_rotation_turns_in_place() -> None:
 def test_arc_is_exact_and_independent_of_chunking() -> None:
     one, many = FakeHardware(), FakeHardware()
     for hw in (one, many):
-        hw.write(WheelCommand(4.0, 6.0))
+        hw.write(WheelSetpoint(4.0, 6.0))
     one.advance(1000)
     for _ in range(100):
         many.advance(10)
@@ -64,7 +64,7 @@ def test_arc_is_exact_and_independent_of_chunking() -> None:
 
 def test_first_order_wheel_lag() -> None:
     hw = FakeHardware(wheel_time_constant=0.1)
-    hw.write(WheelCommand(6.0, 6.0))
+    hw.write(WheelSetpoint(6.0, 6.0))
     hw.advance(50)  # 0.1 s = one time constant
     assert hw.read_wheels().left_velocity == pytest.approx(6.0 * (1.0 - math.exp(-1.0)))
     # Distance = integral of v: v_cmd * (t - tau * (1 - e^-t/tau)).
@@ -137,7 +137,7 @@ def test_box_distance() -> None:
 def test_deterministic_and_guarded() -> None:
     def run() -> tuple[float, ...]:
         hw = FakeHardware(wheel_time_constant=0.05, obstacles=[BoxObstacle(1.0, 0.5, 0.2, 0.2)])
-        hw.write(WheelCommand(3.0, 5.0))
+        hw.write(WheelSetpoint(3.0, 5.0))
         hw.advance(321)
         return (*hw.read_scan().ranges.tolist(), hw.ground_truth().x, hw.ground_truth().yaw)
 
@@ -146,6 +146,15 @@ def test_deterministic_and_guarded() -> None:
         with pytest.raises(ValueError, match="negative"):
             hw.advance(-1)
         with pytest.raises(ValueError, match="finite"):
-            hw.write(WheelCommand(math.nan, 0.0))
+            hw.write(WheelSetpoint(math.nan, 0.0))
     with pytest.raises(RuntimeError, match="closed"):
         hw.advance(1)
+
+
+def test_the_old_name_of_the_wheel_setpoint_warns_and_still_works() -> None:
+    """hal.WheelCommand clashed with msgs.WheelCommand (ADR 0056): renamed WheelSetpoint."""
+    import otonav.hal
+
+    with pytest.warns(DeprecationWarning, match="WheelSetpoint"):
+        old = otonav.hal.WheelCommand
+    assert old is WheelSetpoint

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from otonav.hal import BoxObstacle, RobotHardwareInterface, WheelCommand
+from otonav.hal import BoxObstacle, RobotHardwareInterface, WheelSetpoint
 from otonav.hal.mujoco import MujocoInterface, SceneError, compile_scene, scene_names
 
 pytestmark = pytest.mark.unit
@@ -33,7 +33,7 @@ def drive_and_brake(
     floor_hits: list[int] = []
     forward_floor: list[float] = []
     for seconds, speed in ((drive_s, SPEED), (brake_s, 0.0)):
-        hw.write(WheelCommand(speed, speed))
+        hw.write(WheelSetpoint(speed, speed))
         for _ in range(round(seconds / (SCAN_EVERY * hw.tick))):
             hw.advance(SCAN_EVERY)
             scan = hw.read_scan()
@@ -126,7 +126,7 @@ def test_at_rest_imu_reads_gravity_and_lidar_never_sees_the_robot() -> None:
 
 def test_straight_drive_moves_v_times_t_and_stays_flat() -> None:
     hw = MujocoInterface("empty")
-    hw.write(WheelCommand(SPEED, SPEED))
+    hw.write(WheelSetpoint(SPEED, SPEED))
     max_pitch = 0.0
     for _ in range(100):  # 2 s
         hw.advance(10)
@@ -147,7 +147,7 @@ def test_planar_truth_is_ground_truth_without_the_attitude() -> None:
     """The judge's cheap per-tick read gives exactly ground_truth's x, y, vx, vy (and
     the interface's default, which reads ground_truth, agrees) while the robot arcs."""
     hw = MujocoInterface("empty")
-    hw.write(WheelCommand(SPEED, 0.5 * SPEED))
+    hw.write(WheelSetpoint(SPEED, 0.5 * SPEED))
     for _ in range(60):
         hw.advance(10)
         gt = hw.ground_truth()
@@ -163,7 +163,7 @@ def test_wheel_values_are_read_wheels_as_a_tuple() -> None:
     its field order (and the interface's default, which reads read_wheels, agrees),
     with the wheels turning at different speeds."""
     hw = MujocoInterface("empty")
-    hw.write(WheelCommand(SPEED, -0.5 * SPEED))
+    hw.write(WheelSetpoint(SPEED, -0.5 * SPEED))
     for _ in range(30):
         hw.advance(10)
         w = hw.read_wheels()
@@ -258,7 +258,7 @@ def test_lidar_handedness_a_box_at_plus_y_is_hit_by_the_plus_half_pi_beam(yaw: f
 def test_reading_sensors_does_not_perturb_physics() -> None:
     quiet, chatty = MujocoInterface("obstacles"), MujocoInterface("obstacles")
     for hw in (quiet, chatty):
-        hw.write(WheelCommand(4.0, 6.0))
+        hw.write(WheelSetpoint(4.0, 6.0))
     for _ in range(40):
         quiet.advance(10)
         chatty.advance(10)

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from otonav.hal import WheelCommand
+from otonav.hal import WheelSetpoint
 from otonav.hal.description import Mount, RobotDescription, builtin_robot
 from otonav.hal.mujoco import MujocoInterface, SceneError
 
@@ -67,7 +67,7 @@ def old_scene(tmp_path: Path, scene: str) -> Path:
 
 
 def drive(world: MujocoInterface, speed: float = 3.0, seconds: float = 1.0) -> None:
-    world.write(WheelCommand(speed, speed))
+    world.write(WheelSetpoint(speed, speed))
     world.advance(round(seconds / world.tick))
 
 
@@ -272,7 +272,7 @@ def test_the_default_robot_attached_moves_as_the_old_included_one(tmp_path: Path
     old_world = MujocoInterface(old_scene(tmp_path, "obstacles"))
     new_world = MujocoInterface("obstacles")
     for world in (old_world, new_world):
-        world.write(WheelCommand(4.0, 6.0))
+        world.write(WheelSetpoint(4.0, 6.0))
         world.advance(1500)
     assert old_world.ground_truth() == new_world.ground_truth()
     assert old_world.read_wheels() == new_world.read_wheels()

@@ -44,7 +44,7 @@ from otonav.hal.types import (
     ImuSample,
     RangeScan,
     RobotGeometry,
-    WheelCommand,
+    WheelSetpoint,
     WheelState,
 )
 
@@ -338,7 +338,7 @@ class CanBusInterface(RobotHardwareInterface):
 
     # -- I/O -----------------------------------------------------------------------------
 
-    def write(self, cmd: WheelCommand) -> None:
+    def write(self, cmd: WheelSetpoint) -> None:
         """Send both setpoints as Set_Input_Vel; zero while the drives are not drivable
         (starting, faulted, recovering)."""
         if self._closed:

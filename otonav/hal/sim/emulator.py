@@ -34,7 +34,7 @@ from otonav.hal.can.bus import CAN_ERR_BUSOFF, CAN_ERR_RESTARTED, CanEndpoint, R
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.sim.odrive import AxisModel, AxisParams
 from otonav.hal.sim.schedule import FaultPlan, FaultSchedule
-from otonav.hal.types import WheelCommand
+from otonav.hal.types import WheelSetpoint
 
 __all__ = ["BusFaults", "DriveEmulator", "DriveMount"]
 
@@ -235,7 +235,7 @@ class DriveEmulator:
         )
         if cmd != self._last_cmd:
             self._last_cmd = cmd
-            self._world.write(WheelCommand(cmd[0], cmd[1]))
+            self._world.write(WheelSetpoint(cmd[0], cmd[1]))
         if now == self._sent_at or self._bus_off:
             return
         self._sent_at = now

@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from otonav.hal import FakeHardware, RobotGeometry, WheelCommand
+from otonav.hal import FakeHardware, RobotGeometry, WheelSetpoint
 from otonav.hal.mujoco import MujocoInterface
 from otonav.replay import ReplayInputError
 from otonav.replay.nodes import build_nodes, stack_actor_names
@@ -73,7 +73,7 @@ def test_the_world_is_built_once_and_only_when_asked_for() -> None:
     assert robot.geometry is ODD
     assert not robot.built
     assert built == []
-    robot.write(WheelCommand(1.0, 1.0))
+    robot.write(WheelSetpoint(1.0, 1.0))
     robot.advance(10)
     assert robot.built
     assert len(built) == 1
