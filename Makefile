@@ -26,8 +26,9 @@ test: $(STAMP)
 lint: $(STAMP)
 	$(PY) scripts/gate.py static
 
-## the stack against bare physics (README "Performance"); the other benchmarks/ scripts
-## print the runtime, recording and acceptance figures
+## the stack against bare physics (README "Performance"): the one home of the stack's
+## end-to-end figures (ADR 0056); benchmarks/ holds the subsystems' own (runtime,
+## recording, CAN, planner, replay, sweep, Ray, ROS 2, robots)
 bench: $(STAMP)
 	$(PY) -m otonav bench
 

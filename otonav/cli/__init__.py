@@ -15,9 +15,17 @@ import argparse
 import importlib
 import sys
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from otonav.errors import UsageError
+
+if TYPE_CHECKING:
+    from otonav.cli.loading import load_scenario, load_stack
+
+__all__ = ("load_scenario", "load_stack", "main")
+"""The command line is the CLI's interface; from Python: :func:`main` (``argv`` as
+typed), and the loaders a host uses to take configs as ``otonav run`` does (imported on
+first use, like every command's dependencies)."""
 
 COMMANDS: tuple[str, ...] = ("run", "info", "inspect", "bench", "sweep", "replay")
 """Modules under ``otonav.cli`` whose ``add_parser`` registers a command, in help order."""
@@ -98,3 +106,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"otonav: error: {where}{exc.strerror or exc}", file=sys.stderr)
             return USAGE_ERROR
         raise
+
+
+def __getattr__(name: str) -> object:
+    if name in ("load_scenario", "load_stack"):
+        return getattr(importlib.import_module("otonav.cli.loading"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,14 +1,30 @@
-"""Pure navigation math: go-to-goal controller, obstacle guard, angle helpers (no I/O)."""
+"""Pure navigation math (no I/O, no actors): the go-to-goal controller, the obstacle
+guard, the local planner (DWA), the safety limit, and the navigation that ties them
+with a costmap, a global path and recovery (:class:`Navigation`)."""
 
+from otonav.nav.dwa import DwaParams, DwaResult, dwa_step
+from otonav.nav.footprint import centre_clearance
 from otonav.nav.geometry import wrap_angle
 from otonav.nav.go_to_goal import GoalCommand, GoToGoalParams, go_to_goal
 from otonav.nav.guard import GuardParams, guard_blocked
+from otonav.nav.navigation import Navigation, NavigationParams, NavOutput
+from otonav.nav.safety import SafetyParams, SafetyResult, safe_command
 
 __all__ = (
+    "DwaParams",
+    "DwaResult",
     "GoToGoalParams",
     "GoalCommand",
     "GuardParams",
+    "NavOutput",
+    "Navigation",
+    "NavigationParams",
+    "SafetyParams",
+    "SafetyResult",
+    "centre_clearance",
+    "dwa_step",
     "go_to_goal",
     "guard_blocked",
+    "safe_command",
     "wrap_angle",
 )

@@ -10,28 +10,55 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING
 
-from otonav.scenario.config import BoxSpec, GoalSpec, ScenarioConfig, StartSpec
+from otonav.scenario.builtin import BUILTIN
+from otonav.scenario.config import BoxSpec, Coordinate, GoalSpec, ScenarioConfig, StartSpec
 
 if TYPE_CHECKING:
+    from otonav.scenario.generator import (
+        DENSE,
+        SPARSE,
+        GeneratedWorld,
+        WorldParams,
+        generate_world,
+        generate_worlds,
+        walled_in,
+    )
     from otonav.scenario.judge import Judge
-    from otonav.scenario.run import Verdict, drive_to_goal, run_scenario
+    from otonav.scenario.run import Verdict, run_scenario
+    from otonav.scenario.validate import check_goal
 
 __all__ = (
+    "BUILTIN",
+    "DENSE",
+    "SPARSE",
     "BoxSpec",
+    "Coordinate",
+    "GeneratedWorld",
     "GoalSpec",
     "Judge",
     "ScenarioConfig",
     "StartSpec",
     "Verdict",
-    "drive_to_goal",
+    "WorldParams",
+    "check_goal",
+    "generate_world",
+    "generate_worlds",
     "run_scenario",
+    "walled_in",
 )
 
 _LAZY = {
+    "DENSE": "otonav.scenario.generator",
+    "SPARSE": "otonav.scenario.generator",
+    "GeneratedWorld": "otonav.scenario.generator",
+    "WorldParams": "otonav.scenario.generator",
+    "generate_world": "otonav.scenario.generator",
+    "generate_worlds": "otonav.scenario.generator",
+    "walled_in": "otonav.scenario.generator",
     "Judge": "otonav.scenario.judge",
     "Verdict": "otonav.scenario.run",
-    "drive_to_goal": "otonav.scenario.run",
     "run_scenario": "otonav.scenario.run",
+    "check_goal": "otonav.scenario.validate",
 }
 
 

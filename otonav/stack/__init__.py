@@ -20,13 +20,17 @@ from otonav.stack.config import (
     StackConfig,
     WorldConfig,
 )
+from otonav.stack.files import ConfigFileError, describe_validation_error, to_json
+from otonav.stack.overrides import apply_overrides
 
 if TYPE_CHECKING:
     from otonav.stack.build import build_actors, build_world
+    from otonav.stack.loading import load_stack_file
     from otonav.stack.session import RealTime, StackSession
 
 __all__ = (
     "BaseConfig",
+    "ConfigFileError",
     "DwaConfig",
     "GuardConfig",
     "NavConfig",
@@ -36,13 +40,18 @@ __all__ = (
     "StackConfig",
     "StackSession",
     "WorldConfig",
+    "apply_overrides",
     "build_actors",
     "build_world",
+    "describe_validation_error",
+    "load_stack_file",
+    "to_json",
 )
 
 _LAZY = {
     "build_actors": "otonav.stack.build",
     "build_world": "otonav.stack.build",
+    "load_stack_file": "otonav.stack.loading",
     "RealTime": "otonav.stack.session",
     "StackSession": "otonav.stack.session",
 }
