@@ -9,9 +9,11 @@ Layers, top to bottom; imports point down only (import-linter contracts in pypro
     stack                the launch file as data: robot description + actors -> world + actors
     actors               bridge, base controller, navigator, safety layer, recorder, live view
     record               MCAP recordings in ROS 2 CDR: write, read, info, salvage, bags
-    hal                  RobotHardwareInterface, FakeHardware, robot descriptions; only
-                         hal.mujoco imports mujoco; hal.can (wheels over CAN, only hal.can.bus
-                         imports python-can); hal.sim (the drive emulator: test equipment)
+    hal                  RobotHardwareInterface, FakeHardware, robot descriptions, the viewer
+                         window; hal.mujoco (the MuJoCo world: scene, prepare, derive, world;
+                         only its _lib imports mujoco); hal.can (wheels over CAN, only
+                         hal.can.bus imports python-can); hal.sim (the drive emulator: test
+                         equipment)
     nav, control         pure math: planning, the safety limit, diff-drive kinematics
     msgs, runtime        ROS 2-shaped messages; virtual-time loop, actors, topics, QoS, waits
     errors               OtonavError and UsageError (bad input: one line, exit 2)

@@ -1,11 +1,18 @@
-"""Test-suite configuration: pytester for testing the otonav pytest plugin itself, and the
-one check every bad-input test makes (`cli_fails`)."""
+"""Test-suite configuration: pytester for testing the otonav pytest plugin itself, the
+one check every bad-input test makes (`cli_fails`), and the seeds' pitch bug as a robot
+(`sabotaged_robot`, `sabotaged_robot_config`: tests/sabotage.py)."""
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from pathlib import Path
 
 import pytest
+from sabotage import sabotaged_robot as _sabotaged_robot
+from sabotage import sabotaged_robot_config as _sabotaged_robot_config
+
+from otonav.hal.description import RobotDescription
+from otonav.stack.config import RobotConfig
 
 pytest_plugins = ["pytester"]
 
@@ -35,3 +42,15 @@ def cli_fails(capsys: pytest.CaptureFixture[str]) -> CliFails:
         return line
 
     return fails
+
+
+@pytest.fixture
+def sabotaged_robot(tmp_path: Path) -> RobotDescription:
+    """otonav's robot without its caster, drives kv 10 with no torque limit."""
+    return _sabotaged_robot(tmp_path)
+
+
+@pytest.fixture
+def sabotaged_robot_config(tmp_path: Path) -> RobotConfig:
+    """The same robot as a stack config's ``robot`` section."""
+    return _sabotaged_robot_config(tmp_path)

@@ -1,4 +1,5 @@
-"""Is there a display for the MuJoCo viewer? (No MuJoCo here: this is a plain check.)
+"""The MuJoCo viewer's window, without MuJoCo: is there a display for it, and the handle
+of an open one. (``otonav.hal.mujoco`` launches it; nothing here imports MuJoCo.)
 
 ``mujoco.viewer.launch_passive`` with no usable display does not raise: GLFW fails to
 initialise in the viewer's thread and the whole process exits with code 1 after
@@ -13,13 +14,32 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-from typing import Final
+import threading
+import time
+from collections.abc import Callable, Sequence
+from typing import Any, Final
 
 from otonav.errors import UsageError
 
-__all__ = ["NO_DISPLAY_FIX", "NoDisplayError", "check_display"]
+__all__ = [
+    "NO_DISPLAY_FIX",
+    "VIEWER_AZIMUTH",
+    "VIEWER_DISTANCE",
+    "VIEWER_ELEVATION",
+    "NoDisplayError",
+    "ViewerHandle",
+    "check_display",
+    "launch_viewer",
+]
 
 NO_DISPLAY_FIX: Final = "run without --gui, or under xvfb-run"
+VIEWER_DISTANCE: Final = 4.0
+"""m from the tracked robot to the viewer's camera."""
+VIEWER_ELEVATION: Final = -40.0
+"""degrees: the tracking camera looks down at the robot from this angle."""
+VIEWER_AZIMUTH: Final = 135.0
+"""degrees, MuJoCo's convention: the tracking camera's heading around the robot."""
+_VIEWER_THREAD: Final = "_launch_internal"  # target of launch_passive's thread
 
 # Initialise GLFW as the viewer would; on failure print GLFW's last error, exit 3.
 _PROBE: Final = """
@@ -79,3 +99,85 @@ def check_display(timeout: float = 10.0) -> None:
         raise NoDisplayError(
             f"no display for the viewer: cannot open {name} ({why}); {NO_DISPLAY_FIX}"
         )
+
+
+class ViewerHandle:
+    """MuJoCo's passive viewer on a live world (``MujocoInterface.open_viewer``).
+
+    Single-threaded use from the thread that steps the world: :meth:`sync` after the
+    world advanced (at most ~60 Hz wall: each sync copies the state for drawing),
+    :meth:`is_running` to notice the user closed the window, :meth:`close` when done
+    (also as a context manager). ``start_time_s`` is how long the window took to open.
+    """
+
+    def __init__(
+        self,
+        sync_world: Callable[[], None],
+        handle: Any,
+        threads: Sequence[threading.Thread],
+        start_time_s: float,
+    ) -> None:
+        self._sync_world = sync_world
+        self._handle = handle
+        self._threads = tuple(threads)
+        self.start_time_s = start_time_s
+        self._closed = False
+
+    def is_running(self) -> bool:
+        """False once the window was closed (by the user or :meth:`close`)."""
+        return not self._closed and bool(self._handle.is_running())
+
+    def sync(self) -> None:
+        """Show the world's current state (a no-op once the window is closed)."""
+        if not self.is_running():
+            return
+        self._sync_world()  # poses of the last step, as reading does (no physics change)
+        self._handle.sync()
+
+    def close(self, timeout: float = 5.0) -> None:
+        """Close the window and wait until the viewer's thread has finished tearing
+        down, so the process can exit right after (exiting with the viewer still
+        closing crashed or hung). Idempotent."""
+        if self._closed:
+            return
+        self._closed = True
+        self._handle.close()
+        deadline = time.monotonic() + timeout
+        for thread in self._threads:
+            thread.join(max(0.0, deadline - time.monotonic()))
+        alive = [t.name for t in self._threads if t.is_alive()]
+        if alive:
+            raise RuntimeError(f"MuJoCo viewer did not shut down within {timeout:g} s ({alive})")
+
+    def __enter__(self) -> ViewerHandle:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def launch_viewer(
+    viewer: Any,
+    model: Any,
+    data: Any,
+    *,
+    sync_world: Callable[[], None],
+    tracking: tuple[int, int] | None,
+) -> ViewerHandle:
+    """Open ``viewer.launch_passive`` (the ``mujoco.viewer`` module, handed in by
+    ``otonav.hal.mujoco``: this module never imports MuJoCo) on ``model``/``data`` with
+    no side panels. ``tracking``: (MuJoCo's tracking camera type, the body to follow),
+    seen from behind-left and above, ~4 m away; None: MuJoCo's default free camera."""
+    started = time.perf_counter()
+    before = set(threading.enumerate())
+    handle = viewer.launch_passive(model, data, show_left_ui=False, show_right_ui=False)
+    if tracking is not None:
+        with handle.lock():
+            handle.cam.type, handle.cam.trackbodyid = tracking
+            handle.cam.distance = VIEWER_DISTANCE
+            handle.cam.elevation = VIEWER_ELEVATION
+            handle.cam.azimuth = VIEWER_AZIMUTH
+    elapsed = time.perf_counter() - started
+    new = [t for t in threading.enumerate() if t not in before]
+    threads = [t for t in new if _VIEWER_THREAD in t.name] or new
+    return ViewerHandle(sync_world, handle, threads, elapsed)

@@ -19,7 +19,7 @@ from otonav.actors import (
 )
 from otonav.control import DiffDriveGeometry
 from otonav.hal import BoxObstacle, RobotGeometry, RobotHardwareInterface
-from otonav.hal.mujoco import MujocoInterface, Variant
+from otonav.hal.mujoco import MujocoInterface
 from otonav.nav import GoToGoalParams, GuardParams
 from otonav.nav.dwa import DwaParams
 from otonav.nav.footprint import centre_clearance
@@ -42,7 +42,6 @@ def build_world(
     config: StackConfig,
     *,
     extra_obstacles: Sequence[BoxObstacle] = (),
-    variant: Variant = "shipped",
     start: tuple[float, float, float] = (0.0, 0.0, 0.0),
 ) -> RobotHardwareInterface:
     """The robot for ``config``, placed at ``start``: the MuJoCo world, or with
@@ -56,7 +55,6 @@ def build_world(
         lidar_range_max=world.lidar_range_max,
         timestep=world.timestep,
         extra_obstacles=extra_obstacles,
-        variant=variant,
         start=start,
         robot=robot,
     )

@@ -8,7 +8,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from otonav.hal import BoxObstacle, RobotHardwareInterface
-from otonav.hal.mujoco import Variant
 from otonav.runtime import Actor, System
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.loading import load_stack_file
@@ -30,7 +29,6 @@ async def running_stack(
     navigator: bool = True,
     extra_actors: Sequence[Actor] = (),
     extra_obstacles: Sequence[BoxObstacle] = (),
-    variant: Variant = "shipped",
     realtime_scale: float | None = None,
     record_to: Path | None = None,
 ) -> AsyncIterator[RunningStack]:
@@ -48,7 +46,7 @@ async def running_stack(
     """
     if not isinstance(config, StackConfig):
         config = load_stack_file(config)
-    hal = build_world(config, extra_obstacles=extra_obstacles, variant=variant)
+    hal = build_world(config, extra_obstacles=extra_obstacles)
     try:
         actors = [*build_actors(config, hal, navigator=navigator), *extra_actors]
     except BaseException:

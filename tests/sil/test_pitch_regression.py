@@ -5,7 +5,6 @@ there. The shipped model must never show a floor hit."""
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import anyio
 import pytest
@@ -18,6 +17,7 @@ from otonav.msgs.geometry import Point, Pose
 from otonav.runtime import LATCHED_QOS, Actor, Input
 from otonav.scenario import ScenarioConfig
 from otonav.stack import GuardConfig, NavConfig, StackConfig, WorldConfig
+from otonav.stack.config import RobotConfig
 from otonav.testing import running_stack
 
 pytestmark = pytest.mark.sil
@@ -67,14 +67,19 @@ SEEDS_GUARD = GuardConfig(stop_distance=1.0)
 async def _drive(
     scene: str,
     goal: tuple[float, float],
-    variant: Any,
+    robot: RobotConfig | None,
     seconds: float,
     guard: GuardConfig = GuardConfig(),
 ) -> FloorWatch:
     watch = FloorWatch()
     # The stop-only planner: its front-sector guard is what the floor hits fooled.
-    config = StackConfig(world=WorldConfig(scene=scene), guard=guard, nav=NavConfig(planner="stop"))
-    async with running_stack(config, extra_actors=[watch], variant=variant) as stack:
+    config = StackConfig(
+        world=WorldConfig(scene=scene),
+        guard=guard,
+        nav=NavConfig(planner="stop"),
+        robot=robot or RobotConfig(),
+    )
+    async with running_stack(config, extra_actors=[watch]) as stack:
         watch.hal = stack.hal
         publisher = stack.system.publisher(topics.GOAL, PoseStamped, LATCHED_QOS)
         await publisher.publish(PoseStamped(pose=Pose(position=Point(x=goal[0], y=goal[1]))))
@@ -83,8 +88,10 @@ async def _drive(
 
 
 @pytest.mark.sim(wall_ceiling=120)
-async def test_no_caster_unlimited_torque_dives_and_the_guard_falsely_blocks() -> None:
-    watch = await _drive("empty", (3.0, 0.0), "no_caster_unlimited_torque", 6.0, SEEDS_GUARD)
+async def test_no_caster_unlimited_torque_dives_and_the_guard_falsely_blocks(
+    sabotaged_robot_config: RobotConfig,
+) -> None:
+    watch = await _drive("empty", (3.0, 0.0), sabotaged_robot_config, 6.0, SEEDS_GUARD)
     assert watch.scans >= 50
     assert watch.floor_hits > 0
     assert watch.max_pitch > math.radians(5)
@@ -93,7 +100,7 @@ async def test_no_caster_unlimited_torque_dives_and_the_guard_falsely_blocks() -
 
 @pytest.mark.sim(wall_ceiling=120)
 async def test_same_guard_on_the_shipped_model_is_never_falsely_blocked() -> None:
-    watch = await _drive("empty", (3.0, 0.0), "shipped", 6.0, SEEDS_GUARD)
+    watch = await _drive("empty", (3.0, 0.0), None, 6.0, SEEDS_GUARD)
     assert watch.scans >= 50
     assert watch.floor_hits == 0
     assert watch.false_blocks == 0
@@ -103,7 +110,7 @@ async def test_same_guard_on_the_shipped_model_is_never_falsely_blocked() -> Non
 async def test_shipped_model_never_sees_the_floor_during_the_acceptance_run() -> None:
     scenario = ScenarioConfig()
     scene = scenario.scene or StackConfig().world.scene
-    watch = await _drive(scene, (scenario.goal.x, scenario.goal.y), "shipped", 15.0)
+    watch = await _drive(scene, (scenario.goal.x, scenario.goal.y), None, 15.0)
     assert watch.scans >= 140
     assert watch.floor_hits == 0
     assert watch.false_blocks == 0

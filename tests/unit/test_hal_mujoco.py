@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from otonav.hal import BoxObstacle, RobotHardwareInterface, WheelSetpoint
+from otonav.hal.description import RobotDescription
 from otonav.hal.mujoco import MujocoInterface, SceneError, compile_scene, scene_names
 
 pytestmark = pytest.mark.unit
@@ -182,14 +183,14 @@ def test_shipped_model_stays_flat_and_never_scans_the_floor() -> None:
     assert abs(hw.ground_truth().vx_world) < 0.01  # it did stop
 
 
-def test_bug_variant_scans_the_floor() -> None:
+def test_bug_variant_scans_the_floor(sabotaged_robot: RobotDescription) -> None:
     """The seeds' bug: no caster, no torque limit, kv 10.
 
     Without the caster the centre of mass (ahead of the axle) puts the nose on the
     floor already at rest (about 8 deg, floor read at about 0.9 m ahead); the abrupt
     stop pitches it much further and the floor comes within half a metre.
     """
-    hw = MujocoInterface("obstacles", variant="no_caster_unlimited_torque")
+    hw = MujocoInterface("obstacles", robot=sabotaged_robot)
     hw.read_scan()
     assert hw.scan_floor_hits() > 0
     pitches, floor_hits, forward_floor = drive_and_brake(hw)

@@ -1,0 +1,445 @@
+"""MuJoCo implementation of :class:`~otonav.hal.interface.RobotHardwareInterface`.
+
+Part of ``otonav.hal.mujoco``, the only code in otonav that touches MuJoCo; nothing
+outside it sees a MuJoCo type (``mujoco`` has no type stubs, so its objects are ``Any``
+here and never escape through a public signature).
+
+A scene is a built-in name (see :func:`scene_names`) or a path to an MJCF file. The
+robot is found by name: body ``chassis`` (free joint, base_link), hinge joints
+``left_wheel``/``right_wheel``, actuators ``left_motor``/``right_motor``, sites ``imu``
+and ``lidar``, sensors ``imu_gyro``, ``imu_accel``, ``imu_quat``. Static box geoms named
+``obstacle*`` and ``wall*`` are the world's obstacles and walls. Robot geoms live in
+geom group 1; the lidar casts only against groups 0 and 2.
+
+Time: ``advance(n)`` is the only thing that steps physics; ``ticks`` is an integer
+counter (``data.time`` accumulates float error and is not used). Readings taken after an
+``advance`` see the state *after* the last step: the first read after stepping runs one
+``mj_forward`` (it does not change the trajectory: reading never perturbs physics).
+Construction runs 0.25 s of physics with zero command so that at tick 0 the robot rests
+settled on its wheels and caster.
+
+Viewer: :meth:`MujocoInterface.open_viewer` opens MuJoCo's passive viewer on the live
+world (after :func:`otonav.hal.viewer.check_display`, so a missing display is a
+:class:`~otonav.hal.viewer.NoDisplayError`, not MuJoCo's hard exit). The viewer only
+draws: call :meth:`ViewerHandle.sync` after the world advanced, and
+:meth:`ViewerHandle.close` before the process exits.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Sequence
+from typing import Any, Final
+
+import numpy as np
+from numpy.typing import NDArray
+
+from otonav.hal.description import RobotDescription, builtin_robot
+from otonav.hal.interface import RobotHardwareInterface
+from otonav.hal.mujoco._lib import mujoco, viewer_module
+from otonav.hal.mujoco.derive import _actuator_of, _Derivation, _probe, _site_sensor
+from otonav.hal.mujoco.prepare import ROBOT_PREFIX, _load_robot, _merge_options, _RobotSpec
+from otonav.hal.mujoco.scene import SceneError, _add_box, _compile, _load_spec
+from otonav.hal.types import (
+    BoxObstacle,
+    GroundTruth,
+    ImuSample,
+    RangeScan,
+    RobotGeometry,
+    WheelSetpoint,
+    WheelState,
+)
+from otonav.hal.viewer import ViewerHandle, check_display, launch_viewer
+
+__all__ = ["MujocoInterface"]
+
+_RAY_GROUPS: Final = np.array([1, 0, 1, 0, 0, 0], dtype=np.uint8)  # groups 0 and 2
+_SETTLE_TIME: Final = 0.25  # s of physics run at construction, before tick 0
+_MOUNT_ABOVE: Final = 0.02  # m: a default lidar sits this far above the robot's top
+_REST_TOLERANCE: Final = 1e-3  # m: a model resting within this of the floor is not moved
+
+
+def _yaw_of_quat(w: float, x: float, y: float, z: float) -> float:
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+class MujocoInterface(RobotHardwareInterface):
+    """The otonav robot simulated by MuJoCo.
+
+    ``scene``: built-in scene name (``"empty"``, ``"obstacles"``) or an MJCF path.
+    ``lidar_beams`` beams over a full circle from -pi; ranges in
+    [``lidar_range_min``, ``lidar_range_max``] m, otherwise +inf. ``timestep`` (s)
+    overrides the scene's. ``extra_obstacles`` become 0.5 m tall static boxes named
+    ``obstacle_extra_<i>``. ``start`` is the robot's pose (x, y, yaw)
+    in the world plane before it settles.
+    """
+
+    def __init__(
+        self,
+        scene: str | os.PathLike[str] = "obstacles",
+        *,
+        lidar_beams: int = 360,
+        lidar_range_min: float = 0.12,
+        lidar_range_max: float = 8.0,
+        timestep: float | None = None,
+        extra_obstacles: Sequence[BoxObstacle] = (),
+        start: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        robot: RobotDescription | None = None,
+    ) -> None:
+        if lidar_beams < 1:
+            raise ValueError(f"lidar_beams must be >= 1, got {lidar_beams}")
+        if not 0.0 <= lidar_range_min < lidar_range_max:
+            raise ValueError(
+                f"need 0 <= lidar_range_min < lidar_range_max, got "
+                f"{lidar_range_min}, {lidar_range_max}"
+            )
+        if timestep is not None and not timestep > 0.0:
+            raise ValueError(f"timestep must be positive, got {timestep}")
+
+        spec, label = _load_spec(scene)
+        self._label = label
+        robot = robot if robot is not None else builtin_robot("otonav")
+        self._robot = robot
+        if timestep is not None:
+            spec.option.timestep = timestep
+        for i, box in enumerate(extra_obstacles):
+            _add_box(spec, f"obstacle_extra_{i}", box)
+        if spec.body(robot.base) is not None:
+            # The scene has the robot in it already (a scene that includes robot.xml).
+            robot_spec, robot_file, prefix = spec, label, ""
+        else:
+            included = builtin_robot("otonav").base
+            if spec.body(included) is not None:  # an old scene with our robot in it
+                raise SceneError(
+                    f"MJCF file {label} includes otonav's robot (body {included!r}); remove "
+                    f'its <include file="robot.xml"/> to run robot.model: {robot.label}'
+                )
+            robot_spec, robot_file = _load_robot(robot)
+            prefix = ROBOT_PREFIX
+        parts = _RobotSpec(robot_spec, robot, robot_file)
+        probe = _probe(parts)
+        parts.casters(probe.floor)
+        parts.prepare(probe.mass, probe.wheel_radius)
+        lidar_site = parts.mount("lidar", robot.lidar, (0.0, 0.0, probe.top + _MOUNT_ABOVE))
+        imu_site = parts.mount("imu", robot.imu, (0.0, 0.0, 0.0))
+        parts.imu_sensors(imu_site)
+        self._ctrl_scale = (parts.ctrl_scale["left_wheel"], parts.ctrl_scale["right_wheel"])
+        if prefix:
+            if abs(probe.bottom) > _REST_TOLERANCE:
+                parts.base.pos[2] -= probe.bottom  # rest on the floor, not in or above it
+            _merge_options(spec, robot_spec)
+            spec.worldbody.add_frame().attach_body(parts.base, prefix, "")
+        self._model: Any = _compile(spec, label if not prefix else f"{label} with {robot_file}")
+        self._data: Any = mujoco.MjData(self._model)
+        m = self._model
+        obj = mujoco.mjtObj
+
+        def ident(kind: Any, name: str) -> int:
+            found = int(mujoco.mj_name2id(m, kind, prefix + name))
+            if found < 0:  # prepared above: a bug, not a user's mistake
+                raise SceneError(f"{robot_file}: {name!r} missing after compiling")
+            return found
+
+        self._chassis = ident(obj.mjOBJ_BODY, robot.base)
+        base_joint = int(m.body_jntadr[self._chassis])
+        self._base_qpos = int(m.jnt_qposadr[base_joint])
+        self._base_qvel = int(m.jnt_dofadr[base_joint])
+        left_joint = ident(obj.mjOBJ_JOINT, robot.left_wheel)
+        right_joint = ident(obj.mjOBJ_JOINT, robot.right_wheel)
+        self._wheel_qpos = (int(m.jnt_qposadr[left_joint]), int(m.jnt_qposadr[right_joint]))
+        self._wheel_qvel = (int(m.jnt_dofadr[left_joint]), int(m.jnt_dofadr[right_joint]))
+        self._left_act = _actuator_of(m, left_joint)
+        self._right_act = _actuator_of(m, right_joint)
+        self._lidar_site = ident(obj.mjOBJ_SITE, lidar_site)
+        self._imu_site = ident(obj.mjOBJ_SITE, imu_site)
+        self._gyro = _site_sensor(m, mujoco.mjtSensor.mjSENS_GYRO, self._imu_site)
+        self._accel = _site_sensor(m, mujoco.mjtSensor.mjSENS_ACCELEROMETER, self._imu_site)
+        self._quat = _site_sensor(m, mujoco.mjtSensor.mjSENS_FRAMEQUAT, self._imu_site)
+
+        derived = _Derivation(m, self._chassis, parts)
+        self._wheel_sign = (derived.wheel_sign(left_joint), derived.wheel_sign(right_joint))
+        self._mirrored = self._wheel_sign != (1.0, 1.0)
+        self._ctrl_scale = (
+            self._ctrl_scale[0] * self._wheel_sign[0],
+            self._ctrl_scale[1] * self._wheel_sign[1],
+        )
+        self._geometry = derived.geometry(
+            (left_joint, right_joint), self._lidar_site, self._imu_site, self._base_qpos
+        )
+        self._sources = {**parts.sources, **derived.sources}
+        self._obstacles = self._static_boxes("obstacle")
+        self._walls = self._static_boxes("wall")
+        self._is_floor = np.asarray(m.geom_type == mujoco.mjtGeom.mjGEOM_PLANE, dtype=np.bool_)
+
+        # Lidar: beam directions in the site frame and preallocated ray buffers.
+        self._range_min = float(lidar_range_min)
+        self._range_max = float(lidar_range_max)
+        self._angle_min = -math.pi
+        self._angle_increment = 2.0 * math.pi / lidar_beams
+        angles = self._angle_min + self._angle_increment * np.arange(lidar_beams)
+        self._beams_local = np.zeros((lidar_beams, 3))
+        self._beams_local[:, 0] = np.cos(angles)
+        self._beams_local[:, 1] = np.sin(angles)
+        self._ray_vec = np.zeros((lidar_beams, 3))
+        self._ray_vec_flat = self._ray_vec.reshape(-1)  # a view: filled by matmul(out=)
+        self._ray_origin = np.zeros(3)
+        self._ray_geom = np.full(lidar_beams, -1, dtype=np.int32)
+        self._ray_dist = np.full(lidar_beams, -1.0)
+        self._nbeams = lidar_beams
+
+        # Place the robot at its start pose (x, y, yaw) in the world plane.
+        x0, y0, yaw0 = start
+        p = self._base_qpos
+        self._data.qpos[p] = x0
+        self._data.qpos[p + 1] = y0
+        self._data.qpos[p + 3 : p + 7] = (math.cos(yaw0 / 2), 0.0, 0.0, math.sin(yaw0 / 2))
+        # Let the robot settle onto its wheels and caster (contacts start at zero force)
+        # so tick 0 is a robot at rest: the IMU reads +g, not free fall.
+        mujoco.mj_step(m, self._data, nstep=max(1, round(_SETTLE_TIME / self.tick)))
+        self._data.time = 0.0
+        self._ticks = 0
+        self._stale = True
+        self._closed = False
+        self._sync()
+
+    # -- model facts ----------------------------------------------------------------------
+
+    def _static_boxes(self, prefix: str) -> tuple[BoxObstacle, ...]:
+        m = self._model
+        boxes = []
+        for g in range(m.ngeom):
+            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g) or ""
+            if (
+                name.startswith(prefix)
+                and int(m.geom_bodyid[g]) == 0
+                and m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX
+            ):
+                w, x, y, z = (float(v) for v in m.geom_quat[g])
+                boxes.append(
+                    BoxObstacle(
+                        x=float(m.geom_pos[g][0]),
+                        y=float(m.geom_pos[g][1]),
+                        half_x=float(m.geom_size[g][0]),
+                        half_y=float(m.geom_size[g][1]),
+                        yaw=_yaw_of_quat(w, x, y, z),
+                    )
+                )
+        return tuple(boxes)
+
+    @property
+    def scene_file(self) -> str:
+        """The MJCF file this world was built from."""
+        return self._label
+
+    @property
+    def mj_model(self) -> object:
+        """The compiled ``mujoco.MjModel`` (for a viewer inside ``otonav.hal`` only)."""
+        return self._model
+
+    @property
+    def mj_data(self) -> object:
+        """The live ``mujoco.MjData`` (for a viewer inside ``otonav.hal`` only)."""
+        return self._data
+
+    def open_viewer(self, *, track: bool = True) -> ViewerHandle:
+        """Open MuJoCo's passive viewer (no side panels) on this world.
+
+        ``track``: the camera follows the robot (MuJoCo's tracking camera on body
+        ``chassis``, from behind-left and above, ~4 m away), so it never drives out of
+        the picture; the user can still turn and zoom it. ``track=False``: MuJoCo's
+        default free camera, fixed on the model's centre.
+
+        Raises :class:`NoDisplayError` (one line: what is missing, and the fix) when
+        there is no display GLFW can open, instead of MuJoCo's hard exit.
+        """
+        self._check_open()
+        check_display()
+        self._sync()
+        tracking = (int(mujoco.mjtCamera.mjCAMERA_TRACKING), self._chassis) if track else None
+        return launch_viewer(
+            viewer_module(), self._model, self._data, sync_world=self._sync, tracking=tracking
+        )
+
+    # -- time -----------------------------------------------------------------------------
+
+    @property
+    def tick(self) -> float:
+        return float(self._model.opt.timestep)
+
+    @property
+    def ticks(self) -> int:
+        return self._ticks
+
+    def advance(self, n: int) -> None:
+        self._check_open()
+        if n < 0:
+            raise ValueError(f"cannot advance by a negative number of ticks ({n})")
+        if n == 0:
+            return
+        mujoco.mj_step(self._model, self._data, nstep=n)
+        self._ticks += n
+        self._stale = True
+        warnings = self._data.warning
+        if int(warnings[mujoco.mjtWarning.mjWARN_BADQACC].number) > 0:
+            raise RuntimeError(
+                f"MuJoCo simulation of {self._label} diverged (bad qacc) before "
+                f"t = {self.sim_time:.4f} s; the state was reset by MuJoCo"
+            )
+
+    def _sync(self) -> None:
+        """Bring derived quantities (sites, sensors, geom poses) up to the current state."""
+        if self._stale:
+            mujoco.mj_forward(self._model, self._data)
+            self._stale = False
+
+    # -- I/O ------------------------------------------------------------------------------
+
+    def write(self, cmd: WheelSetpoint) -> None:
+        self._check_open()
+        if not (math.isfinite(cmd.left) and math.isfinite(cmd.right)):
+            raise ValueError(f"wheel command must be finite, got {cmd}")
+        left_scale, right_scale = self._ctrl_scale
+        # A velocity actuator with a gear takes actuator speed: gear x wheel speed.
+        self._data.ctrl[self._left_act] = cmd.left if left_scale == 1.0 else cmd.left * left_scale
+        self._data.ctrl[self._right_act] = (
+            cmd.right if right_scale == 1.0 else cmd.right * right_scale
+        )
+
+    def read_wheels(self) -> WheelState:
+        left_pos, right_pos, left_vel, right_vel = self.wheel_values()
+        return WheelState(
+            left_position=left_pos,
+            right_position=right_pos,
+            left_velocity=left_vel,
+            right_velocity=right_vel,
+        )
+
+    def wheel_values(self) -> tuple[float, float, float, float]:
+        # The drive emulator's read at every 10 ms instant: the same four doubles as
+        # read_wheels, without building a WheelState (1.1 -> ~0.35 us).
+        qpos, qvel = self._data.qpos, self._data.qvel
+        (pl, pr), (vl, vr) = self._wheel_qpos, self._wheel_qvel
+        if self._mirrored:  # a joint axis along -y: its positive turn drives backwards
+            sl, sr = self._wheel_sign
+            return sl * qpos.item(pl), sr * qpos.item(pr), sl * qvel.item(vl), sr * qvel.item(vr)
+        return qpos.item(pl), qpos.item(pr), qvel.item(vl), qvel.item(vr)
+
+    def read_imu(self) -> ImuSample:
+        self._sync()
+        s = self._data.sensordata
+        q, g, a = s[self._quat], s[self._gyro], s[self._accel]
+        return ImuSample(
+            orientation=(float(q[0]), float(q[1]), float(q[2]), float(q[3])),
+            angular_velocity=(float(g[0]), float(g[1]), float(g[2])),
+            linear_acceleration=(float(a[0]), float(a[1]), float(a[2])),
+        )
+
+    def read_scan(self) -> RangeScan:
+        self._sync()
+        d = self._data
+        rot = d.site_xmat[self._lidar_site].reshape(3, 3)
+        np.matmul(self._beams_local, rot.T, out=self._ray_vec)
+        self._ray_origin[:] = d.site_xpos[self._lidar_site]
+        mujoco.mj_multiRay(
+            self._model,
+            d,
+            self._ray_origin,
+            self._ray_vec_flat,
+            _RAY_GROUPS,
+            1,
+            self._chassis,
+            self._ray_geom,
+            self._ray_dist,
+            None,
+            self._nbeams,
+            self._range_max,
+        )
+        dist = self._ray_dist
+        hit = self._ray_geom >= 0
+        valid = hit & (dist >= self._range_min) & (dist <= self._range_max)
+        # REP 117: no return within range_max is +inf; a return closer than range_min
+        # (too close to measure) is -inf, so nobody reads it as free space.
+        too_close = hit & (dist < self._range_min)
+        ranges = np.where(valid, dist, np.where(too_close, -np.inf, np.inf)).astype(np.float32)
+        ranges.flags.writeable = False
+        return RangeScan(
+            angle_min=self._angle_min,
+            angle_max=self._angle_min + self._angle_increment * (self._nbeams - 1),
+            angle_increment=self._angle_increment,
+            range_min=self._range_min,
+            range_max=self._range_max,
+            ranges=ranges,
+        )
+
+    def scan_hit_geoms(self) -> NDArray[np.int32]:
+        """Geom id hit by each beam of the last :meth:`read_scan` (-1: miss). A copy."""
+        return self._ray_geom.copy()
+
+    def scan_floor_mask(self) -> NDArray[np.bool_]:
+        """Per beam of the last :meth:`read_scan`: did it hit a floor plane within range?"""
+        geoms, dist = self._ray_geom, self._ray_dist
+        in_range = (geoms >= 0) & (dist >= self._range_min) & (dist <= self._range_max)
+        mask = np.zeros(self._nbeams, dtype=np.bool_)
+        mask[in_range] = self._is_floor[geoms[in_range]]
+        return mask
+
+    def scan_floor_hits(self) -> int:
+        """How many beams of the last :meth:`read_scan` hit a floor plane within range.
+
+        Non-zero means the chassis is pitched or rolled enough for the lidar to read the
+        floor as an obstacle (the seeds' pitch bug).
+        """
+        return int(np.count_nonzero(self.scan_floor_mask()))
+
+    def geom_name(self, geom_id: int) -> str:
+        """Name of a geom id (e.g. from :meth:`scan_hit_geoms`); ``""`` if unnamed."""
+        return str(mujoco.mj_id2name(self._model, mujoco.mjtObj.mjOBJ_GEOM, geom_id) or "")
+
+    def ground_truth(self) -> GroundTruth:
+        qpos, qvel = self._data.qpos, self._data.qvel
+        p, v = self._base_qpos, self._base_qvel
+        w, x, y, z = (float(c) for c in qpos[p + 3 : p + 7])
+        sin_pitch = max(-1.0, min(1.0, 2.0 * (w * y - z * x)))
+        return GroundTruth(
+            x=float(qpos[p]),
+            y=float(qpos[p + 1]),
+            yaw=_yaw_of_quat(w, x, y, z),
+            pitch=math.asin(sin_pitch),
+            roll=math.atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y)),
+            vx_world=float(qvel[v]),  # free joint: linear velocity is in the world frame
+            vy_world=float(qvel[v + 1]),
+        )
+
+    def planar_truth(self) -> tuple[float, float, float, float]:
+        # The judge's read at every tick: two slices instead of seven floats and the
+        # attitude's trigonometry (2.9 -> ~0.4 us, ~1.5 % of the acceptance run).
+        p, v = self._base_qpos, self._base_qvel
+        x, y = self._data.qpos[p : p + 2].tolist()
+        vx, vy = self._data.qvel[v : v + 2].tolist()  # free joint: world-frame velocity
+        return x, y, vx, vy
+
+    @property
+    def geometry(self) -> RobotGeometry:
+        return self._geometry
+
+    def geometry_sources(self) -> dict[str, str]:
+        return dict(self._sources)
+
+    @property
+    def robot(self) -> RobotDescription:
+        """The description this world's robot was built from."""
+        return self._robot
+
+    def obstacles(self) -> tuple[BoxObstacle, ...]:
+        return self._obstacles
+
+    def walls(self) -> tuple[BoxObstacle, ...]:
+        return self._walls
+
+    def close(self) -> None:
+        self._closed = True
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise RuntimeError(f"MujocoInterface for {self._label} is closed")
