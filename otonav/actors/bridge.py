@@ -14,7 +14,7 @@ import anyio
 import numpy as np
 
 from otonav.actors import topics
-from otonav.control import Pose2D, integrate_odometry
+from otonav.control import OdometryEstimate, Pose2D, estimate_odometry
 from otonav.hal import HardwareHealth, HealthLevel, ImuSample, RobotHardwareInterface, WheelSetpoint
 from otonav.msgs import (
     Clock,
@@ -214,10 +214,7 @@ class Bridge(Actor):
             "diagnostics": 1.0 / diagnostics_hz,
         }
         self._health: HardwareHealth | None = None
-        self._pose = Pose2D(*initial_pose)
-        self._last_wheels = (0.0, 0.0)
-        self._v = 0.0
-        self._last_odom_time = 0.0
+        self._odometry = OdometryEstimate(Pose2D(*initial_pose), 0.0, 0.0, 0.0, 0.0)
         self._imu_sample: ImuSample | None = None
         self._imu_time = -1.0
         self._pending: deque[tuple[Publisher[Any], Any]] = deque()
@@ -278,9 +275,10 @@ class Bridge(Actor):
         )
         counts = [1] * len(publishers)
         due = [start + period for period, _, _ in publishers]
-        self._last_odom_time = start
         wheels = self.hal.read_wheels()  # odometry counts motion from the start
-        self._last_wheels = (wheels.left_position, wheels.right_position)
+        self._odometry = self._odometry._replace(
+            left=wheels.left_position, right=wheels.right_position, time=start
+        )
         clock = self.clock
         while True:
             instant = min(due)
@@ -328,21 +326,15 @@ class Bridge(Actor):
         hal = self.hal
         wheels = hal.read_wheels()
         gyro_z = self._imu_at(now).angular_velocity[2]
-        geometry = hal.geometry
-        dt = now - self._last_odom_time
-        v = self._v  # the same instant again: the same estimate
-        if dt > 0:  # 0 in real-time mode when the world ran past two instants at once
-            self._last_odom_time = now
-            left0, right0 = self._last_wheels  # first read at the start of the loop
-            self._last_wheels = (wheels.left_position, wheels.right_position)
-            distance = (
-                geometry.wheel_radius
-                * ((wheels.left_position - left0) + (wheels.right_position - right0))
-                / 2
-            )
-            v = self._v = distance / dt
-            self._pose = integrate_odometry(self._pose, v, gyro_z, dt)
-        pose = self._pose
+        odometry = self._odometry = estimate_odometry(
+            self._odometry,
+            wheels.left_position,
+            wheels.right_position,
+            gyro_z,
+            now,
+            hal.geometry.wheel_radius,
+        )
+        pose, v = odometry.pose, odometry.v
         qz, qw = math.sin(pose.yaw / 2), math.cos(pose.yaw / 2)  # Quaternion.from_yaw's
         self._send(self.odom, ODOM(sec, nanosec, pose.x, pose.y, qz, qw, v, gyro_z))
         self._send(self.tf, TF(sec, nanosec, pose.x, pose.y, qz, qw))

@@ -8,10 +8,13 @@ from otonav.control.kinematics import (
     twist_to_wheels,
     wheels_to_twist,
 )
+from otonav.control.odometry import OdometryEstimate, estimate_odometry
 
 __all__ = (
     "DiffDriveGeometry",
+    "OdometryEstimate",
     "Pose2D",
+    "estimate_odometry",
     "integrate_odometry",
     "limit_twist",
     "twist_to_wheels",

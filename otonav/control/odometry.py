@@ -1,0 +1,54 @@
+"""Wheel-and-gyro odometry: the estimate the bridge publishes on /odom, as a pure step.
+
+Forward speed comes from the wheel encoders (the mean of both wheels' travel since the
+last estimate over the time between them); the yaw rate from the IMU's gyro, which does
+not slip as wheels do on a turn; the pose is the exact arc for that twist held over the
+interval (:func:`~otonav.control.kinematics.integrate_odometry`). No I/O, no clock: the
+caller passes the readings and their sim time.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+from otonav.control.kinematics import Pose2D, integrate_odometry
+
+__all__ = ("OdometryEstimate", "estimate_odometry")
+
+
+class OdometryEstimate(NamedTuple):
+    """The odometry after one step, and what the next step measures from."""
+
+    pose: Pose2D
+    """``base_link`` in ``odom``."""
+    v: float
+    """m/s, forward speed over the last interval."""
+    left: float
+    """rad, the left wheel's position at ``time``."""
+    right: float
+    """rad, the right wheel's position at ``time``."""
+    time: float
+    """s, sim time of the readings this estimate used."""
+
+
+def estimate_odometry(
+    last: OdometryEstimate,
+    left: float,
+    right: float,
+    yaw_rate: float,
+    now: float,
+    wheel_radius: float,
+) -> OdometryEstimate:
+    """One odometry step from wheel positions ``left``/``right`` (rad) and the gyro's
+    ``yaw_rate`` (rad/s) read at sim time ``now`` (s), for wheels of ``wheel_radius`` m.
+
+    When ``now`` is not after ``last.time`` (the same instant read again, or a real-time
+    world that ran past two instants at once) there is no interval to measure: ``last``
+    is returned unchanged, its speed the same estimate.
+    """
+    dt = now - last.time
+    if not dt > 0:
+        return last
+    distance = wheel_radius * ((left - last.left) + (right - last.right)) / 2
+    v = distance / dt
+    return OdometryEstimate(integrate_odometry(last.pose, v, yaw_rate, dt), v, left, right, now)
