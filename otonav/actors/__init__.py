@@ -1,5 +1,10 @@
-"""The actors: thin adapters that subscribe, call a pure function, and publish."""
+"""The actors: thin adapters that subscribe, call a pure function, and publish.
 
+``topics`` is a public module: the stack's topic names and QoS profiles (``topics.ODOM``,
+``topics.SENSOR_QOS``), as a ROS 2 interface package names them.
+"""
+
+from otonav.actors import topics
 from otonav.actors.avoiding_navigator import AvoidingNavigator
 from otonav.actors.base_controller import BaseController, BaseLimits
 from otonav.actors.bridge import Bridge
@@ -16,4 +21,5 @@ __all__ = (
     "CommandWatch",
     "Navigator",
     "SafetyLayer",
+    "topics",
 )

@@ -22,10 +22,11 @@ from otonav.errors import UsageError
 if TYPE_CHECKING:
     from otonav.cli.loading import load_scenario, load_stack
 
-__all__ = ("load_scenario", "load_stack", "main")
+__all__ = ("build_parser", "load_scenario", "load_stack", "main")
 """The command line is the CLI's interface; from Python: :func:`main` (``argv`` as
-typed), and the loaders a host uses to take configs as ``otonav run`` does (imported on
-first use, like every command's dependencies)."""
+typed), :func:`build_parser` (the docs' CLI reference is generated from it), and the
+loaders a host uses to take configs as ``otonav run`` does (imported on first use, like
+every command's dependencies)."""
 
 COMMANDS: tuple[str, ...] = ("run", "info", "inspect", "bench", "sweep", "replay")
 """Modules under ``otonav.cli`` whose ``add_parser`` registers a command, in help order."""

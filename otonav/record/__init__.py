@@ -3,8 +3,8 @@ summarised, salvaged after a cut-off, and laid out as a rosbag2 bag directory.
 
 - write: :class:`RecordingWriter` (one file), :class:`RotatingRecordingWriter` (a new
   file every N bytes, for long-lived services); the stack's recorder actor uses them;
-- read: :func:`read_messages` (typed messages in log-time order), :func:`summarize`
-  (``otonav info``); a damaged file is a :class:`DamagedRecordingError`;
+- read: :func:`read_messages` (typed messages in log-time order),
+  :func:`summarize_recording` (``otonav info``); a damaged file is a :class:`DamagedRecordingError`;
 - repair: :func:`salvage` (what a killed writer left, as a readable, indexed copy);
 - ROS 2: :func:`write_bag_directory` (``metadata.yaml`` beside the file, for
   ``ros2 bag`` and rosbags).
@@ -26,8 +26,8 @@ if TYPE_CHECKING:
         RecordingSummary,
         TopicSummary,
         read_messages,
-        summarize,
     )
+    from otonav.record.reader import summarize as summarize_recording
     from otonav.record.rotating import RotatingRecordingWriter
     from otonav.record.salvage import salvage
     from otonav.record.writer import RecordingWriter
@@ -41,7 +41,7 @@ __all__ = (
     "TopicSummary",
     "read_messages",
     "salvage",
-    "summarize",
+    "summarize_recording",
     "write_bag_directory",
 )
 
@@ -52,7 +52,7 @@ _LAZY = {
     "RecordingSummary": "otonav.record.reader",
     "TopicSummary": "otonav.record.reader",
     "read_messages": "otonav.record.reader",
-    "summarize": "otonav.record.reader",
+    "summarize_recording": "otonav.record.reader",
     "RotatingRecordingWriter": "otonav.record.rotating",
     "salvage": "otonav.record.salvage",
     "RecordingWriter": "otonav.record.writer",
@@ -61,5 +61,7 @@ _LAZY = {
 
 def __getattr__(name: str) -> object:
     if name in _LAZY:
-        return getattr(importlib.import_module(_LAZY[name]), name)
+        # summarize_recording: reader's summarize (sweep.summarize is a sweep's summary)
+        attr = "summarize" if name == "summarize_recording" else name
+        return getattr(importlib.import_module(_LAZY[name]), attr)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
