@@ -73,20 +73,21 @@ from starlette.responses import FileResponse, JSONResponse, Response, StreamingR
 from starlette.routing import Route
 
 from otonav.actors import topics
-from otonav.cli.loading import load_stack
+from otonav.cli import load_stack
 from otonav.embed import LiveStack, check_run, open_live_stack, run_scenario_async
 from otonav.hal.mujoco import SceneError, scene_names
 from otonav.limits import check_scale
 from otonav.msgs import Odometry
-from otonav.record.rotating import RotatingRecordingWriter
+from otonav.record import RotatingRecordingWriter
 from otonav.runtime import QoS, Reliability
-from otonav.scenario import GoalSpec, ScenarioConfig, Verdict
-from otonav.scenario.builtin import BUILTIN
-from otonav.scenario.config import Coordinate
-from otonav.scenario.validate import check_goal
-from otonav.stack import StackConfig
-from otonav.stack.files import ConfigFileError, describe_validation_error, to_json
-from otonav.stack.overrides import apply_overrides
+from otonav.scenario import BUILTIN, Coordinate, GoalSpec, ScenarioConfig, Verdict, check_goal
+from otonav.stack import (
+    ConfigFileError,
+    StackConfig,
+    apply_overrides,
+    describe_validation_error,
+    to_json,
+)
 
 log = logging.getLogger("otonav.service")
 
