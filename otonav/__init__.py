@@ -3,8 +3,9 @@
 Layers, top to bottom; imports point down only (import-linter contracts in pyproject.toml):
     cli, testing, embed  what users touch: ``python -m otonav``, the pytest plugin and
                          fixtures, a live stack and fast runs inside an asyncio service
-    sweep, replay, ros2  families of runs on a pool or Ray; re-simulating actors against a
-                         recording; the ROS 2 bridge over DDS (only ros2.dds imports cyclonedds)
+    sweep, replay, ros2  families of runs on a pool or Ray (sweep.backends); re-simulating
+                         actors against a recording; the ROS 2 bridge over DDS (only ros2.dds
+                         imports cyclonedds)
     scenario             run a scenario in sim time, judge it from ground truth, plot it
     stack                the launch file as data: robot description + actors -> world + actors
     actors               bridge, base controller, navigator, safety layer, recorder, live view
