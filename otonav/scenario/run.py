@@ -35,6 +35,7 @@ from otonav.runtime import (
     until,
     virtual_loop_factory,
 )
+from otonav.runtime._asyncio_compat import preload_anyio_backend
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.crash import RunCrashedError, crash_reason
 from otonav.scenario.judge import Judge
@@ -46,11 +47,19 @@ from otonav.stack.session import RealTime, StackSession
 
 VERDICT_TOPIC = "/scenario/verdict"
 RUN_METADATA = "otonav"
-LAZY_IMPORTS = ("anyio._backends._asyncio", "numpy.ma")
-"""Modules a process's first run would otherwise import inside its timed span: anyio's
-asyncio backend (when the loop starts) and numpy.ma (numpy imports it at the first
-``np.unique``, in the navigator's map). 25-110 ms on this machine: imports, not the run,
-so they load before the summary's wall clock starts (ADR 0027)."""
+LAZY_IMPORTS = ("numpy.ma",)
+"""Modules a process's first run would otherwise import inside its timed span, with
+anyio's asyncio backend (when the loop starts; :func:`preload_lazy_imports`): numpy.ma
+(numpy imports it at the first ``np.unique``, in the navigator's map). 25-110 ms on this
+machine: imports, not the run, so they load before the summary's wall clock starts (ADR
+0027)."""
+
+
+def preload_lazy_imports() -> None:
+    """Import :data:`LAZY_IMPORTS` and anyio's asyncio backend now."""
+    preload_anyio_backend()
+    for module in LAZY_IMPORTS:
+        importlib.import_module(module)
 
 
 @dataclass(frozen=True, slots=True)
@@ -315,8 +324,7 @@ def run_scenario(
             extra_actors=tuple(extra_actors),
             recording=out_dir / "recording.mcap" if out_dir and record else None,
         )
-        for module in LAZY_IMPORTS:
-            importlib.import_module(module)
+        preload_lazy_imports()
         wall_start = time.perf_counter()
         sim_time = 0.0
         ended = "completed"

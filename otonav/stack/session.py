@@ -174,7 +174,7 @@ class StackSession:
 
     def drain(self) -> None:
         """Write everything the recorder's funnel still holds (no-op without one)."""
-        if self.recorder is not None and self.recorder._funnel is not None:
+        if self.recorder is not None and self.recorder.wired:
             self.recorder.drain()
 
     def close(self, *, epilogue: Callable[[RecordingWriter], None] | None = None) -> None:
