@@ -17,7 +17,6 @@ from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
 from otonav.limits import check_scale
 from otonav.runtime import Actor, ActorCrashedError, RealTimeClock
-from otonav.runtime.clock import MAX_STEP_BATCH
 from otonav.runtime.timesource import tick_rate
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.crash import RunCrashedError, crash_reason
@@ -33,7 +32,7 @@ from otonav.scenario.run import (
     scenario_world,
 )
 from otonav.stack import StackConfig
-from otonav.stack.session import RealTime, StackSession
+from otonav.stack.session import StackSession
 
 __all__ = ["VIEWER_HZ", "run_scenario_realtime"]
 
@@ -42,9 +41,6 @@ VIEWER_HZ = 60.0
 
 HOLD_POLL_S = 0.05
 """Wall seconds between looks at whether the user closed the held window."""
-
-"""Most sim seconds stepped at once: a machine slower than the scale makes sim time slip
-behind the wall clock (the verdict's RTF shows it) rather than step in bursts."""
 
 
 async def _show(
@@ -129,7 +125,7 @@ def run_scenario_realtime(
         stack,
         hal,
         judge,
-        realtime=RealTime(scale, MAX_STEP_BATCH),
+        realtime=RealTimeClock(hal, scale=scale),
         extra_actors=extra_actors,
         recording=out_dir / "recording.mcap" if out_dir and record else None,
     )

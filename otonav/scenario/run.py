@@ -43,7 +43,7 @@ from otonav.scenario.plot import plot_trajectory
 from otonav.scenario.validate import check_cost, check_goal
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.robot import describe_robot
-from otonav.stack.session import RealTime, StackSession
+from otonav.stack.session import StackSession
 
 VERDICT_TOPIC = "/scenario/verdict"
 RUN_METADATA = "otonav"
@@ -192,7 +192,7 @@ def scenario_session(
     judge: Judge,
     *,
     extra_actors: tuple[Actor, ...] = (),
-    realtime: RealTime | None = None,
+    realtime: RealTimeClock | None = None,
     recording: Path | None = None,
 ) -> StackSession:
     """The session of a scenario run: the recorder (with ``recording``), the extra

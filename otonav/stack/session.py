@@ -19,15 +19,16 @@ ends the run (ADR 0007):
 
 Each step runs even if an earlier one raised. Time mode: ``realtime=None`` is virtual
 time (the world is the running :class:`~otonav.runtime.VirtualTimeLoop`'s time
-source); :class:`RealTime` (or a ready :class:`~otonav.runtime.RealTimeClock`) paces
-the world to the wall clock on any loop, with a pacer task stepping it in small batches
-while every actor sleeps.
+source); a :class:`~otonav.runtime.RealTimeClock` of the world paces it to the wall clock
+on any loop, with a pacer task stepping it in small batches while every actor sleeps.
+(:class:`RealTime`, which made that clock, is deprecated: ADR 0055.)
 """
 
 from __future__ import annotations
 
 import asyncio
 import contextlib
+import warnings
 from collections.abc import AsyncIterator, Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,12 +47,19 @@ __all__ = ("RealTime", "StackSession")
 
 @dataclass(frozen=True, slots=True)
 class RealTime:
-    """Real-time mode: sim time follows the wall clock times ``scale``; one advance
-    steps at most ``max_step_batch`` s of sim time (beyond that, sim time slips: see
-    :class:`~otonav.runtime.RealTimeClock`)."""
+    """Deprecated (ADR 0055): pass ``realtime=RealTimeClock(hal, scale=...)``, the same
+    clock with the same ``max_step_batch`` default. Constructing one warns."""
 
     scale: float = 1.0
     max_step_batch: float = MAX_STEP_BATCH
+
+    def __post_init__(self) -> None:
+        warnings.warn(
+            "otonav.stack.RealTime is deprecated: pass realtime=RealTimeClock(hal, scale=...) "
+            "(otonav.runtime) to StackSession",
+            DeprecationWarning,
+            stacklevel=3,
+        )
 
     def clock(self, source: TimeSource) -> RealTimeClock:
         return RealTimeClock(source, scale=self.scale, max_step_batch=self.max_step_batch)
@@ -158,7 +166,8 @@ class StackSession:
             raise RuntimeError(
                 "a stack in virtual time needs a running VirtualTimeLoop (a test marked "
                 "@pytest.mark.sim, or asyncio.Runner(loop_factory=virtual_loop_factory())); "
-                "for real-time mode on this loop, ask for it (realtime_scale= / RealTime())"
+                "for real-time mode on this loop, ask for it (realtime_scale= / "
+                "RealTimeClock(hal))"
             )
         if loop.source is not self.hal:
             self._loop, self._previous_source = loop, loop.source

@@ -9,10 +9,10 @@ from pathlib import Path
 
 from otonav.hal import BoxObstacle, RobotHardwareInterface
 from otonav.hal.mujoco import Variant
-from otonav.runtime import Actor, System
+from otonav.runtime import Actor, RealTimeClock, System
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.loading import load_stack_file
-from otonav.stack.session import RealTime, StackSession
+from otonav.stack.session import StackSession
 
 
 @dataclass(slots=True)
@@ -57,7 +57,7 @@ async def running_stack(
     session = StackSession(
         hal,
         actors,
-        realtime=RealTime(realtime_scale) if realtime_scale is not None else None,
+        realtime=RealTimeClock(hal, scale=realtime_scale) if realtime_scale is not None else None,
         record_to=record_to,
     )
     async with session.running() as system:

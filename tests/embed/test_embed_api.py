@@ -14,7 +14,6 @@ import pytest
 from otonav.actors import topics
 from otonav.embed import (
     LiveStack,
-    PacedClock,
     check_run,
     open_live_stack,
     run_scenario_async,
@@ -28,6 +27,7 @@ from otonav.runtime import (
     ActorCrashedError,
     JumpSource,
     QoSIncompatibleError,
+    RealTimeClock,
     TopicTypeError,
     until,
 )
@@ -170,7 +170,7 @@ def test_a_stalled_host_slips_sim_time_instead_of_stepping_one_long_batch() -> N
     setattr(loop, "time", lambda: real_time() + stall[0])  # noqa: B010 - a stall, simulated
 
     async def main() -> tuple[float, float]:
-        clock = PacedClock(source, scale=1.0, max_step_batch=0.05)
+        clock = RealTimeClock(source, scale=1.0)  # capped at MAX_STEP_BATCH by default
         start = clock.now()
         pacer = asyncio.ensure_future(clock.pace())
         sleeper = asyncio.ensure_future(clock.sleep_until(start + 0.2))
