@@ -331,7 +331,9 @@ async def open_live_stack(
     :class:`LiveStack`. With ``record_to`` every topic goes to that MCAP file, finished
     on every exit (or to that writer, e.g. a size-capped
     :class:`~otonav.record.rotating.RotatingRecordingWriter`). ``goal``: an initial
-    goal for the navigator (or publish one later).
+    goal for the navigator (or publish one later). Which planner runs, and whether the
+    safety layer does, is the stack config's (``nav.planner``, ``safety.enabled``);
+    ``navigator=False`` is the deprecated spelling of ``nav.planner: external``.
 
     On exit (normal, an exception, or the host's cancellation) the stack stops and the
     recording is finished. If an actor crashed and stopped the stack while the body ran

@@ -6,6 +6,7 @@ viewer: the same world, actors, judge, recording and verdict as
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import time
 from collections.abc import Callable
 from dataclasses import replace
@@ -16,18 +17,17 @@ import anyio
 from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
 from otonav.limits import check_scale
-from otonav.runtime import Actor, ActorCrashedError, RealTimeClock
+from otonav.record.outlock import lock_output
+from otonav.runtime import Actor, RealTimeClock
 from otonav.runtime.timesource import tick_rate
 from otonav.scenario.config import ScenarioConfig
-from otonav.scenario.crash import RunCrashedError, crash_reason
 from otonav.scenario.judge import Judge
 from otonav.scenario.run import (
+    JudgedRun,
     Verdict,
     drive,
-    judge_verdict,
-    robot_summary,
+    judged_run,
     run_task,
-    save_artifacts,
     scenario_session,
     scenario_world,
 )
@@ -96,17 +96,18 @@ def run_scenario_realtime(
     extra_actors: tuple[Actor, ...] = (),
     hold: Callable[[Verdict], None] | None = None,
     loop_factory: Callable[[], asyncio.AbstractEventLoop] | None = None,
+    source: str = "scenario",
+    progress: Callable[[Judge, float], None] | None = None,
 ) -> Verdict:
-    """Run ``scenario`` with sim time following the wall clock times ``scale`` and judge
-    it, like :func:`~otonav.scenario.run.run_scenario` (same artifacts in ``out_dir``,
-    recording finished on every exit path).
+    """:func:`~otonav.scenario.run.run_scenario` with ``realtime=scale`` (and ``gui``,
+    ``hold``), which is how to ask for it: sim time follows the wall clock times
+    ``scale``; the same world, judge, artifacts and endings (:func:`judged_run`).
 
     ``gui=True`` shows the run in MuJoCo's viewer: the display is checked before
     anything is built (:class:`~otonav.hal.viewer.NoDisplayError`, one line, when there
     is none), the window opens before the clock starts, is synced at ~60 Hz wall and
     closed at the end. Closing the window stops the run: the verdict fails and says so.
     ``on_start(loop, task)`` is called on the run's loop once the window (if any) is up.
-    ``extra_actors`` join the system (a live view, monitors).
     ``hold`` (with ``gui``): once the run is over and its recording finished, call
     ``hold(verdict)`` (its artifact paths are not set yet) and keep the window open on
     the final state until the user closes it; Ctrl-C ends the hold too.
@@ -118,8 +119,44 @@ def run_scenario_realtime(
         raise ValueError(problem)
     if gui:
         check_display()
-    scenario, stack, hal = scenario_world(scenario, stack)
-    judge = Judge(hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance)
+    with lock_output(out_dir) if out_dir is not None else contextlib.nullcontext():
+        return _run(
+            scenario,
+            stack,
+            out_dir=out_dir,
+            record=record,
+            plot=plot,
+            scale=scale,
+            gui=gui,
+            on_start=on_start,
+            extra_actors=extra_actors,
+            hold=hold,
+            loop_factory=loop_factory,
+            source=source,
+            progress=progress,
+        )
+
+
+def _run(
+    scenario: ScenarioConfig,
+    stack: StackConfig,
+    *,
+    out_dir: Path | None,
+    record: bool,
+    plot: bool,
+    scale: float,
+    gui: bool,
+    on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None,
+    extra_actors: tuple[Actor, ...],
+    hold: Callable[[Verdict], None] | None,
+    loop_factory: Callable[[], asyncio.AbstractEventLoop] | None,
+    source: str,
+    progress: Callable[[Judge, float], None] | None,
+) -> Verdict:
+    scenario, stack, hal = scenario_world(scenario, stack, source=source)
+    judge = Judge(
+        hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance, progress=progress
+    )
     session = scenario_session(
         scenario,
         stack,
@@ -130,6 +167,7 @@ def run_scenario_realtime(
         recording=out_dir / "recording.mcap" if out_dir and record else None,
     )
     viewer: ViewerHandle | None = None
+    held: list[Verdict] = []
     if gui:
         try:
             # Over CAN the world is the interface's sensor source: view that.
@@ -144,43 +182,28 @@ def run_scenario_realtime(
         if hold is not None:  # cleanups run last added first: before the window closes
             shown = viewer
             session.add_cleanup(lambda: _hold(shown, held, hold))
-    held: list[Verdict] = []
     closed_at: list[float] = []
-    wall_start = time.perf_counter()
-    ended = "completed"
-    crash: ActorCrashedError | None = None
-    try:
+
+    def run() -> None:
         with asyncio.Runner(loop_factory=loop_factory) as runner:
             runner.run(_main(scenario, session, judge, viewer, closed_at, on_start))
-    except ActorCrashedError as exc:  # a verdict still, raised with it (as run_scenario)
-        crash, ended = exc, f"ActorCrashedError: {crash_reason(exc)}"
-    except BaseException as exc:
-        sim = hal.ticks / tick_rate(hal.tick)
-        ended = f"{type(exc).__name__} at sim time {sim:.3f} s: {exc}".strip().rstrip(":")
-        raise
-    finally:
-        wall = time.perf_counter() - wall_start
-        sim_time = hal.ticks / tick_rate(hal.tick)
-        try:
-            verdict = judge_verdict(
-                scenario, judge, sim_time, wall, robot=robot_summary(stack, hal)
+
+    def amend(verdict: Verdict) -> Verdict:
+        if closed_at and not judge.reached:
+            verdict = replace(
+                verdict,
+                passed=False,
+                reason=(
+                    f"stopped: the viewer window was closed at sim time {closed_at[0]:.3f} s "
+                    f"({judge.distance:.3f} m from the goal)"
+                ),
             )
-            if ended != "completed":
-                verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
-            elif closed_at and not judge.reached:
-                verdict = replace(
-                    verdict,
-                    passed=False,
-                    reason=(
-                        f"stopped: the viewer window was closed at sim time {closed_at[0]:.3f} s "
-                        f"({judge.distance:.3f} m from the goal)"
-                    ),
-                )
-            if ended == "completed":
-                held.append(verdict)
-            verdict = save_artifacts(verdict, scenario, stack, judge, session, out_dir, plot)
-        finally:
-            session.close()  # idempotent: the viewer, then the world, on every path
-    if crash is not None:
-        raise RunCrashedError(crash, verdict) from crash.__cause__
-    return verdict
+        held.append(verdict)  # the run completed: what a held window shows
+        return verdict
+
+    return judged_run(
+        JudgedRun(scenario, stack, hal, judge, session, out_dir, plot),
+        run,
+        lambda: hal.ticks / tick_rate(hal.tick),
+        amend=amend,
+    )

@@ -297,6 +297,9 @@ def run_scenario(
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
     source: str = "scenario",
     progress: Callable[[Judge, float], None] | None = None,
+    realtime: float | None = None,
+    gui: bool = False,
+    hold: Callable[[Verdict], None] | None = None,
 ) -> Verdict:
     """Run ``scenario`` headless in virtual time and judge it. With ``out_dir``, leave
     ``recording.mcap`` (unless ``record=False``) and ``trajectory.png`` there. The
@@ -309,7 +312,32 @@ def run_scenario(
     Another run writing to ``out_dir`` raises :class:`~otonav.record.outlock.OutputBusyError`
     before anything is touched. An actor's crash raises
     :class:`~otonav.scenario.crash.RunCrashedError` once the artifacts are written: an
-    ``ActorCrashedError`` carrying the failed verdict."""
+    ``ActorCrashedError`` carrying the failed verdict.
+
+    ``realtime=scale`` paces sim time to the wall clock times ``scale`` instead (the same
+    actors, judge and artifacts; ``wall_ceiling`` does not apply); ``gui=True`` (real
+    time, scale 1 unless given) shows the run in MuJoCo's viewer, and ``hold(verdict)``
+    keeps its window open at the end: see
+    :func:`~otonav.scenario.realtime.run_scenario_realtime`."""
+    if realtime is not None or gui:
+        from otonav.scenario.realtime import run_scenario_realtime
+
+        return run_scenario_realtime(
+            scenario,
+            stack,
+            out_dir=out_dir,
+            record=record,
+            plot=plot,
+            scale=1.0 if realtime is None else realtime,
+            gui=gui,
+            on_start=on_start,
+            extra_actors=tuple(extra_actors),
+            hold=hold,
+            source=source,
+            progress=progress,
+        )
+    if hold is not None:
+        raise ValueError("run_scenario: hold= needs gui=True (it keeps the viewer open)")
     with lock_output(out_dir) if out_dir is not None else contextlib.nullcontext():
         # one run per out_dir (issue 27): a second is refused before it touches a file
         scenario, stack, hal = scenario_world(scenario, stack, source=source)
@@ -325,40 +353,87 @@ def run_scenario(
             recording=out_dir / "recording.mcap" if out_dir and record else None,
         )
         preload_lazy_imports()
-        wall_start = time.perf_counter()
-        sim_time = 0.0
-        ended = "completed"
-        crash: ActorCrashedError | None = None
-        try:
+        sim_time = [0.0]
+
+        def run() -> None:
             # The session makes the world the loop's time source when the run starts.
             factory = virtual_loop_factory(wall_ceiling=wall_ceiling)
             with asyncio.Runner(loop_factory=factory) as runner:
                 try:
                     runner.run(_main(scenario, session, judge, on_start))
                 finally:
-                    sim_time = runner.get_loop().time()
-        except ActorCrashedError as exc:  # a verdict still (below), raised with it
-            crash, ended = exc, f"ActorCrashedError: {crash_reason(exc)}"
-        except BaseException as exc:
-            ended = f"{type(exc).__name__} at sim time {sim_time:.3f} s: {exc}".strip().rstrip(":")
-            raise
+                    sim_time[0] = runner.get_loop().time()
+
+        return judged_run(
+            JudgedRun(scenario, stack, hal, judge, session, out_dir, plot),
+            run,
+            lambda: sim_time[0],
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class JudgedRun:
+    """What a judged run is made of, for :func:`judged_run`."""
+
+    scenario: ScenarioConfig
+    stack: StackConfig
+    hal: RobotHardwareInterface
+    judge: Judge
+    session: StackSession
+    out_dir: Path | None
+    plot: bool
+
+
+def judged_run(
+    parts: JudgedRun,
+    run: Callable[[], None],
+    sim_time: Callable[[], float],
+    *,
+    amend: Callable[[Verdict], Verdict] | None = None,
+) -> Verdict:
+    """``run()`` the scenario, then judge it and tear it down, whatever ended it: the
+    verdict (failed with "run ended early (...)" if ``run`` raised; ``amend(verdict)``
+    may change one that completed), appended to the recording, the plot drawn, the
+    session closed. An actor's crash raises :class:`RunCrashedError` carrying the
+    verdict, once the artifacts are written; any other exception propagates after them.
+    ``sim_time()`` is the run's sim time (after ``run`` returned or raised). The one
+    ending of every judged runner (virtual and real time)."""
+    scenario, stack, hal, judge, session = (
+        parts.scenario,
+        parts.stack,
+        parts.hal,
+        parts.judge,
+        parts.session,
+    )
+    wall_start = time.perf_counter()
+    ended = "completed"
+    crash: ActorCrashedError | None = None
+    try:
+        run()
+    except ActorCrashedError as exc:  # a verdict still (below), raised with it
+        crash, ended = exc, f"ActorCrashedError: {crash_reason(exc)}"
+    except BaseException as exc:
+        ended = f"{type(exc).__name__} at sim time {sim_time():.3f} s: {exc}"
+        ended = ended.strip().rstrip(":")
+        raise
+    finally:
+        wall = time.perf_counter() - wall_start
+        try:
+            verdict = judge_verdict(
+                scenario, judge, sim_time(), wall, robot=robot_summary(stack, hal)
+            )
+            if ended != "completed":
+                verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
+            elif amend is not None:
+                verdict = amend(verdict)
+            verdict = save_artifacts(
+                verdict, scenario, stack, judge, session, parts.out_dir, parts.plot
+            )
         finally:
-            try:
-                verdict = judge_verdict(
-                    scenario,
-                    judge,
-                    sim_time,
-                    time.perf_counter() - wall_start,
-                    robot=robot_summary(stack, hal),
-                )
-                if ended != "completed":
-                    verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
-                verdict = save_artifacts(verdict, scenario, stack, judge, session, out_dir, plot)
-            finally:
-                session.close()  # idempotent: reached even if the verdict or plot failed
-        if crash is not None:
-            raise RunCrashedError(crash, verdict) from crash.__cause__
-        return verdict
+            session.close()  # idempotent: reached even if the verdict or plot failed
+    if crash is not None:
+        raise RunCrashedError(crash, verdict) from crash.__cause__
+    return verdict
 
 
 TITLE_REASON_WIDTH = 64
