@@ -361,7 +361,6 @@ async def open_live_stack(
     live: LiveStack | None = None
     try:
         try:
-            clock = RealTimeClock(hal, scale=scale, max_step_batch=max_step_batch)
             actors = [*build_actors(stack, hal, navigator=navigator, goal=goal), *extra_actors]
             if server is not None:
                 actors.append(LiveView(server))
@@ -376,7 +375,16 @@ async def open_live_stack(
             if server is not None:
                 server.close()
             raise
-        session = StackSession(hal, actors, realtime=clock, record_to=record_to)
+        try:  # the session owns the world from here (it closes it if it fails)
+            session = StackSession(
+                hal, actors, realtime=scale, record_to=record_to, max_step_batch=max_step_batch
+            )
+        except BaseException:
+            if server is not None:
+                server.close()
+            raise
+        clock = session.realtime_clock
+        assert clock is not None
         if server is not None:
             session.add_cleanup(server.close)
         live = LiveStack(session, clock)

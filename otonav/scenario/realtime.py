@@ -162,7 +162,7 @@ def _run(
         stack,
         hal,
         judge,
-        realtime=RealTimeClock(hal, scale=scale),
+        realtime=scale,
         extra_actors=extra_actors,
         recording=out_dir / "recording.mcap" if out_dir and record else None,
     )

@@ -192,11 +192,12 @@ def scenario_session(
     judge: Judge,
     *,
     extra_actors: tuple[Actor, ...] = (),
-    realtime: RealTimeClock | None = None,
+    realtime: float | None = None,
     recording: Path | None = None,
 ) -> StackSession:
     """The session of a scenario run: the recorder (with ``recording``), the extra
-    actors, the robot stack starting at the scenario's start pose, and the judge."""
+    actors, the robot stack starting at the scenario's start pose, and the judge;
+    ``realtime``: the scale of a real-time run (None: virtual time)."""
     try:
         robot = build_actors(stack, hal, initial_pose=scenario.start.as_tuple())
     except BaseException:

@@ -73,6 +73,11 @@ class StackSession:
     Use ``async with session.running() as system:`` (tears down on exit), or
     ``session.running(close=False)`` followed by :meth:`close` when something must be
     appended to the recording after the run (a scenario's verdict).
+
+    Time: ``realtime=None`` is virtual time; ``realtime=scale`` (a number) paces the
+    world to the wall clock times ``scale`` with a :class:`~otonav.runtime.RealTimeClock`
+    the session makes (``max_step_batch`` per advance at most); a ready
+    ``RealTimeClock`` of ``hal`` is taken as it is.
     """
 
     def __init__(
@@ -80,9 +85,10 @@ class StackSession:
         hal: RobotHardwareInterface,
         actors: Sequence[Actor],
         *,
-        realtime: RealTime | RealTimeClock | None = None,
+        realtime: float | RealTimeClock | RealTime | None = None,
         record_to: Path | RecordingWriter | None = None,
         restart: RestartPolicy | Mapping[str, RestartPolicy] | None = None,
+        max_step_batch: float | None = MAX_STEP_BATCH,
     ) -> None:
         self.hal = hal
         self.writer: RecordingWriter | None = None
@@ -94,6 +100,8 @@ class StackSession:
         try:
             if isinstance(realtime, RealTime):
                 realtime = realtime.clock(hal)
+            elif isinstance(realtime, int | float):
+                realtime = RealTimeClock(hal, scale=realtime, max_step_batch=max_step_batch)
             self.realtime_clock: RealTimeClock | None = realtime
             if record_to is not None:
                 # A path, or a writer of the caller's (e.g. a RotatingRecordingWriter)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from otonav.hal import BoxObstacle, RobotHardwareInterface
 from otonav.hal.mujoco import Variant
-from otonav.runtime import Actor, RealTimeClock, System
+from otonav.runtime import Actor, System
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.loading import load_stack_file
 from otonav.stack.session import StackSession
@@ -63,7 +63,7 @@ async def running_stack(
     session = StackSession(
         hal,
         actors,
-        realtime=RealTimeClock(hal, scale=realtime_scale) if realtime_scale is not None else None,
+        realtime=realtime_scale,
         record_to=record_to,
     )
     async with session.running() as system:
