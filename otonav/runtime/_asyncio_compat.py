@@ -7,7 +7,7 @@ anyio's asyncio backend (``anyio._backends._asyncio``) outside their timed span.
 else in otonav touches a private name of either library (``tests/static/
 test_private_reaches.py`` walks the code), and each assumption made here is pinned by a
 test in ``tests/unit/runtime/test_asyncio_compat.py`` that fails when a new CPython or
-anyio changes it. Supported: CPython 3.11-3.13 (ADR 0001, 0055).
+anyio changes it, on every CPython CI runs (ADR 0049, 0055).
 
 What it offers instead, to the rest of the runtime:
 
