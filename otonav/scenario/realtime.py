@@ -108,6 +108,7 @@ def run_scenario_realtime(
     is none), the window opens before the clock starts, is synced at ~60 Hz wall and
     closed at the end. Closing the window stops the run: the verdict fails and says so.
     ``on_start(loop, task)`` is called on the run's loop once the window (if any) is up.
+    ``extra_actors`` join the system (a live view, monitors).
     ``hold`` (with ``gui``): once the run is over and its recording finished, call
     ``hold(verdict)`` (its artifact paths are not set yet) and keep the window open on
     the final state until the user closes it; Ctrl-C ends the hold too.
@@ -119,91 +120,59 @@ def run_scenario_realtime(
         raise ValueError(problem)
     if gui:
         check_display()
+    # one run per out_dir (issue 27): a second is refused before it touches a file
     with lock_output(out_dir) if out_dir is not None else contextlib.nullcontext():
-        return _run(
+        scenario, stack, hal = scenario_world(scenario, stack, source=source)
+        judge = Judge(
+            hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance, progress=progress
+        )
+        session = scenario_session(
             scenario,
             stack,
-            out_dir=out_dir,
-            record=record,
-            plot=plot,
-            scale=scale,
-            gui=gui,
-            on_start=on_start,
+            hal,
+            judge,
+            realtime=scale,
             extra_actors=extra_actors,
-            hold=hold,
-            loop_factory=loop_factory,
-            source=source,
-            progress=progress,
+            recording=out_dir / "recording.mcap" if out_dir and record else None,
         )
+        viewer: ViewerHandle | None = None
+        held: list[Verdict] = []
+        if gui:
+            try:
+                # Over CAN the world is the interface's sensor source: view that.
+                world = hal if isinstance(hal, MujocoInterface) else getattr(hal, "sensors", None)
+                if not isinstance(world, MujocoInterface):
+                    raise TypeError(f"gui=True needs the MuJoCo world, got {type(hal).__name__}")
+                viewer = world.open_viewer()
+            except BaseException:
+                session.close()
+                raise
+            session.add_cleanup(viewer.close)  # after the recording, before the world
+            if hold is not None:  # cleanups run last added first: before the window closes
+                shown = viewer
+                session.add_cleanup(lambda: _hold(shown, held, hold))
+        closed_at: list[float] = []
 
+        def run() -> None:
+            with asyncio.Runner(loop_factory=loop_factory) as runner:
+                runner.run(_main(scenario, session, judge, viewer, closed_at, on_start))
 
-def _run(
-    scenario: ScenarioConfig,
-    stack: StackConfig,
-    *,
-    out_dir: Path | None,
-    record: bool,
-    plot: bool,
-    scale: float,
-    gui: bool,
-    on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None,
-    extra_actors: tuple[Actor, ...],
-    hold: Callable[[Verdict], None] | None,
-    loop_factory: Callable[[], asyncio.AbstractEventLoop] | None,
-    source: str,
-    progress: Callable[[Judge, float], None] | None,
-) -> Verdict:
-    scenario, stack, hal = scenario_world(scenario, stack, source=source)
-    judge = Judge(
-        hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance, progress=progress
-    )
-    session = scenario_session(
-        scenario,
-        stack,
-        hal,
-        judge,
-        realtime=scale,
-        extra_actors=extra_actors,
-        recording=out_dir / "recording.mcap" if out_dir and record else None,
-    )
-    viewer: ViewerHandle | None = None
-    held: list[Verdict] = []
-    if gui:
-        try:
-            # Over CAN the world is the interface's sensor source: view that.
-            world = hal if isinstance(hal, MujocoInterface) else getattr(hal, "sensors", None)
-            if not isinstance(world, MujocoInterface):
-                raise TypeError(f"gui=True needs the MuJoCo world, got {type(hal).__name__}")
-            viewer = world.open_viewer()
-        except BaseException:
-            session.close()
-            raise
-        session.add_cleanup(viewer.close)  # after the recording, before the world
-        if hold is not None:  # cleanups run last added first: before the window closes
-            shown = viewer
-            session.add_cleanup(lambda: _hold(shown, held, hold))
-    closed_at: list[float] = []
+        def amend(verdict: Verdict) -> Verdict:
+            if closed_at and not judge.reached:
+                verdict = replace(
+                    verdict,
+                    passed=False,
+                    reason=(
+                        f"stopped: the viewer window was closed at sim time {closed_at[0]:.3f} s "
+                        f"({judge.distance:.3f} m from the goal)"
+                    ),
+                )
+            held.append(verdict)  # the run completed: what a held window shows
+            return verdict
 
-    def run() -> None:
-        with asyncio.Runner(loop_factory=loop_factory) as runner:
-            runner.run(_main(scenario, session, judge, viewer, closed_at, on_start))
-
-    def amend(verdict: Verdict) -> Verdict:
-        if closed_at and not judge.reached:
-            verdict = replace(
-                verdict,
-                passed=False,
-                reason=(
-                    f"stopped: the viewer window was closed at sim time {closed_at[0]:.3f} s "
-                    f"({judge.distance:.3f} m from the goal)"
-                ),
-            )
-        held.append(verdict)  # the run completed: what a held window shows
-        return verdict
-
-    return judged_run(
-        JudgedRun(scenario, stack, hal, judge, session, out_dir, plot),
-        run,
-        lambda: hal.ticks / tick_rate(hal.tick),
-        amend=amend,
-    )
+        return judged_run(
+            JudgedRun(scenario, stack, hal, judge, session, out_dir, plot),
+            run,
+            lambda: hal.ticks / tick_rate(hal.tick),
+            amend=amend,
+        )
