@@ -70,7 +70,7 @@ class Recorder(Actor):
             return 0.0
         now = self._otonav_clock.now
         if self._funnel is not None:
-            self._funnel._now = now
+            self._funnel.use_clock(now)
         return now()
 
     @property
@@ -95,6 +95,11 @@ class Recorder(Actor):
             if wake.cancelled_caught:
                 k -= 1  # woken early by the high-water mark: that boundary is still ahead
             self.drain()
+
+    @property
+    def wired(self) -> bool:
+        """Whether a System has wired the recorder (it has a funnel to drain)."""
+        return self._funnel is not None
 
     def drain(self) -> None:
         """Write everything still queued (on stop, and before a verdict is appended)."""

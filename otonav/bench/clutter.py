@@ -11,7 +11,6 @@ the PNG drawn separately and timed. One cProfile run per count says what dominat
 from __future__ import annotations
 
 import functools
-import importlib
 import random
 import statistics
 import time
@@ -74,10 +73,9 @@ def _plot(boxes: tuple[BoxObstacle, ...]) -> float:
 def warm_up() -> None:
     """What a process's first run pays once and a second does not (matplotlib and its
     fonts, the lazy imports): paid here, outside every figure."""
-    from otonav.scenario.run import LAZY_IMPORTS
+    from otonav.scenario.run import preload_lazy_imports
 
-    for module in LAZY_IMPORTS:
-        importlib.import_module(module)
+    preload_lazy_imports()
     _plot(())
 
 

@@ -20,16 +20,17 @@ Two shapes, one entry point each:
   Cancelling the awaiting task stops the simulation and waits until its recording is
   finished (an indexed, readable file) before the cancellation propagates.
 
-Blocking work on the host's loop: physics runs inside the real-time clock's advances.
-A pacer task consults the clock every half ``max_step_batch`` of wall time, so the
-world follows the wall clock in small batches (5 steps of 2 ms between the bridge's
-100 Hz wakes, at most 25) even while every actor sleeps; no advance steps more than
-``max_step_batch`` (0.05 s of sim time: 25 MuJoCo steps, well under a millisecond for
-the shipped robot). After the host's loop stalls for longer than that, the stack does
-not catch up in one long burst: sim time *slips* (it falls behind the wall clock by the
-excess, counted in :attr:`LiveStack.slip_s`), as a simulator running below real time
-does. The other work on the host's loop is the actors' own (a lidar scan ~0.1 ms, an
-MCAP chunk compressed every 64 KiB when recording).
+Blocking work on the host's loop: physics runs inside the real-time clock's advances. A
+pacer task consults the clock every half ``max_step_batch`` of wall time, so the world
+follows the wall clock in small batches (5 steps of 2 ms between the bridge's 100 Hz
+wakes, at most 25) even while every actor sleeps; no advance steps more than
+``max_step_batch`` (:data:`~otonav.runtime.MAX_STEP_BATCH`, 0.05 s of sim time: 25
+MuJoCo steps, well under a millisecond for the shipped robot). After the host's loop
+stalls for longer than that, the stack does not catch up in one long burst: sim time
+*slips* (it falls behind the wall clock by the excess, counted in
+:attr:`LiveStack.slip_s`), as a simulator running below real time does. The other work
+on the host's loop is the actors' own (a lidar scan ~0.1 ms, an MCAP chunk compressed
+every 64 KiB when recording).
 """
 
 from otonav.embed.live import HOST_QOS, LiveStack, LiveSubscription, open_live_stack

@@ -13,7 +13,6 @@ from typing import Any, Generic, TypeVar
 from otonav.actors import topics
 from otonav.actors.live_view import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.embed._wait import _wait_done
-from otonav.embed.paced import PacedClock
 from otonav.hal import RobotHardwareInterface
 from otonav.limits import check_scale
 from otonav.msgs import Header, Message, Point, Pose, PoseStamped, Time
@@ -21,6 +20,7 @@ from otonav.record.writer import RecordingWriter
 from otonav.runtime import (
     DEFAULT_QOS,
     LATCHED_QOS,
+    MAX_STEP_BATCH,
     Actor,
     Clock,
     Durability,
@@ -28,11 +28,11 @@ from otonav.runtime import (
     MailboxStatistics,
     Publisher,
     QoS,
+    RealTimeClock,
     Reliability,
     Subscription,
     System,
 )
-from otonav.runtime.clock import MAX_STEP_BATCH
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.session import StackSession
 
@@ -141,7 +141,7 @@ class LiveStack:
     """A robot stack running on the host's loop in real-time mode (see the module
     docstring). Made by :func:`open_live_stack`."""
 
-    def __init__(self, session: StackSession, clock: PacedClock) -> None:
+    def __init__(self, session: StackSession, clock: RealTimeClock) -> None:
         self._session = session
         self._system = session.system
         self._hal = session.hal
@@ -178,7 +178,8 @@ class LiveStack:
 
     @property
     def slip_s(self) -> float:
-        """Sim seconds dropped because the host's loop was held up (see :class:`PacedClock`)."""
+        """Sim seconds dropped because the host's loop was held up (see
+        :class:`~otonav.runtime.RealTimeClock`)."""
         return self._clock.slip_s
 
     @property
@@ -336,7 +337,9 @@ async def open_live_stack(
     :class:`LiveStack`. With ``record_to`` every topic goes to that MCAP file, finished
     on every exit (or to that writer, e.g. a size-capped
     :class:`~otonav.record.rotating.RotatingRecordingWriter`). ``goal``: an initial
-    goal for the navigator (or publish one later).
+    goal for the navigator (or publish one later). Which planner runs, and whether the
+    safety layer does, is the stack config's (``nav.planner``, ``safety.enabled``);
+    ``navigator=False`` is the deprecated spelling of ``nav.planner: external``.
 
     On exit (normal, an exception, or the host's cancellation) the stack stops and the
     recording is finished. If an actor crashed and stopped the stack while the body ran
@@ -364,7 +367,6 @@ async def open_live_stack(
     live: LiveStack | None = None
     try:
         try:
-            clock = PacedClock(hal, scale=scale, max_step_batch=max_step_batch)
             actors = [*build_actors(stack, hal, navigator=navigator, goal=goal), *extra_actors]
             if server is not None:
                 actors.append(LiveView(server))
@@ -379,7 +381,16 @@ async def open_live_stack(
             if server is not None:
                 server.close()
             raise
-        session = StackSession(hal, actors, realtime=clock, record_to=record_to)
+        try:  # the session owns the world from here (it closes it if it fails)
+            session = StackSession(
+                hal, actors, realtime=scale, record_to=record_to, max_step_batch=max_step_batch
+            )
+        except BaseException:
+            if server is not None:
+                server.close()
+            raise
+        clock = session.realtime_clock
+        assert clock is not None
         if server is not None:
             session.add_cleanup(server.close)
         live = LiveStack(session, clock)

@@ -1,17 +1,24 @@
-"""The clock a live stack on a host's loop uses: real time with a bounded catch-up."""
+"""Deprecated: :class:`PacedClock` is :class:`~otonav.runtime.RealTimeClock` (ADR 0055)."""
 
 from __future__ import annotations
 
-from otonav.runtime import RealTimeClock, TimeSource
-from otonav.runtime.clock import MAX_STEP_BATCH
+import warnings
+
+from otonav.runtime import MAX_STEP_BATCH, RealTimeClock, TimeSource
 
 
 class PacedClock(RealTimeClock):
-    """:class:`~otonav.runtime.RealTimeClock` with a 0.05 s catch-up cap by default: one
-    advance never blocks the host's loop for more than a small physics batch (the live
-    stack also runs :meth:`pace`)."""
+    """Deprecated alias of :class:`~otonav.runtime.RealTimeClock`, which now has the same
+    0.05 s catch-up cap (:data:`~otonav.runtime.MAX_STEP_BATCH`) by default. Kept so
+    code written against otonav.embed keeps working; constructing one warns."""
 
     def __init__(
         self, source: TimeSource, *, scale: float = 1.0, max_step_batch: float = MAX_STEP_BATCH
     ) -> None:
+        warnings.warn(
+            "otonav.embed.PacedClock is deprecated: use otonav.runtime.RealTimeClock "
+            "(the same clock, with the same max_step_batch default)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
         super().__init__(source, scale=scale, max_step_batch=max_step_batch)

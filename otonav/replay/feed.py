@@ -33,7 +33,6 @@ publishes on every wake, so this is exact for them. Actors that sleep on the clo
 from __future__ import annotations
 
 import asyncio
-import math
 from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
 from functools import partial
@@ -43,7 +42,7 @@ from otonav.actors.bridge import CLOCK, IMU, ODOM, TF
 from otonav.msgs import Message
 from otonav.replay.lazy import input_maker
 from otonav.replay.recording import RecordedMessage
-from otonav.runtime import Clock, Publisher, VirtualTimeLoop
+from otonav.runtime import Clock, Publisher, Reliability, VirtualTimeLoop
 from otonav.runtime.timesource import tick_rate
 
 
@@ -316,7 +315,7 @@ class Feeder:
             publisher,
             input_maker(publisher.msg_type, FLAT_LAYOUTS),
             subscriptions,
-            tuple(s for s in subscriptions if s._reliable),
+            tuple(s for s in subscriptions if s.qos.reliability is Reliability.RELIABLE),
         )
         return route
 
@@ -412,15 +411,15 @@ class Feeder:
         instants = self._instants
         bound = self._quiet_bound()
         if bound is not None:
-            ready: Any = self._loop._ready  # type: ignore[attr-defined]
-            resolution: float = self._loop._clock_resolution
+            loop = self._loop
+            resolution = loop.clock_resolution
             rate = self._rate
             while index < len(instants):
                 following = instants[index]
                 # A timer fires at tick T when its deadline < T / rate + resolution.
                 if (
                     following.holds
-                    or ready
+                    or loop.has_ready()
                     or bound < (following.tick - 1) / rate + resolution
                     or not self._fits(following)
                 ):
@@ -446,16 +445,11 @@ class Feeder:
         (1342 -> 491, 9 ms of 96). Delivering changes none of this but the ready queue,
         so the bound holds while :meth:`_go_on` delivers.
 
-        Reads the loop's private state (asyncio's ready queue and timer heap, the
-        virtual loop's watchers and holds): the replay tests break if they change."""
-        loop: Any = self._loop
-        if loop._holds or any(w is not self._idle_watcher for w in loop._watchers):
+        Asks the loop (its ready queue and timer heap, its watchers and holds)."""
+        loop = self._loop
+        if loop.holding or loop.has_idle_watchers(other_than=self._idle_watcher):
             return None
-        heap = loop._scheduled
-        # The root is this instant's own timer, or an earlier one; after it, the
-        # earliest timer is one of the root's children.
-        rest = heap[1:3] if heap and heap[0] is self._timer else heap[:1]
-        return min((timer.when() for timer in rest), default=math.inf)
+        return loop.deadline_after(self._timer)
 
     def _fits(self, instant: Instant) -> bool:
         """Whether the instant's messages fit its reliable mailboxes (none would wait)."""
@@ -463,7 +457,7 @@ class Feeder:
         route_of = self._route_of
         for step in instant.steps:
             for s in route_of(step.topic).reliable:  # type: ignore[union-attr]
-                if len(s._queue) + n > s._depth:
+                if not s.has_room(n):
                     return False
         return True
 
@@ -483,7 +477,7 @@ class Feeder:
             assert not isinstance(step, Settle)
             publisher, make, subscriptions, reliable = route_of(step.topic)
             for s in reliable:
-                if len(s._queue) >= s._depth:
+                if not s.has_room():
                     return k
             message = make(step.data)
             publisher.published += 1

@@ -7,7 +7,6 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import gc
-import importlib
 import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field, replace
@@ -35,6 +34,7 @@ from otonav.runtime import (
     System,
     VirtualTimeLoop,
 )
+from otonav.runtime._asyncio_compat import preload_anyio_backend
 from otonav.runtime.funnel import Funnel
 from otonav.stack import StackConfig
 from otonav.stack.overrides import apply_overrides
@@ -43,8 +43,7 @@ from otonav.stack.overrides import apply_overrides
 # `otonav replay` process. Loaded here, with the replay's own code, rather than inside the
 # first replay's window (the span its RTF is measured over); the same for the command as
 # a whole (ADR 0036; `otonav run` does the same, ADR 0027).
-with contextlib.suppress(ImportError):  # a library that reorganised: the replay pays
-    importlib.import_module("anyio._backends._asyncio")
+preload_anyio_backend()
 
 
 @dataclass(slots=True)

@@ -3,7 +3,8 @@
 - ``loop``: the virtual-time asyncio loop (sim time is loop time) and ``run_blocking``;
   ``watchdog``: its wall-clock ceiling and stop requests, enforced from a thread.
 - ``timesource``: what advances time (a physics world, or ``JumpSource``).
-- ``clock``: sim time for actors in virtual or real-time mode; ``Rate``.
+- ``clock``: sim time for actors, one contract (``Clock``) and its two modes
+  (``VirtualClock``, ``RealTimeClock``, capped at ``MAX_STEP_BATCH`` per advance); ``Rate``.
 - ``qos`` / ``mailbox``: QoS with ROS 2 matching, typed topics, publishers, mailboxes.
 - ``actor`` / ``system``: actors with typed ports, wired and supervised by a ``System``;
   ``events``: what the system reports about them (``SystemEvent``, ``EventKind``).
@@ -12,7 +13,14 @@
 """
 
 from otonav.runtime.actor import Actor, Input, Output
-from otonav.runtime.clock import Clock, Rate, RealTimeClock, VirtualClock, current_clock
+from otonav.runtime.clock import (
+    MAX_STEP_BATCH,
+    Clock,
+    Rate,
+    RealTimeClock,
+    VirtualClock,
+    current_clock,
+)
 from otonav.runtime.errors import (
     ActorCrashedError,
     ActorDefinitionError,
@@ -45,6 +53,7 @@ from otonav.runtime.waits import next_message, until
 __all__ = (
     "DEFAULT_QOS",
     "LATCHED_QOS",
+    "MAX_STEP_BATCH",
     "SENSOR_DATA_QOS",
     "Actor",
     "ActorCrashedError",

@@ -1,9 +1,12 @@
-"""Sim time as actors see it, in both modes, behind one small interface.
+"""Sim time as actors see it, in both modes: one contract, two implementations.
 
 Actors never read the wall clock and never pick a mode: they ask their :class:`Clock`
-for ``now()`` and sleep until a sim time. In virtual mode the loop's time *is* sim time
-(:class:`VirtualClock`); in real-time mode a stock loop runs on the wall clock and the
-world is stepped to follow it, optionally scaled (:class:`RealTimeClock`).
+for ``now()`` and sleep until a sim time (as trio's tasks ask its one ``Clock`` ABC).
+In virtual mode the loop's time *is* sim time (:class:`VirtualClock`); in real-time
+mode a stock loop runs on the wall clock and the world is stepped to follow it,
+optionally scaled, at most :data:`MAX_STEP_BATCH` at once (:class:`RealTimeClock`).
+What is stepped is the world's :class:`~otonav.runtime.timesource.TimeSource`, a
+separate contract (the world's side, not the actors'). ADR 0055 lists the time types.
 """
 
 from __future__ import annotations
@@ -127,7 +130,9 @@ def _wake(future: asyncio.Future[None]) -> None:
 
 MAX_STEP_BATCH = 0.05
 """s of sim time: the most a real-time run steps at once after the loop was held up (the
-excess slips); the one value every real-time runner (CLI, embedding, tests) uses."""
+excess slips): 25 MuJoCo steps of 2 ms, well under a millisecond for the shipped robot.
+The default of :class:`RealTimeClock`, and so of every real-time runner (CLI, embedding,
+``running_stack``)."""
 
 
 class RealTimeClock(Clock):
@@ -137,15 +142,21 @@ class RealTimeClock(Clock):
     time or wakes from a sleep, ``source`` is advanced to the tick the wall clock has
     reached. Watchers are evaluated after each advance.
 
-    ``max_step_batch`` (s of sim time) caps one advance: after the loop was held up (a
-    stalled host, a slow callback) the excess is dropped instead of stepped in one
-    burst; sim time slips behind the wall clock by it (:attr:`slip_s`) and follows it
-    again from there, as a simulator running below real time does. Run :meth:`pace`
-    alongside to step the world in small batches even while every actor sleeps.
+    ``max_step_batch`` (s of sim time, default :data:`MAX_STEP_BATCH`; None: no cap)
+    caps one advance: after the loop was held up (a stalled host, a slow callback) the
+    excess is dropped instead of stepped in one burst; sim time slips behind the wall
+    clock by it (:attr:`slip_s`) and follows it again from there, as a simulator running
+    below real time does. Run :meth:`pace` alongside (a
+    :class:`~otonav.stack.session.StackSession` does) to step the world in small batches
+    even while every actor sleeps.
     """
 
     def __init__(
-        self, source: TimeSource, *, scale: float = 1.0, max_step_batch: float | None = None
+        self,
+        source: TimeSource,
+        *,
+        scale: float = 1.0,
+        max_step_batch: float | None = MAX_STEP_BATCH,
     ) -> None:
         if not (scale > 0 and math.isfinite(scale)):
             raise ValueError(f"real-time scale must be a finite number > 0, got {scale!r}")

@@ -136,6 +136,11 @@ class Funnel:
             self._tap(topic)
         bus.add_topic_listener(self._tap)
 
+    def use_clock(self, now: Callable[[], float]) -> None:
+        """Stamp deliveries with ``now()`` from here on (e.g. a clock's bound ``now``,
+        once the System hands out clocks)."""
+        self._now = now
+
     def _tap(self, topic: Topic[Any]) -> None:
         if topic.name in self.taps or not self._wanted(topic.name):
             return

@@ -8,31 +8,25 @@ the earliest due timer and runs what woke. Equal deadlines wake in FIFO order
 hangs: a deadlock (nothing can ever wake) and a livelock (sim time runs on, the run
 never ends: a wall-clock ceiling).
 
-The hook is the selector: asyncio's ``_run_once`` calls ``select(timeout)`` exactly
-once per iteration with the time to the next timer, or 0 when callbacks are ready;
-that is where real waiting would happen, so that is where time jumps instead.
-
-The loop also runs its own ``_run_once`` (asyncio's steps, in asyncio's order): after
-the ready callbacks ran, the callbacks they made ready run in the same call, pass after
-pass, until the instant has settled. A timer that wakes a task is two passes (the timer
-sets a future, the future schedules the task); asyncio paid a full iteration with a
-selector call for each (ADR 0027). Debug mode runs asyncio's own iteration.
+asyncio's iteration, re-implemented so that the instant settles in one call, and every
+other reach into asyncio's private state live in :mod:`otonav.runtime._asyncio_compat`
+(:class:`~otonav.runtime._asyncio_compat.SteppedSelectorLoop`): this loop is its
+``select_idle`` hook, called where asyncio would wait in ``select``. That is where real
+waiting would happen, so that is where time jumps instead.
 """
 
 from __future__ import annotations
 
 import asyncio
 import contextlib
-import contextvars
-import heapq
 import math
 import selectors
 import time
-from asyncio import base_events
 from collections.abc import Callable, Coroutine, Generator
 from concurrent.futures import Executor
 from typing import Any, TypeVar, TypeVarTuple
 
+from otonav.runtime._asyncio_compat import SteppedSelectorLoop
 from otonav.runtime.errors import DeadlockError, TimeSourceError, WallClockCeilingError
 from otonav.runtime.timesource import FrozenSource, JumpSource, TimeSource, tick_rate
 from otonav.runtime.watchdog import LoopWatchdog
@@ -42,82 +36,7 @@ _Ts = TypeVarTuple("_Ts")
 _Watcher = Callable[[], bool]
 
 
-_INLINE_INIT = {*asyncio.Handle.__slots__, *asyncio.TimerHandle.__slots__} == {
-    "_callback", "_args", "_cancelled", "_loop", "_source_traceback", "_repr",
-    "__weakref__", "_context", "_scheduled", "_when",
-}  # fmt: skip
-"""The handle attributes :class:`_FifoTimerHandle` sets itself are all there are (the
-CPython it was written against); on any other, asyncio's own __init__ runs."""
-
-
-class _FifoTimerHandle(asyncio.TimerHandle):
-    """A timer that breaks deadline ties by scheduling order (FIFO)."""
-
-    __slots__ = ("_seq",)
-
-    def __init__(
-        self,
-        when: float,
-        callback: Callable[..., object],
-        args: tuple[Any, ...],
-        loop: asyncio.AbstractEventLoop,
-        context: contextvars.Context | None,
-        seq: int,
-    ) -> None:
-        if not _INLINE_INIT or loop.get_debug():
-            super().__init__(when, callback, args, loop, context)
-        else:
-            # asyncio's Handle + TimerHandle __init__ without debug mode, inline: the same
-            # attributes (two Python calls less per timer; a wake sets one timer).
-            self._context = contextvars.copy_context() if context is None else context
-            self._loop = loop
-            self._callback = callback
-            self._args = args
-            self._cancelled = False
-            self._repr = None
-            self._source_traceback = None
-            self._when = when
-            self._scheduled = False
-        self._seq = seq
-
-    def __lt__(self, other: object) -> bool:
-        if isinstance(other, _FifoTimerHandle):
-            mine: float = self._when
-            theirs: float = other._when
-            return mine < theirs or (mine == theirs and self._seq < other._seq)
-        return NotImplemented
-
-
-class _VirtualSelector:
-    """Wraps the real selector; ``select`` advances virtual time instead of waiting."""
-
-    def __init__(self, inner: selectors.BaseSelector) -> None:
-        self._inner = inner
-        self.loop: VirtualTimeLoop | None = None
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self._inner, name)
-
-    def select(self, timeout: float | None = None) -> list[tuple[selectors.SelectorKey, int]]:
-        loop = self.loop
-        assert loop is not None
-        return loop._idle_select(self._inner, timeout)
-
-    # Registrations change whether a poll can return anything (VirtualTimeLoop._poll).
-    def register(self, fileobj: Any, events: int, data: Any = None) -> selectors.SelectorKey:
-        key = self._inner.register(fileobj, events, data)
-        if self.loop is not None:
-            self.loop._update_poll()
-        return key
-
-    def unregister(self, fileobj: Any) -> selectors.SelectorKey:
-        key = self._inner.unregister(fileobj)
-        if self.loop is not None:
-            self.loop._update_poll()
-        return key
-
-
-class VirtualTimeLoop(asyncio.SelectorEventLoop):
+class VirtualTimeLoop(SteppedSelectorLoop):
     """An asyncio loop whose ``time()`` is the simulated time of ``source``.
 
     ``wall_ceiling``: seconds of wall time after which the run is cancelled with
@@ -137,9 +56,7 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         deadlock_grace: float | None = 0.5,
         hold_grace: float = 2.0,
     ) -> None:
-        selector = _VirtualSelector(selectors.DefaultSelector())
-        super().__init__(selector)  # type: ignore[arg-type]
-        selector.loop = self
+        super().__init__()
         self._source: TimeSource = source if source is not None else JumpSource()
         self._rate = tick_rate(self._source.tick)
         self._base = 0.0
@@ -147,8 +64,7 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         # The loop advances to the first tick at or after a deadline; the resolution lets
         # a timer whose deadline is float noise above a tick fire at that tick. It must
         # stay well above the float spacing of large times (a year in: ~4e-9 s).
-        self._clock_resolution = 0.25 / self._rate
-        self._seq = 0
+        self.clock_resolution = 0.25 / self._rate
         self._holds = 0
         self._watchers: list[_Watcher] = []
         self._wall_ceiling = wall_ceiling
@@ -158,19 +74,10 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         self._failure: BaseException | None = None
         self._fail_stop_at = 0.0
         self.wakes = 0  # time jumps taken, for benchmarks and introspection
-        self.beats = 0  # loop passes run: the watchdog's sign of progress
-        self.waiting = False  # in the selector (time jumps, I/O waits): not held
         self._hold_grace = hold_grace
         self._watchdog: LoopWatchdog | None = None
         self.held_by: str | None = None
         """What held the loop when the watchdog last had to interrupt it."""
-        self._poll = False
-        self._update_poll()
-        # asyncio's thresholds for dropping all cancelled timers at once.
-        self._min_scheduled: int = getattr(base_events, "_MIN_SCHEDULED_TIMER_HANDLES", 100)
-        self._min_cancelled_fraction: float = getattr(
-            base_events, "_MIN_CANCELLED_TIMER_HANDLES_FRACTION", 0.5
-        )
 
     # -- time ---------------------------------------------------------------------------
 
@@ -195,21 +102,7 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         self._ticks = 0
         self._source = source
         self._rate = tick_rate(source.tick)
-        self._clock_resolution = 0.25 / self._rate
-
-    def call_at(
-        self,
-        when: float,
-        callback: Callable[[*_Ts], object],
-        *args: *_Ts,
-        context: contextvars.Context | None = None,
-    ) -> asyncio.TimerHandle:
-        self._check_closed()  # type: ignore[attr-defined]
-        self._seq += 1
-        timer = _FifoTimerHandle(when, callback, args, self, context, self._seq)
-        heapq.heappush(self._scheduled, timer)  # type: ignore[attr-defined]
-        timer._scheduled = True
-        return timer
+        self.clock_resolution = 0.25 / self._rate
 
     # -- watchers: predicates evaluated whenever the system is idle at an instant -------
 
@@ -223,6 +116,10 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
                 self._watchers.remove(watcher)
 
         return remove
+
+    def has_idle_watchers(self, other_than: _Watcher | None = None) -> bool:
+        """Whether an idle watcher besides ``other_than`` is registered."""
+        return any(w is not other_than for w in self._watchers)
 
     def _run_watchers(self) -> None:
         if not self._watchers:
@@ -250,6 +147,11 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         future.add_done_callback(self._release_hold)
         return future
 
+    @property
+    def holding(self) -> bool:
+        """Whether sim time holds still for blocking work in a thread (:func:`run_blocking`)."""
+        return self._holds > 0
+
     def _release_hold(self, _future: asyncio.Future[Any]) -> None:
         self._holds -= 1
 
@@ -262,7 +164,7 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
 
     # -- the idle path ------------------------------------------------------------------
 
-    def _idle_select(
+    def select_idle(
         self, inner: selectors.BaseSelector, timeout: float | None
     ) -> list[tuple[selectors.SelectorKey, int]]:
         if self._wall_ceiling is not None:
@@ -272,19 +174,19 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
             # self-pipe is registered: call_soon_threadsafe appends to the ready queue
             # itself, the pipe only wakes a blocked select (and is drained whenever the
             # loop does wait). Saves an epoll syscall on ~3 of 4 loop iterations.
-            if self._must_poll(inner):
+            if self.polls:
                 return inner.select(0)
             return []
         # Nothing is ready: the system has settled at this instant.
         if self._watchers:
             self._run_watchers()
-            if self._ready:  # type: ignore[attr-defined]
+            if self.has_ready():
                 return inner.select(0)
-        if self._must_poll(inner):
+        if self.polls:
             events = inner.select(0)
             if events:
                 return events
-        elif self._ready:  # type: ignore[attr-defined]
+        elif self.has_ready():
             # Nothing to poll: a thread's call_soon_threadsafe has already queued its
             # callback. (Skipping the epoll per time jump took the virtual wake from
             # 1.54x to 1.42x the stock loop's due timer: benchmarks/runtime_bench.py.)
@@ -294,7 +196,9 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
             return inner.select(0.05)
         if timeout is None:
             return self._wait_or_deadlock(inner)
-        self._advance_to_deadline(self._scheduled[0]._when)  # type: ignore[attr-defined]
+        deadline = self.next_deadline()
+        assert deadline is not None  # asyncio passed a timeout: a timer is scheduled
+        self._advance_to_deadline(deadline)
         return []
 
     def _advance_to_deadline(self, when: float) -> None:
@@ -305,7 +209,7 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         clock resolution but before its deadline; staying put would livelock.
         """
         target = max(self._ticks + 1, math.ceil((when - self._base) * self._rate - 1.0))
-        while self._time_at(target) + self._clock_resolution <= when:
+        while self._time_at(target) + self.clock_resolution <= when:
             target += 1
         try:
             self._source.advance(target - self._ticks)
@@ -320,111 +224,19 @@ class VirtualTimeLoop(asyncio.SelectorEventLoop):
         self._ticks = target
         self.wakes += 1
 
-    def _must_poll(self, _inner: selectors.BaseSelector) -> bool:
-        """Whether select(0) can return anything: an fd besides the self-pipe, or signal
-        handlers (their signals arrive as bytes on the self-pipe). Kept up to date by
-        (un)registrations and signal handlers instead of asked each iteration (asking:
-        ~1.7 % of a stack run)."""
-        return self._poll
-
-    def _update_poll(self) -> None:
-        selector = self._selector  # type: ignore[attr-defined]
-        fds = len(selector._inner.get_map()) if isinstance(selector, _VirtualSelector) else 0
-        self._poll = fds > 1 or bool(getattr(self, "_signal_handlers", None))
-
-    def add_signal_handler(self, sig: int, callback: Callable[[*_Ts], object], *args: *_Ts) -> None:
-        super().add_signal_handler(sig, callback, *args)
-        self._update_poll()
-
-    def remove_signal_handler(self, sig: int) -> bool:
-        removed = super().remove_signal_handler(sig)
-        self._update_poll()
-        return removed
-
-    # -- one iteration ------------------------------------------------------------------
-
-    def _drop_cancelled_timers(self) -> None:
-        """asyncio's first step: drop cancelled timers (all, when they are many)."""
-        this: Any = self  # asyncio's private attributes, untyped
-        scheduled: list[Any] = this._scheduled
-        count = len(scheduled)
-        if (
-            count > this._min_scheduled
-            and this._timer_cancelled_count / count > this._min_cancelled_fraction
-        ):
-            kept = []
-            for handle in scheduled:
-                if handle._cancelled:
-                    handle._scheduled = False
-                else:
-                    kept.append(handle)
-            heapq.heapify(kept)
-            this._scheduled = kept
-            this._timer_cancelled_count = 0
-        else:
-            while scheduled and scheduled[0]._cancelled:
-                this._timer_cancelled_count -= 1
-                heapq.heappop(scheduled)._scheduled = False
-
-    def _run_once(self) -> None:
-        """One asyncio iteration (module docstring): asyncio's steps in asyncio's order,
-        repeated while callbacks are ready, so the order of every callback is the one
-        asyncio's iterations give. The selector is asked only when waiting (time jumps
-        there) or when something can be polled."""
-        this: Any = self  # asyncio's private attributes, untyped
-        self.beats += 1
-        if this._debug:
-            self.waiting = True  # a debug loop: the watchdog only catches a held selector
-            super()._run_once()  # type: ignore[misc]
-            return
-        ready = this._ready
-        inner = this._selector._inner
-        self._drop_cancelled_timers()
-        scheduled: list[Any] = this._scheduled
-        if ready or this._stopping:
-            if self._poll:
-                this._process_events(inner.select(0))
-        else:
-            timeout = max(0.0, scheduled[0]._when - self.time()) if scheduled else None
-            self.waiting = True
-            events = self._idle_select(inner, timeout)
-            self.waiting = False
-            this._process_events(events)
-        passes = 0
-        while True:
-            self.beats += 1
-            # Due timers join the ready queue, then the callbacks ready now run (not the
-            # ones they make ready: those are the next pass, as in asyncio).
-            end_time = self.time() + self._clock_resolution
-            while scheduled and scheduled[0]._when < end_time:
-                handle = heapq.heappop(scheduled)
-                handle._scheduled = False
-                ready.append(handle)
-            for _ in range(len(ready)):
-                handle = ready.popleft()
-                if not handle._cancelled:
-                    handle._run()
-            handle = None  # break cycles when an exception occurs (as asyncio does)
-            if not ready or this._stopping:
-                return
-            # The next pass starts as asyncio's next iteration would.
-            passes += 1
-            if not passes & 255 and self._wall_ceiling is not None:
-                self._check_wall_ceiling()  # a task that never waits on time
-            self._drop_cancelled_timers()
-            scheduled = this._scheduled
-            if self._poll:
-                this._process_events(inner.select(0))
+    def iteration_check(self) -> None:
+        if self._wall_ceiling is not None:
+            self._check_wall_ceiling()  # a task that never waits on time
 
     def _wait_or_deadlock(
         self, inner: selectors.BaseSelector
     ) -> list[tuple[selectors.SelectorKey, int]]:
         # Only the loop's self-pipe registered means no outside I/O can wake us either.
-        has_io = len(inner.get_map()) > 1
+        has_io = self.has_io()
         if has_io or self._deadlock_grace is None:
             return inner.select(0.05)
         events = inner.select(self._deadlock_grace)
-        if events or self._ready:  # type: ignore[attr-defined]
+        if events or self.has_ready():
             return events
         self._fail(
             DeadlockError(

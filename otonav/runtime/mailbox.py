@@ -108,6 +108,12 @@ class Subscription(Generic[M]):
         """True when ``n`` more messages go in now (a reliable mailbox never drops)."""
         return not self._reliable or len(self._queue) + n <= self._depth
 
+    def has_room(self, n: int = 1) -> bool:
+        """Whether ``n`` more messages go in now without a publisher waiting (always
+        True for a best-effort mailbox, which drops its oldest instead). For code that
+        delivers on the runtime's behalf, e.g. the replay feeder."""
+        return self._has_room(n)
+
     def _offer_all(self, messages: Sequence[M]) -> None:
         """:meth:`_offer` each of ``messages``, in order, after :meth:`_has_room` said
         they fit: one ``extend``, and for a best-effort mailbox the oldest dropped and

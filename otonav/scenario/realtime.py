@@ -6,6 +6,7 @@ viewer: the same world, actors, judge, recording and verdict as
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import time
 from collections.abc import Callable
 from dataclasses import replace
@@ -16,24 +17,22 @@ import anyio
 from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
 from otonav.limits import check_scale
-from otonav.runtime import Actor, ActorCrashedError, RealTimeClock
-from otonav.runtime.clock import MAX_STEP_BATCH
+from otonav.record.outlock import lock_output
+from otonav.runtime import Actor, RealTimeClock
 from otonav.runtime.timesource import tick_rate
 from otonav.scenario.config import ScenarioConfig
-from otonav.scenario.crash import RunCrashedError, crash_reason
 from otonav.scenario.judge import Judge
 from otonav.scenario.run import (
+    JudgedRun,
     Verdict,
     drive,
-    judge_verdict,
-    robot_summary,
+    judged_run,
     run_task,
-    save_artifacts,
     scenario_session,
     scenario_world,
 )
 from otonav.stack import StackConfig
-from otonav.stack.session import RealTime, StackSession
+from otonav.stack.session import StackSession
 
 __all__ = ["VIEWER_HZ", "run_scenario_realtime"]
 
@@ -42,9 +41,6 @@ VIEWER_HZ = 60.0
 
 HOLD_POLL_S = 0.05
 """Wall seconds between looks at whether the user closed the held window."""
-
-"""Most sim seconds stepped at once: a machine slower than the scale makes sim time slip
-behind the wall clock (the verdict's RTF shows it) rather than step in bursts."""
 
 
 async def _show(
@@ -100,10 +96,12 @@ def run_scenario_realtime(
     extra_actors: tuple[Actor, ...] = (),
     hold: Callable[[Verdict], None] | None = None,
     loop_factory: Callable[[], asyncio.AbstractEventLoop] | None = None,
+    source: str = "scenario",
+    progress: Callable[[Judge, float], None] | None = None,
 ) -> Verdict:
-    """Run ``scenario`` with sim time following the wall clock times ``scale`` and judge
-    it, like :func:`~otonav.scenario.run.run_scenario` (same artifacts in ``out_dir``,
-    recording finished on every exit path).
+    """:func:`~otonav.scenario.run.run_scenario` with ``realtime=scale`` (and ``gui``,
+    ``hold``), which is how to ask for it: sim time follows the wall clock times
+    ``scale``; the same world, judge, artifacts and endings (:func:`judged_run`).
 
     ``gui=True`` shows the run in MuJoCo's viewer: the display is checked before
     anything is built (:class:`~otonav.hal.viewer.NoDisplayError`, one line, when there
@@ -122,56 +120,45 @@ def run_scenario_realtime(
         raise ValueError(problem)
     if gui:
         check_display()
-    scenario, stack, hal = scenario_world(scenario, stack)
-    judge = Judge(hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance)
-    session = scenario_session(
-        scenario,
-        stack,
-        hal,
-        judge,
-        realtime=RealTime(scale, MAX_STEP_BATCH),
-        extra_actors=extra_actors,
-        recording=out_dir / "recording.mcap" if out_dir and record else None,
-    )
-    viewer: ViewerHandle | None = None
-    if gui:
-        try:
-            # Over CAN the world is the interface's sensor source: view that.
-            world = hal if isinstance(hal, MujocoInterface) else getattr(hal, "sensors", None)
-            if not isinstance(world, MujocoInterface):
-                raise TypeError(f"gui=True needs the MuJoCo world, got {type(hal).__name__}")
-            viewer = world.open_viewer()
-        except BaseException:
-            session.close()
-            raise
-        session.add_cleanup(viewer.close)  # after the recording, before the world
-        if hold is not None:  # cleanups run last added first: before the window closes
-            shown = viewer
-            session.add_cleanup(lambda: _hold(shown, held, hold))
-    held: list[Verdict] = []
-    closed_at: list[float] = []
-    wall_start = time.perf_counter()
-    ended = "completed"
-    crash: ActorCrashedError | None = None
-    try:
-        with asyncio.Runner(loop_factory=loop_factory) as runner:
-            runner.run(_main(scenario, session, judge, viewer, closed_at, on_start))
-    except ActorCrashedError as exc:  # a verdict still, raised with it (as run_scenario)
-        crash, ended = exc, f"ActorCrashedError: {crash_reason(exc)}"
-    except BaseException as exc:
-        sim = hal.ticks / tick_rate(hal.tick)
-        ended = f"{type(exc).__name__} at sim time {sim:.3f} s: {exc}".strip().rstrip(":")
-        raise
-    finally:
-        wall = time.perf_counter() - wall_start
-        sim_time = hal.ticks / tick_rate(hal.tick)
-        try:
-            verdict = judge_verdict(
-                scenario, judge, sim_time, wall, robot=robot_summary(stack, hal)
-            )
-            if ended != "completed":
-                verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
-            elif closed_at and not judge.reached:
+    # one run per out_dir (issue 27): a second is refused before it touches a file
+    with lock_output(out_dir) if out_dir is not None else contextlib.nullcontext():
+        scenario, stack, hal = scenario_world(scenario, stack, source=source)
+        judge = Judge(
+            hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance, progress=progress
+        )
+        session = scenario_session(
+            scenario,
+            stack,
+            hal,
+            judge,
+            realtime=scale,
+            extra_actors=extra_actors,
+            recording=out_dir / "recording.mcap" if out_dir and record else None,
+        )
+        viewer: ViewerHandle | None = None
+        held: list[Verdict] = []
+        if gui:
+            try:
+                # Over CAN the world is the interface's sensor source: view that.
+                world = hal if isinstance(hal, MujocoInterface) else getattr(hal, "sensors", None)
+                if not isinstance(world, MujocoInterface):
+                    raise TypeError(f"gui=True needs the MuJoCo world, got {type(hal).__name__}")
+                viewer = world.open_viewer()
+            except BaseException:
+                session.close()
+                raise
+            session.add_cleanup(viewer.close)  # after the recording, before the world
+            if hold is not None:  # cleanups run last added first: before the window closes
+                shown = viewer
+                session.add_cleanup(lambda: _hold(shown, held, hold))
+        closed_at: list[float] = []
+
+        def run() -> None:
+            with asyncio.Runner(loop_factory=loop_factory) as runner:
+                runner.run(_main(scenario, session, judge, viewer, closed_at, on_start))
+
+        def amend(verdict: Verdict) -> Verdict:
+            if closed_at and not judge.reached:
                 verdict = replace(
                     verdict,
                     passed=False,
@@ -180,11 +167,12 @@ def run_scenario_realtime(
                         f"({judge.distance:.3f} m from the goal)"
                     ),
                 )
-            if ended == "completed":
-                held.append(verdict)
-            verdict = save_artifacts(verdict, scenario, stack, judge, session, out_dir, plot)
-        finally:
-            session.close()  # idempotent: the viewer, then the world, on every path
-    if crash is not None:
-        raise RunCrashedError(crash, verdict) from crash.__cause__
-    return verdict
+            held.append(verdict)  # the run completed: what a held window shows
+            return verdict
+
+        return judged_run(
+            JudgedRun(scenario, stack, hal, judge, session, out_dir, plot),
+            run,
+            lambda: hal.ticks / tick_rate(hal.tick),
+            amend=amend,
+        )

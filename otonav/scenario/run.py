@@ -35,6 +35,7 @@ from otonav.runtime import (
     until,
     virtual_loop_factory,
 )
+from otonav.runtime._asyncio_compat import preload_anyio_backend
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.crash import RunCrashedError, crash_reason
 from otonav.scenario.judge import Judge
@@ -42,15 +43,23 @@ from otonav.scenario.plot import plot_trajectory
 from otonav.scenario.validate import check_cost, check_goal
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.robot import describe_robot
-from otonav.stack.session import RealTime, StackSession
+from otonav.stack.session import StackSession
 
 VERDICT_TOPIC = "/scenario/verdict"
 RUN_METADATA = "otonav"
-LAZY_IMPORTS = ("anyio._backends._asyncio", "numpy.ma")
-"""Modules a process's first run would otherwise import inside its timed span: anyio's
-asyncio backend (when the loop starts) and numpy.ma (numpy imports it at the first
-``np.unique``, in the navigator's map). 25-110 ms on this machine: imports, not the run,
-so they load before the summary's wall clock starts (ADR 0027)."""
+LAZY_IMPORTS = ("numpy.ma",)
+"""Modules a process's first run would otherwise import inside its timed span, with
+anyio's asyncio backend (when the loop starts; :func:`preload_lazy_imports`): numpy.ma
+(numpy imports it at the first ``np.unique``, in the navigator's map). 25-110 ms on this
+machine: imports, not the run, so they load before the summary's wall clock starts (ADR
+0027)."""
+
+
+def preload_lazy_imports() -> None:
+    """Import :data:`LAZY_IMPORTS` and anyio's asyncio backend now."""
+    preload_anyio_backend()
+    for module in LAZY_IMPORTS:
+        importlib.import_module(module)
 
 
 @dataclass(frozen=True, slots=True)
@@ -183,11 +192,12 @@ def scenario_session(
     judge: Judge,
     *,
     extra_actors: tuple[Actor, ...] = (),
-    realtime: RealTime | None = None,
+    realtime: float | None = None,
     recording: Path | None = None,
 ) -> StackSession:
     """The session of a scenario run: the recorder (with ``recording``), the extra
-    actors, the robot stack starting at the scenario's start pose, and the judge."""
+    actors, the robot stack starting at the scenario's start pose, and the judge;
+    ``realtime``: the scale of a real-time run (None: virtual time)."""
     try:
         robot = build_actors(stack, hal, initial_pose=scenario.start.as_tuple())
     except BaseException:
@@ -288,6 +298,9 @@ def run_scenario(
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
     source: str = "scenario",
     progress: Callable[[Judge, float], None] | None = None,
+    realtime: float | None = None,
+    gui: bool = False,
+    hold: Callable[[Verdict], None] | None = None,
 ) -> Verdict:
     """Run ``scenario`` headless in virtual time and judge it. With ``out_dir``, leave
     ``recording.mcap`` (unless ``record=False``) and ``trajectory.png`` there. The
@@ -300,7 +313,32 @@ def run_scenario(
     Another run writing to ``out_dir`` raises :class:`~otonav.record.outlock.OutputBusyError`
     before anything is touched. An actor's crash raises
     :class:`~otonav.scenario.crash.RunCrashedError` once the artifacts are written: an
-    ``ActorCrashedError`` carrying the failed verdict."""
+    ``ActorCrashedError`` carrying the failed verdict.
+
+    ``realtime=scale`` paces sim time to the wall clock times ``scale`` instead (the same
+    actors, judge and artifacts; ``wall_ceiling`` does not apply); ``gui=True`` (real
+    time, scale 1 unless given) shows the run in MuJoCo's viewer, and ``hold(verdict)``
+    keeps its window open at the end: see
+    :func:`~otonav.scenario.realtime.run_scenario_realtime`."""
+    if realtime is not None or gui:
+        from otonav.scenario.realtime import run_scenario_realtime
+
+        return run_scenario_realtime(
+            scenario,
+            stack,
+            out_dir=out_dir,
+            record=record,
+            plot=plot,
+            scale=1.0 if realtime is None else realtime,
+            gui=gui,
+            on_start=on_start,
+            extra_actors=tuple(extra_actors),
+            hold=hold,
+            source=source,
+            progress=progress,
+        )
+    if hold is not None:
+        raise ValueError("run_scenario: hold= needs gui=True (it keeps the viewer open)")
     with lock_output(out_dir) if out_dir is not None else contextlib.nullcontext():
         # one run per out_dir (issue 27): a second is refused before it touches a file
         scenario, stack, hal = scenario_world(scenario, stack, source=source)
@@ -315,42 +353,88 @@ def run_scenario(
             extra_actors=tuple(extra_actors),
             recording=out_dir / "recording.mcap" if out_dir and record else None,
         )
-        for module in LAZY_IMPORTS:
-            importlib.import_module(module)
-        wall_start = time.perf_counter()
-        sim_time = 0.0
-        ended = "completed"
-        crash: ActorCrashedError | None = None
-        try:
+        preload_lazy_imports()
+        sim_time = [0.0]
+
+        def run() -> None:
             # The session makes the world the loop's time source when the run starts.
             factory = virtual_loop_factory(wall_ceiling=wall_ceiling)
             with asyncio.Runner(loop_factory=factory) as runner:
                 try:
                     runner.run(_main(scenario, session, judge, on_start))
                 finally:
-                    sim_time = runner.get_loop().time()
-        except ActorCrashedError as exc:  # a verdict still (below), raised with it
-            crash, ended = exc, f"ActorCrashedError: {crash_reason(exc)}"
-        except BaseException as exc:
-            ended = f"{type(exc).__name__} at sim time {sim_time:.3f} s: {exc}".strip().rstrip(":")
-            raise
+                    sim_time[0] = runner.get_loop().time()
+
+        return judged_run(
+            JudgedRun(scenario, stack, hal, judge, session, out_dir, plot),
+            run,
+            lambda: sim_time[0],
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class JudgedRun:
+    """What a judged run is made of, for :func:`judged_run`."""
+
+    scenario: ScenarioConfig
+    stack: StackConfig
+    hal: RobotHardwareInterface
+    judge: Judge
+    session: StackSession
+    out_dir: Path | None
+    plot: bool
+
+
+def judged_run(
+    parts: JudgedRun,
+    run: Callable[[], None],
+    sim_time: Callable[[], float],
+    *,
+    amend: Callable[[Verdict], Verdict] | None = None,
+) -> Verdict:
+    """``run()`` the scenario, then judge it and tear it down, whatever ended it: the
+    verdict (failed with "run ended early (...)" if ``run`` raised; ``amend(verdict)``
+    may change one that completed), appended to the recording, the plot drawn, the
+    session closed. An actor's crash raises :class:`RunCrashedError` carrying the
+    verdict, once the artifacts are written; any other exception propagates after them.
+    ``sim_time()`` is the run's sim time (after ``run`` returned or raised). The one
+    ending of every judged runner (virtual and real time)."""
+    scenario, stack, hal, judge, session = (
+        parts.scenario,
+        parts.stack,
+        parts.hal,
+        parts.judge,
+        parts.session,
+    )
+    wall_start = time.perf_counter()
+    ended = "completed"
+    crash: ActorCrashedError | None = None
+    try:
+        run()
+    except ActorCrashedError as exc:  # a verdict still (below), raised with it
+        crash, ended = exc, f"ActorCrashedError: {crash_reason(exc)}"
+    except BaseException as exc:
+        ended = f"{type(exc).__name__} at sim time {sim_time():.3f} s: {exc}"
+        ended = ended.strip().rstrip(":")
+        raise
+    finally:
+        wall = time.perf_counter() - wall_start
+        try:
+            verdict = judge_verdict(
+                scenario, judge, sim_time(), wall, robot=robot_summary(stack, hal)
+            )
+            if ended != "completed":
+                verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
+            elif amend is not None:
+                verdict = amend(verdict)
+            verdict = save_artifacts(
+                verdict, scenario, stack, judge, session, parts.out_dir, parts.plot
+            )
         finally:
-            try:
-                verdict = judge_verdict(
-                    scenario,
-                    judge,
-                    sim_time,
-                    time.perf_counter() - wall_start,
-                    robot=robot_summary(stack, hal),
-                )
-                if ended != "completed":
-                    verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")
-                verdict = save_artifacts(verdict, scenario, stack, judge, session, out_dir, plot)
-            finally:
-                session.close()  # idempotent: reached even if the verdict or plot failed
-        if crash is not None:
-            raise RunCrashedError(crash, verdict) from crash.__cause__
-        return verdict
+            session.close()  # idempotent: reached even if the verdict or plot failed
+    if crash is not None:
+        raise RunCrashedError(crash, verdict) from crash.__cause__
+    return verdict
 
 
 TITLE_REASON_WIDTH = 64

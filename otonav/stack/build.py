@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+import warnings
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -148,8 +149,12 @@ def build_actors(
     goal: tuple[float, float] | None = None,
     initial_pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
 ) -> list[Actor]:
-    """bridge + base controller (+ navigator) for ``hal``. ``initial_pose`` is where
-    odometry starts (the known start pose: odom is then the world frame)."""
+    """bridge + base controller, the planner ``nav.planner`` names and the safety layer
+    (``safety.enabled``) for ``hal``. ``initial_pose`` is where odometry starts (the known
+    start pose: odom is then the world frame). ``navigator=False``: deprecated spelling
+    of ``nav.planner: external`` (the safety layer stays; ADR 0055)."""
+    if not navigator:
+        config, navigator = external_planner(config), True
     geometry = hal.geometry
     rates, base, nav, guard = config.rates, robot_base(config), config.nav, config.guard
     actors: list[Actor] = [
@@ -221,6 +226,18 @@ def build_actors(
             topic = topics.CMD_VEL_NAV if config.safety.enabled else topics.CMD_VEL
             actors.append(CommandWatch(topic, within=EXTERNAL_COMMAND_WAIT))
     return launch(actors, config.actors)
+
+
+def external_planner(config: StackConfig) -> StackConfig:
+    """``config`` with ``nav.planner: external`` (what ``navigator=False`` means), with a
+    DeprecationWarning for that spelling."""
+    warnings.warn(
+        "navigator=False is deprecated: set nav.planner: external in the stack config (the "
+        "safety layer stays unless safety.enabled: false)",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+    return config.model_copy(update={"nav": config.nav.model_copy(update={"planner": "external"})})
 
 
 def navigation_params(config: StackConfig, geometry: RobotGeometry) -> NavigationParams:

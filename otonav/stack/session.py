@@ -19,15 +19,16 @@ ends the run (ADR 0007):
 
 Each step runs even if an earlier one raised. Time mode: ``realtime=None`` is virtual
 time (the world is the running :class:`~otonav.runtime.VirtualTimeLoop`'s time
-source); :class:`RealTime` (or a ready :class:`~otonav.runtime.RealTimeClock`) paces
-the world to the wall clock on any loop, with a pacer task stepping it in small batches
-while every actor sleeps.
+source); a :class:`~otonav.runtime.RealTimeClock` of the world paces it to the wall clock
+on any loop, with a pacer task stepping it in small batches while every actor sleeps.
+(:class:`RealTime`, which made that clock, is deprecated: ADR 0055.)
 """
 
 from __future__ import annotations
 
 import asyncio
 import contextlib
+import warnings
 from collections.abc import AsyncIterator, Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,12 +47,19 @@ __all__ = ("RealTime", "StackSession")
 
 @dataclass(frozen=True, slots=True)
 class RealTime:
-    """Real-time mode: sim time follows the wall clock times ``scale``; one advance
-    steps at most ``max_step_batch`` s of sim time (beyond that, sim time slips: see
-    :class:`~otonav.runtime.RealTimeClock`)."""
+    """Deprecated (ADR 0055): pass ``realtime=RealTimeClock(hal, scale=...)``, the same
+    clock with the same ``max_step_batch`` default. Constructing one warns."""
 
     scale: float = 1.0
     max_step_batch: float = MAX_STEP_BATCH
+
+    def __post_init__(self) -> None:
+        warnings.warn(
+            "otonav.stack.RealTime is deprecated: pass realtime=RealTimeClock(hal, scale=...) "
+            "(otonav.runtime) to StackSession",
+            DeprecationWarning,
+            stacklevel=3,
+        )
 
     def clock(self, source: TimeSource) -> RealTimeClock:
         return RealTimeClock(source, scale=self.scale, max_step_batch=self.max_step_batch)
@@ -65,6 +73,11 @@ class StackSession:
     Use ``async with session.running() as system:`` (tears down on exit), or
     ``session.running(close=False)`` followed by :meth:`close` when something must be
     appended to the recording after the run (a scenario's verdict).
+
+    Time: ``realtime=None`` is virtual time; ``realtime=scale`` (a number) paces the
+    world to the wall clock times ``scale`` with a :class:`~otonav.runtime.RealTimeClock`
+    the session makes (``max_step_batch`` per advance at most); a ready
+    ``RealTimeClock`` of ``hal`` is taken as it is.
     """
 
     def __init__(
@@ -72,9 +85,10 @@ class StackSession:
         hal: RobotHardwareInterface,
         actors: Sequence[Actor],
         *,
-        realtime: RealTime | RealTimeClock | None = None,
+        realtime: float | RealTimeClock | RealTime | None = None,
         record_to: Path | RecordingWriter | None = None,
         restart: RestartPolicy | Mapping[str, RestartPolicy] | None = None,
+        max_step_batch: float | None = MAX_STEP_BATCH,
     ) -> None:
         self.hal = hal
         self.writer: RecordingWriter | None = None
@@ -86,6 +100,8 @@ class StackSession:
         try:
             if isinstance(realtime, RealTime):
                 realtime = realtime.clock(hal)
+            elif isinstance(realtime, int | float):
+                realtime = RealTimeClock(hal, scale=realtime, max_step_batch=max_step_batch)
             self.realtime_clock: RealTimeClock | None = realtime
             if record_to is not None:
                 # A path, or a writer of the caller's (e.g. a RotatingRecordingWriter)
@@ -158,7 +174,8 @@ class StackSession:
             raise RuntimeError(
                 "a stack in virtual time needs a running VirtualTimeLoop (a test marked "
                 "@pytest.mark.sim, or asyncio.Runner(loop_factory=virtual_loop_factory())); "
-                "for real-time mode on this loop, ask for it (realtime_scale= / RealTime())"
+                "for real-time mode on this loop, ask for it (realtime_scale= / "
+                "RealTimeClock(hal))"
             )
         if loop.source is not self.hal:
             self._loop, self._previous_source = loop, loop.source
@@ -174,7 +191,7 @@ class StackSession:
 
     def drain(self) -> None:
         """Write everything the recorder's funnel still holds (no-op without one)."""
-        if self.recorder is not None and self.recorder._funnel is not None:
+        if self.recorder is not None and self.recorder.wired:
             self.recorder.drain()
 
     def close(self, *, epilogue: Callable[[RecordingWriter], None] | None = None) -> None:

@@ -11,7 +11,7 @@ from otonav.hal import BoxObstacle, RobotHardwareInterface
 from otonav.runtime import Actor, System
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.loading import load_stack_file
-from otonav.stack.session import RealTime, StackSession
+from otonav.stack.session import StackSession
 
 
 @dataclass(slots=True)
@@ -32,7 +32,9 @@ async def running_stack(
     realtime_scale: float | None = None,
     record_to: Path | None = None,
 ) -> AsyncIterator[RunningStack]:
-    """Bring up world + bridge + base (+ navigator) for the body of an ``async with``.
+    """Bring up the stack ``config`` launches (world, bridge, base, the planner
+    ``nav.planner`` names, the safety layer unless ``safety.enabled: false``, its
+    ``actors``) for the body of an ``async with``.
 
     On a :class:`VirtualTimeLoop` (``@pytest.mark.sim``) the world becomes the loop's time
     source: sim time is loop time. With ``realtime_scale`` set, the stack runs on the
@@ -42,7 +44,11 @@ async def running_stack(
     the loop gets its previous time source back, so the test can go on sleeping.
 
     ``config`` is a :class:`StackConfig` or the path of a stack config file: the same
-    file ``otonav run --config`` takes, with its robot and its ``actors``.
+    file ``otonav run --config`` takes, with its robot and its ``actors``. To drive the
+    robot yourself, say so there: ``nav.planner: external`` (your node publishes
+    /cmd_vel_nav, behind the safety layer), plus ``safety.enabled: false`` to publish
+    /cmd_vel straight to the base. ``navigator=False`` is the deprecated spelling of
+    ``nav.planner: external`` (ADR 0055).
     """
     if not isinstance(config, StackConfig):
         config = load_stack_file(config)
@@ -55,7 +61,7 @@ async def running_stack(
     session = StackSession(
         hal,
         actors,
-        realtime=RealTime(realtime_scale) if realtime_scale is not None else None,
+        realtime=realtime_scale,
         record_to=record_to,
     )
     async with session.running() as system:

@@ -33,10 +33,10 @@ pytestmark = pytest.mark.smoke
 REPO = Path(__file__).resolve().parents[2]
 APP = REPO / "examples" / "service" / "app.py"
 START_CEILING_S = 30.0
-# Not a speed target (those live in benchmarks, PROTOCOL): the failure this catches is a
-# simulation on the host's loop, which holds every request for seconds. A 50 ms budget
-# failed at load average 11 on 2 cores (p90 56-58 ms) with nothing wrong.
-HEALTH_BUDGET_S = 0.5
+# The probes' latency is a figure, printed here and measured by benchmarks/embed_bench.py;
+# a timed assertion (p90 < 50 ms, then < 0.5 s) failed on a loaded machine (load average
+# 11 on 2 cores: p90 56-58 ms) with nothing wrong. What is asserted is in sim time.
+PROBES = 25
 # Reaches no goal (the navigator stops 8 cm short of a 1 mm tolerance): it runs until
 # cancelled or its sim budget (minutes of sim time) is spent.
 ENDLESS: dict[str, Any] = {
@@ -127,32 +127,39 @@ def _wait_status(client: httpx.Client, run_id: str, until: Any, within: float) -
 
 
 def test_health_answers_while_simulations_run(client: httpx.Client) -> None:
+    """Every probe is answered while both simulations run, and the answers come at many
+    instants of the simulations' sim time: the service serves between their steps (a
+    simulation on its loop would hold every request until it ended or the client's
+    timeout, a hang ceiling, gave up)."""
     runs = [_start(client, {"scenario": ENDLESS}) for _ in range(2)]
     for run_id in runs:
         _wait_status(client, run_id, lambda r: r["status"] == "running", within=10)
     first = [client.get(f"/runs/{r}").json()["sim_time_s"] for r in runs]
     latencies = []
+    sim_at_answer: list[float] = []
     with httpx.Client(base_url=client.base_url, timeout=5.0) as probe:
-        for _ in range(25):
+        for _ in range(PROBES):
             start = time.perf_counter()
             response = probe.get("/health")
             latencies.append(time.perf_counter() - start)
             assert response.status_code == 200
             assert response.json()["runs_active"] == 2
+            sim_at_answer.append(probe.get(f"/runs/{runs[0]}").json()["sim_time_s"])
     # Both simulations were running through every probe (and made progress).
     after = [client.get(f"/runs/{r}").json() for r in runs]
     assert all(r["status"] == "running" for r in after)
     assert all(a["sim_time_s"] > f for a, f in zip(after, first, strict=True))
     for run_id in runs:
         assert client.delete(f"/runs/{run_id}").json()["status"] == "cancelled"
+    assert sim_at_answer == sorted(sim_at_answer)
+    assert len(set(sim_at_answer)) >= 5, f"answered at sim instants {sim_at_answer} only"
     latencies.sort()
-    p90 = latencies[int(0.9 * (len(latencies) - 1))]
     print(
         f"\n/health during 2 simulations + the live robot: median "
-        f"{statistics.median(latencies) * 1e3:.1f} ms, p90 {p90 * 1e3:.1f} ms, "
-        f"max {latencies[-1] * 1e3:.1f} ms over {len(latencies)} probes"
+        f"{statistics.median(latencies) * 1e3:.1f} ms, "
+        f"p90 {latencies[int(0.9 * (len(latencies) - 1))] * 1e3:.1f} ms, "
+        f"max {latencies[-1] * 1e3:.1f} ms over {len(latencies)} probes (a figure, not a test)"
     )
-    assert p90 < HEALTH_BUDGET_S
 
 
 def test_cancelled_run_leaves_an_indexed_recording(client: httpx.Client) -> None:

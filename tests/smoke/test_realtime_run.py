@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 
 import pytest
 
+from otonav.record.outlock import OutputBusyError, lock_output
+from otonav.scenario import run_scenario
 from otonav.scenario.builtin import BUILTIN
 from otonav.scenario.realtime import run_scenario_realtime
 
@@ -15,7 +18,8 @@ SCALE = 10.0  # the "empty" scenario takes ~8.5 s of sim time: ~0.85 s of wall t
 
 
 def test_realtime_run_reaches_the_goal_paced_to_the_scaled_wall_clock(tmp_path: Path) -> None:
-    verdict = run_scenario_realtime(BUILTIN["empty"], out_dir=tmp_path, scale=SCALE)
+    # One entry point for a judged run: real time is a mode of run_scenario (ADR 0055).
+    verdict = run_scenario(BUILTIN["empty"], out_dir=tmp_path, realtime=SCALE)
 
     assert verdict.passed, verdict.reason
     assert verdict.reached
@@ -37,3 +41,30 @@ def test_realtime_run_reaches_the_goal_paced_to_the_scaled_wall_clock(tmp_path: 
 def test_realtime_run_rejects_a_scale_it_cannot_honour(scale: float) -> None:
     with pytest.raises(ValueError, match=r"scale .*must be a number in \[0.01, 100\]"):
         run_scenario_realtime(BUILTIN["empty"], scale=scale, record=False, plot=False)
+
+
+def test_a_realtime_run_refuses_an_out_dir_another_run_writes_to(tmp_path: Path) -> None:
+    """The same ending and guards as a virtual-time run: one run per out_dir."""
+    out = tmp_path / "run"
+    entered, release = threading.Event(), threading.Event()
+
+    def other_run() -> None:
+        with lock_output(out):
+            entered.set()
+            release.wait(30)
+
+    thread = threading.Thread(target=other_run)
+    thread.start()
+    try:
+        assert entered.wait(30)
+        with pytest.raises(OutputBusyError, match="another otonav"):
+            run_scenario(BUILTIN["empty"], out_dir=out, realtime=SCALE)
+    finally:
+        release.set()
+        thread.join()
+    assert list(out.iterdir()) == []
+
+
+def test_hold_without_the_viewer_is_refused() -> None:
+    with pytest.raises(ValueError, match="hold= needs gui=True"):
+        run_scenario(BUILTIN["empty"], record=False, plot=False, hold=print)

@@ -12,9 +12,16 @@ import pytest
 from otonav.actors import topics
 from otonav.msgs import Clock, Imu, LaserScan, Odometry, Twist
 from otonav.runtime import Subscription, until
+from otonav.stack import StackConfig
 from otonav.testing import running_stack
 
 pytestmark = pytest.mark.smoke
+
+#: The robot driven straight through /cmd_vel: no planner, no safety layer, said in the
+#: config (``navigator=False`` meant this until ADR 0055; it now keeps the safety layer).
+BASE_ONLY = StackConfig.model_validate(
+    {"nav": {"planner": "external"}, "safety": {"enabled": False}}
+)
 
 SENSORS: dict[str, type[Any]] = {
     topics.CLOCK: Clock,
@@ -27,7 +34,7 @@ SENSORS: dict[str, type[Any]] = {
 async def _drive_and_watch(realtime_scale: float | None, within: float) -> dict[str, int]:
     counts = dict.fromkeys(SENSORS, 0)
     last_odom: list[Odometry] = []
-    async with running_stack(navigator=False, realtime_scale=realtime_scale) as stack:
+    async with running_stack(BASE_ONLY, realtime_scale=realtime_scale) as stack:
         system = stack.system
         start_x = stack.hal.ground_truth().x
         subs: dict[str, Subscription[Any]] = {

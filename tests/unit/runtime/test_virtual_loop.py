@@ -228,27 +228,3 @@ def test_one_instant_runs_callbacks_in_stock_asyncio_order(debug: bool) -> None:
     virtual = trace(VirtualTimeLoop())
     assert "never" not in stock
     assert virtual == stock
-
-
-def test_a_timer_handle_built_inline_is_asyncios_own() -> None:
-    """_FifoTimerHandle sets asyncio's Handle/TimerHandle attributes itself (no debug
-    mode): the same values as asyncio's __init__ gives, for every slot."""
-    import contextvars
-
-    from otonav.runtime.loop import _INLINE_INIT, _FifoTimerHandle
-
-    assert _INLINE_INIT  # the CPython the tests run on: the inline path is the one used
-    loop = VirtualTimeLoop()
-    try:
-        context = contextvars.copy_context()
-        inline = _FifoTimerHandle(2.5, print, ("x",), loop, context, 7)
-        stock = asyncio.TimerHandle(2.5, print, ("x",), loop, context)
-        slots = {*asyncio.Handle.__slots__, *asyncio.TimerHandle.__slots__} - {"__weakref__"}
-        assert {s: getattr(inline, s) for s in slots} == {s: getattr(stock, s) for s in slots}
-        assert inline._seq == 7
-        # Without a context, each gets a copy of the current one, as asyncio does.
-        fresh = _FifoTimerHandle(1.0, print, (), loop, None, 8)
-        assert isinstance(fresh._context, contextvars.Context)
-        assert fresh._context is not context
-    finally:
-        loop.close()

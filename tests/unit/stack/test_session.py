@@ -16,12 +16,19 @@ from otonav.hal.fake import FakeHardware
 from otonav.msgs import Point, Pose, PoseStamped
 from otonav.record.reader import read_messages
 from otonav.runtime import Actor, JumpSource, Output, VirtualTimeLoop, virtual_loop_factory
+from otonav.stack import StackConfig
 from otonav.stack.session import StackSession
 from otonav.testing import running_stack
 
 pytestmark = pytest.mark.unit
 
 LAST_WORDS = "/last_words"
+
+#: The robot driven straight through /cmd_vel: no planner, no safety layer, said in the
+#: config (``navigator=False`` meant this until ADR 0055; it now keeps the safety layer).
+BASE_ONLY = StackConfig.model_validate(
+    {"nav": {"planner": "external"}, "safety": {"enabled": False}}
+)
 
 
 class LastWords(Actor):
@@ -44,15 +51,15 @@ Runner = Callable[[Path, Actor], AbstractAsyncContextManager[object]]
 
 
 def _virtual(path: Path, actor: Actor) -> AbstractAsyncContextManager[object]:
-    return running_stack(navigator=False, record_to=path, extra_actors=[actor])
+    return running_stack(BASE_ONLY, record_to=path, extra_actors=[actor])
 
 
 def _realtime(path: Path, actor: Actor) -> AbstractAsyncContextManager[object]:
-    return running_stack(navigator=False, record_to=path, extra_actors=[actor], realtime_scale=20)
+    return running_stack(BASE_ONLY, record_to=path, extra_actors=[actor], realtime_scale=20)
 
 
 def _live(path: Path, actor: Actor) -> AbstractAsyncContextManager[object]:
-    return open_live_stack(navigator=False, record_to=path, extra_actors=[actor], scale=20)
+    return open_live_stack(BASE_ONLY, record_to=path, extra_actors=[actor], scale=20)
 
 
 async def _run_stack(runner: Runner, path: Path) -> None:
@@ -78,7 +85,7 @@ def test_the_recording_ends_with_every_stop_in_reverse_start_order(
     recorded = list(read_messages(path, [LAST_WORDS, "/rosout"]))
     assert [t for t, _s, _m in recorded].count(LAST_WORDS) == 1
     stops = [m.name for t, _s, m in recorded if t == "/rosout" and m.msg == "stopped"]
-    assert stops == ["last_words", "base", "bridge", "recorder"]
+    assert stops == ["last_words", "command_watch", "base", "bridge", "recorder"]
     # The last words came after the robot actors had begun stopping, before the recorder.
     topics = [t if t == LAST_WORDS else m.msg for t, _s, m in recorded]
     assert topics.index(LAST_WORDS) < len(topics) - 1
@@ -91,7 +98,7 @@ async def test_running_stack_gives_the_loop_its_time_source_back() -> None:
     loop = asyncio.get_running_loop()
     assert isinstance(loop, VirtualTimeLoop)
     before = loop.source
-    async with running_stack(navigator=False) as stack:
+    async with running_stack(BASE_ONLY) as stack:
         assert loop.source is stack.hal
         await stack.system.clock.sleep(0.1)
     assert loop.source is before
