@@ -208,6 +208,7 @@ PINNED: dict[str, tuple[str, ...]] = {
         "JumpSource",
         "LATCHED_QOS",
         "LoopHeldError",
+        "MAX_STEP_BATCH",
         "MailboxStatistics",
         "OtonavRuntimeError",
         "Output",
