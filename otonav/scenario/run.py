@@ -495,6 +495,14 @@ def judge_verdict(
                 f"the navigator did not report the goal unreachable within "
                 f"{scenario.sim_budget:g} s (last state: {judge.nav_state})"
             )
+    if judge.hardware_fault is not None and not judge.reached:
+        outcome = False
+        reasons[:] = [judge.hardware_fault]
+    elif not outcome and (health := judge.hal.health()).faulted:
+        # A fault that outlasted the run (e.g. encoder data late the whole time).
+        reasons.append(
+            f"hardware fault since {health.since:.2f} s: {health.fault}: {health.message}"
+        )
     if not clear:
         reasons.append(
             f"came {judge.min_clearance:.3f} m from an obstacle "
