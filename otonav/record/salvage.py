@@ -53,7 +53,10 @@ def salvage(
         try:
             header = NonSeekingReader(f).get_header()
         except CUT_OFF_ERRORS as exc:
-            raise RecordingError(f"{source}: no readable MCAP header ({exc})") from None
+            raise RecordingError(
+                f"{source}: no readable MCAP header after the magic ({source.stat().st_size} "
+                "bytes): not a recording, nothing to salvage"
+            ) from None
     damage: list[Damage] = [] if damaged is None else damaged
     try:
         count = _copy(source, target, header.profile, header.library, damage)
