@@ -52,7 +52,7 @@ def salvage(
     with source.open("rb") as f:
         try:
             header = NonSeekingReader(f).get_header()
-        except CUT_OFF_ERRORS as exc:
+        except CUT_OFF_ERRORS:
             raise RecordingError(
                 f"{source}: no readable MCAP header after the magic ({source.stat().st_size} "
                 "bytes): not a recording, nothing to salvage"
