@@ -192,3 +192,27 @@ def test_recovery_given_up_ends_the_run_with_the_fault_as_its_reason(tmp_path: P
     ]
     assert statuses[-1].level >= ERROR
     assert "gave up" in statuses[-1].message
+
+
+def test_half_a_second_of_bus_delay_is_one_fault_not_a_recovery_a_second(
+    tmp_path: Path,
+) -> None:
+    # The first case: 0.5 s of delay faulted and "recovered" 17 times in 17 s,
+    # each time "attempt 1". Now the late encoder data is a fault for the whole run.
+    config = apply_overrides(CAN, ["hal.sim.faults.delay.delay=0.5"])
+    verdict = run_scenario(ScenarioConfig(), config, out_dir=tmp_path, plot=False)
+    recording = tmp_path / "recording.mcap"
+    status = [m for _topic, _t, m in read_messages(recording, [topics.HARDWARE_STATUS])]
+    # The drives start late (startup_timeout, one recovery); then the first stale
+    # encoder estimate is a fault that lasts: no recovery after it.
+    stale_at = [i for i, m in enumerate(status) if m.fault == "encoder_stale"]
+    assert stale_at, [(m.fault, m.message) for m in status]
+    stale = stale_at[0]
+    assert [m.fault for m in status[:stale] if m.level >= ERROR] == ["startup_timeout"]
+    after = status[stale:]
+    assert not any(m.ready for m in after), [m.message for m in after]
+    assert all(m.fault == "encoder_stale" for m in after)
+    assert not verdict.passed
+    assert verdict.path_length_m < 0.05  # it never drove on the late data
+    assert "hardware fault since " in verdict.reason
+    assert "encoder_stale" in verdict.reason
