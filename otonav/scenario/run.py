@@ -301,7 +301,9 @@ def run_scenario(
     Another run writing to ``out_dir`` raises :class:`~otonav.record.outlock.OutputBusyError`
     before anything is touched. An actor's crash raises
     :class:`~otonav.scenario.crash.RunCrashedError` once the artifacts are written: an
-    ``ActorCrashedError`` carrying the failed verdict."""
+    ``ActorCrashedError`` carrying the failed verdict. A full disk stops the run and
+    raises :class:`~otonav.record.diskfull.DiskFullError` naming the file, once the
+    recording is closed (readable) and the world too."""
     with lock_output(out_dir) if out_dir is not None else contextlib.nullcontext():
         # one run per out_dir (issue 27): a second is refused before it touches a file
         scenario, stack, hal = scenario_world(scenario, stack, source=source)
