@@ -9,7 +9,8 @@ see the raylet die, then wait on a GCS that is gone. Ray's pipe-based agent heal
 still alive 40 s later).
 
 :func:`start_reaper` starts this module as a small watcher process before the cluster
-starts. It notes the driver's descendants (pid and start time, from ``/proc``) every
+starts. It notes the driver's descendants that are Ray's (their command line names Ray;
+pid and start time, from ``/proc``) every
 :data:`SCAN_S` for the first :data:`SETTLE_S` (the cluster starting: ~5 ms a look),
 then every :data:`SCAN_SLOW_S`, and blocks on a pipe from the driver in between; end of file (the
 driver exited, however: SIGKILL included) makes it kill every process it noted that is
@@ -100,8 +101,20 @@ def descendants(root: int) -> dict[int, int]:
     return found
 
 
+def _is_ray(pid: int) -> bool:
+    """``pid`` is one of Ray's processes (``ray::NAME``, raylet, gcs_server, Ray's Python
+    services): its command line names Ray. Anything else the driver started is not ours
+    to kill."""
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as f:
+            cmdline = f.read()
+    except OSError:
+        return False
+    return b"ray" in cmdline
+
+
 def _watch(driver: int) -> dict[int, int]:
-    """Note the driver's descendants until its pipe closes; return them."""
+    """Note the driver's descendants that are Ray's until its pipe closes; return them."""
     seen: dict[int, int] = {}
     me = os.getpid()
     start = time.monotonic()
@@ -110,8 +123,11 @@ def _watch(driver: int) -> dict[int, int]:
         readable, _, _ = select.select([sys.stdin.buffer], [], [], wait)
         if readable and not os.read(sys.stdin.buffer.fileno(), 4096):
             return seen  # end of file: the driver exited
-        seen.update(descendants(driver))
-        seen.pop(me, None)
+        seen.update(
+            (pid, started)
+            for pid, started in descendants(driver).items()
+            if pid not in seen and pid != me and _is_ray(pid)
+        )
 
 
 def _reap(seen: dict[int, int]) -> None:
