@@ -72,10 +72,14 @@ def exit_codes() -> str:
 
     section = EPILOG.split("exit codes:\n", 1)[1]
     rows = ["| code | meaning |", "|---|---|"]
+    entries: list[list[str]] = []
     for line in section.splitlines():
-        match = re.match(r"^\s+(\S+)\s{2,}(.*)$", line)
+        match = re.match(r"^\s{1,8}(\S+)\s{2,}(.*)$", line)
         if match:
-            rows.append(f"| `{match.group(1)}` | {match.group(2)} |")
+            entries.append([match.group(1), match.group(2)])
+        elif entries and line.startswith(" " * 9) and line.strip():
+            entries[-1][1] += " " + line.strip()  # a meaning that goes on
+    rows += [f"| `{code}` | {meaning} |" for code, meaning in entries]
     if len(rows) < 4:
         raise ValueError("exit codes: the CLI epilog lists none (format changed?)")
     return "\n".join(rows) + "\n"

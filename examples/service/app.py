@@ -124,8 +124,10 @@ class BadRequest(Exception):
 # -- requests ----------------------------------------------------------------------------
 
 
+# Strict: JSON's types as they are. `"seed": true` is not seed 1 and `"x": "1"` is not
+# x 1.0 (lax pydantic took both; issue 27). An int is still a valid float.
 class RunRequest(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", strict=True)
     scenario: str | dict[str, Any] = "acceptance"
     """A built-in scenario name, or a scenario inline (the keys of a scenario YAML)."""
     set: list[str] = Field(default_factory=list)
@@ -134,7 +136,7 @@ class RunRequest(BaseModel):
 
 
 class GoalRequest(BaseModel):
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, strict=True)
     x: Coordinate  # bounded as in a scenario file
     y: Coordinate
 
@@ -152,8 +154,8 @@ async def _json_body(request: Request) -> object:
         raw += chunk
         if len(raw) > MAX_BODY_BYTES:
             raise BadRequest(f"request body: larger than {MAX_BODY_BYTES // 1024} KiB", 413)
-    if not raw:
-        return {}
+    if not raw.strip():  # not taken as {}: a client that sent nothing meant something
+        raise BadRequest("request body: empty; send a JSON object (`{}` for every default)")
     try:
         text = bytes(raw).decode("utf-8")
     except UnicodeDecodeError as exc:

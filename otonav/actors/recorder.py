@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Collection
+from collections.abc import Callable, Collection
 
 import anyio
 
+from otonav.record.diskfull import DiskFullError
 from otonav.record.writer import RecordingWriter
 from otonav.runtime import Actor, Bus
 from otonav.runtime.funnel import Funnel
@@ -27,6 +28,10 @@ class Recorder(Actor):
     10 ms instant instead cost ~10 us per wake: 13 % of the recorder's cost in a 30 s
     run. A SIGKILL can lose up to ``period`` s more than the last chunk; every other
     exit drains the funnel first.
+
+    A full disk (:class:`~otonav.record.diskfull.DiskFullError`) is handed to
+    ``on_disk_full`` (the session stops the run; the file's owner reports it) instead of
+    crashing the recorder; without one it is a crash. What arrives after it is dropped.
     """
 
     def __init__(
@@ -46,6 +51,7 @@ class Recorder(Actor):
         self.writer = writer
         self._wanted = frozenset(topics) if topics is not None else None
         self._funnel: Funnel | None = None
+        self.on_disk_full: Callable[[DiskFullError], None] | None = None
 
     def on_wired(self, bus: Bus) -> None:
         wanted = self._wanted
@@ -108,7 +114,12 @@ class Recorder(Actor):
         # woken by the room made is served on its own turn, not inside this call.
         while deliveries := funnel.take_all():
             if not writer.finished:  # else: taken, and nowhere to write them
-                writer.write_all(deliveries)
+                try:
+                    writer.write_all(deliveries)
+                except DiskFullError as exc:
+                    if self.on_disk_full is None:
+                        raise
+                    self.on_disk_full(exc)
 
     async def on_stop(self) -> None:
         self.drain()

@@ -18,6 +18,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from otonav.errors import UsageError
+from otonav.record.diskfull import DISK_FULL_EXIT, DiskFullError, is_disk_full
 
 if TYPE_CHECKING:
     from otonav.cli.loading import load_scenario, load_stack
@@ -42,6 +43,9 @@ exit codes:
   0        the scenario passed, or the command succeeded
   1        the scenario failed
   2        usage or configuration error (one line on stderr, no traceback)
+  4        the disk is full (or a quota or file size limit): the run was stopped,
+           what was written is kept; one line names the file and the way on
+           (`otonav salvage` for a recording)
   130/143  interrupted by Ctrl-C / SIGTERM (the recording is finished and readable)
 """
 
@@ -99,6 +103,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("otonav: interrupted; the recording was finished and is readable", file=sys.stderr)
         return 130
     except Exception as exc:
+        if isinstance(exc, DiskFullError) or is_disk_full(exc):
+            print(f"otonav: error: {_disk_full_line(exc)}", file=sys.stderr)
+            return DISK_FULL_EXIT
         if isinstance(exc, UsageError):  # bad input: every kind derives from it
             print(f"otonav: error: {exc}", file=sys.stderr)
             return USAGE_ERROR
@@ -107,6 +114,14 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"otonav: error: {where}{exc.strerror or exc}", file=sys.stderr)
             return USAGE_ERROR
         raise
+
+
+def _disk_full_line(exc: BaseException) -> str:
+    """One line for a full disk: the error's own, or the path and the system's words."""
+    if isinstance(exc, OSError):
+        where = f"{exc.filename}: " if exc.filename else ""
+        return f"{where}{(exc.strerror or str(exc)).lower()}"
+    return str(exc)
 
 
 def __getattr__(name: str) -> object:

@@ -208,6 +208,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
     from otonav.cli.loading import load_scenario, load_stack
     from otonav.cli.progress import ProgressLine
     from otonav.limits import check_scale
+    from otonav.record.diskfull import DiskFullError, is_disk_full
     from otonav.record.outlock import lock_output
     from otonav.runtime import WallClockCeilingError
     from otonav.scenario import ScenarioConfig, run_scenario
@@ -325,7 +326,17 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
 
         console.print(f"bag: {write_bag_directory(Path(verdict.recording), out / BAG_DIR)}")
     summary = out / "summary.json"
-    summary.write_text(json.dumps(finite_figures(verdict.as_dict()), indent=2, default=str) + "\n")
+    try:
+        summary.write_text(
+            json.dumps(finite_figures(verdict.as_dict()), indent=2, default=str) + "\n"
+        )
+    except OSError as exc:
+        if not is_disk_full(exc):
+            raise
+        summary.unlink(missing_ok=True)  # half a summary would pass for one
+        raise DiskFullError(
+            summary, exc, "the recording and plot were written; the summary was not"
+        ) from exc
     if held:  # the table was printed while the window was held open
         for label, path in (("recording", verdict.recording), ("plot", verdict.plot)):
             if path:

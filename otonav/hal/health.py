@@ -42,6 +42,9 @@ class HardwareHealth:
     message: str = "ok"
     since: float = 0.0
     values: tuple[tuple[str, str], ...] = ()
+    permanent: bool = False
+    """The fault will not clear without people (recovery gave up, or a wrong node id):
+    a scenario run ends on it, with the fault as its verdict's reason."""
 
     @property
     def faulted(self) -> bool:

@@ -5,7 +5,10 @@ world and run records are written when the recording starts; the verdict's recor
 the end is lost with the end of the file).
 
 Only chunks that match their CRC are copied: a damaged chunk is skipped and reported,
-never rewritten under a fresh CRC (that would make damaged data look recorded)."""
+never rewritten under a fresh CRC (that would make damaged data look recorded).
+
+A target that cannot be finished (a full disk, Ctrl-C) is removed: a partial copy
+is no salvage, and a retry would have to ``--force`` past it."""
 
 from __future__ import annotations
 
@@ -15,6 +18,7 @@ from mcap.reader import NonSeekingReader
 from mcap.records import Channel, Metadata, Schema
 from mcap.writer import CompressionType, Writer
 
+from otonav.record.diskfull import DiskFullError, is_disk_full
 from otonav.record.reader import (
     CUT_OFF_ERRORS,
     DamagedRecordingError,
@@ -48,13 +52,37 @@ def salvage(
     with source.open("rb") as f:
         try:
             header = NonSeekingReader(f).get_header()
-        except CUT_OFF_ERRORS as exc:
-            raise RecordingError(f"{source}: no readable MCAP header ({exc})") from None
-    count = 0
+        except CUT_OFF_ERRORS:
+            raise RecordingError(
+                f"{source}: no readable MCAP header after the magic ({source.stat().st_size} "
+                "bytes): not a recording, nothing to salvage"
+            ) from None
     damage: list[Damage] = [] if damaged is None else damaged
+    try:
+        count = _copy(source, target, header.profile, header.library, damage)
+    except BaseException as exc:
+        # A partial target is no salvage (and a retry would refuse it without --force).
+        target.unlink(missing_ok=True)
+        if isinstance(exc, OSError) and is_disk_full(exc):
+            raise DiskFullError(
+                target,
+                exc,
+                "the partial copy was removed: free some space or salvage to another disk",
+            ) from exc
+        raise
+    if damaged is None and damage:
+        raise DamagedRecordingError(
+            f"{describe_damage(source, damage)}; {target} holds the {count} messages of "
+            "the intact chunks"
+        )
+    return count
+
+
+def _copy(source: Path, target: Path, profile: str, library: str, damage: list[Damage]) -> int:
+    count = 0
     with target.open("wb") as out:
         writer = Writer(out, chunk_size=CHUNK_SIZE, compression=CompressionType.ZSTD)
-        writer.start(profile=header.profile, library=header.library)
+        writer.start(profile=profile, library=library)
         schemas: dict[int, Schema] = {}
         channels: dict[int, Channel] = {}
         schema_ids: dict[int, int] = {}
@@ -89,9 +117,4 @@ def salvage(
                 )
                 count += 1
         writer.finish()  # type: ignore[no-untyped-call]
-    if damaged is None and damage:
-        raise DamagedRecordingError(
-            f"{describe_damage(source, damage)}; {target} holds the {count} messages of "
-            "the intact chunks"
-        )
     return count

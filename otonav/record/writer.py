@@ -9,11 +9,19 @@ stamps. Crash-safe by construction (ADR 0004):
   writer produced a file with no valid footer on one (measured here);
 - ``finish()`` (footer + index) runs on every exit path: the owner calls it in ``finally``
   and the CLI turns SIGINT/SIGTERM into cancellation. What a SIGKILL leaves, ``salvage``
-  rewrites as an indexed file.
+  rewrites as an indexed file;
+- a full disk (``ENOSPC``, ``EDQUOT``, ``EFBIG``) raises :class:`DiskFullError` once;
+  the file is cut back to the end of its last chunk that reached the disk and closed
+  with a footer that has no index (50 bytes; MCAP readers then scan it), so it stays
+  readable; if even that does not fit, it ends at that chunk, which ``salvage`` reads.
+  Later writes are dropped (:attr:`RecordingWriter.dropped`) (issue 27).
 """
 
 from __future__ import annotations
 
+import contextlib
+import os
+import struct
 from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from types import TracebackType
@@ -25,6 +33,7 @@ from otonav._version import __version__
 from otonav.msgs import Message
 from otonav.msgs.flat import real_type
 from otonav.record.cdr import encode
+from otonav.record.diskfull import DiskFullError, is_disk_full
 from otonav.record.fastwriter import FastWriter
 from otonav.record.qos_profile import offered_qos_yaml
 from otonav.record.schemas import schema_for
@@ -32,6 +41,11 @@ from otonav.record.type_hash import rihs01
 from otonav.runtime.qos import QoS
 
 CHUNK_SIZE = 64 * 1024
+
+_MAGIC = b"\x89MCAP0\r\n"
+# DataEnd (CRC 0: not computed) and a Footer with no summary section, then the magic:
+# what closes a data section nobody can index any more (MCAP spec, records 0x0F, 0x02).
+_BARE_END = struct.pack("<BQI", 0x0F, 4, 0) + struct.pack("<BQQQI", 0x02, 20, 0, 0, 0) + _MAGIC
 
 
 def _library() -> str:
@@ -51,6 +65,11 @@ class RecordingWriter:
         )
         self._writer.start(profile="ros2", library=_library())
         self._file.flush()
+        self._good = self._file.tell()  # the end of what is on disk, at a record boundary
+        self.failed: DiskFullError | None = None
+        """Set when the disk filled up: nothing more is written."""
+        self.dropped = 0
+        """Messages not written because the disk was full."""
         self._schemas: dict[type[Message], int] = {}
         self._channels: dict[str, int] = {}
         self._sequence: dict[int, int] = {}
@@ -79,21 +98,31 @@ class RecordingWriter:
     def write(self, topic: str, message: Message, sim_time: float) -> bool:
         """Record ``message`` on ``topic`` at ``sim_time`` seconds (log and publish time).
         True when this completed a chunk (it is in the file now)."""
-        channel_id = self._channels.get(topic)
-        if channel_id is None:
-            channel_id = self._channel(topic, real_type(type(message)))
-        stamp = round(sim_time * 1e9)
-        self._sequence[channel_id] += 1
-        # Messages accumulate in memory until a chunk is full; when one was written,
-        # it goes to the OS at once. (Asking the file its position after every message
-        # instead cost an lseek syscall per message.)
-        chunk = self._writer.add_message_and_check(
-            channel_id, stamp, encode(message), stamp, self._sequence[channel_id]
-        )
-        if chunk:
-            self._file.flush()
+        if self.failed is not None:
+            self.dropped += 1
+            return False
+        try:
+            channel_id = self._channels.get(topic)
+            if channel_id is None:
+                channel_id = self._channel(topic, real_type(type(message)))
+            stamp = round(sim_time * 1e9)
+            self._sequence[channel_id] += 1
+            # Messages accumulate in memory until a chunk is full; when one was written,
+            # it goes to the OS at once. (Asking the file its position after every message
+            # instead cost an lseek syscall per message.)
+            chunk = self._writer.add_message_and_check(
+                channel_id, stamp, encode(message), stamp, self._sequence[channel_id]
+            )
+            if chunk:
+                self._flush()
+        except OSError as exc:
+            raise self._disk_full(exc) from exc
         self.messages += 1
         return chunk
+
+    def _flush(self) -> None:
+        self._file.flush()
+        self._good = self._file.tell()
 
     def write_all(self, deliveries: Iterable[tuple[str, float, Message]]) -> None:
         """:meth:`write` each ``(topic, sim_time, message)`` in order (a recorder's
@@ -106,6 +135,15 @@ class RecordingWriter:
             for topic, sim_time, message in deliveries:
                 self.write(topic, message, sim_time)
             return
+        if self.failed is not None:
+            self.dropped += sum(1 for _ in deliveries)
+            return
+        try:
+            self._write_all(deliveries)
+        except OSError as exc:
+            raise self._disk_full(exc) from exc
+
+    def _write_all(self, deliveries: Iterable[tuple[str, float, Message]]) -> None:
         channels, sequences = self._channels, self._sequence
         batch: list[tuple[int, int, bytes, int, int]] = []
         append = batch.append
@@ -133,7 +171,7 @@ class RecordingWriter:
             # (write() would have written each one before the failure, too).
             chunks += self._add_batch(batch)
             if chunks:
-                self._file.flush()
+                self._flush()
 
     def _add_batch(self, batch: list[tuple[int, int, bytes, int, int]]) -> int:
         if not batch:
@@ -144,17 +182,48 @@ class RecordingWriter:
         return chunks
 
     def add_metadata(self, name: str, data: dict[str, str]) -> None:
-        self._writer.add_metadata(name, data)
+        if self.failed is not None:
+            return
+        try:
+            self._writer.add_metadata(name, data)
+        except OSError as exc:
+            raise self._disk_full(exc) from exc
 
     def finish(self) -> None:
-        """Write the footer and index and close the file; safe to call twice."""
+        """Write the footer and index and close the file; safe to call twice. A full
+        disk raises :class:`DiskFullError` (once: then the file is closed as it can be)."""
         if self.finished:
             return
         self.finished = True
         try:
-            self._writer.finish()  # type: ignore[no-untyped-call]
-        finally:
-            self._file.close()
+            try:
+                self._writer.finish()  # type: ignore[no-untyped-call]
+            finally:
+                self._file.close()
+        except OSError as exc:
+            raise self._disk_full(exc) from exc
+
+    def _disk_full(self, exc: OSError) -> OSError | DiskFullError:
+        """On a full disk: close the file readable (see the module), remember and return
+        the :class:`DiskFullError`; any other OSError is returned as it is."""
+        if not is_disk_full(exc):
+            return exc
+        self.finished = True
+        with contextlib.suppress(OSError):
+            self._file.close()  # its buffer cannot be flushed: the close still closes
+        good, path = self._good, self.path
+        try:
+            with open(path, "r+b") as f:
+                f.truncate(good)
+                f.seek(good)
+                f.write(_BARE_END)
+            kept = "closed without an index (readable)"
+        except OSError:
+            with contextlib.suppress(OSError):
+                os.truncate(path, good)
+            kept = "cut off after its last complete chunk"
+        self.failed = DiskFullError(path, exc, f"the recording was {kept} at {good} bytes")
+        return self.failed
 
     def __enter__(self) -> RecordingWriter:
         return self

@@ -16,7 +16,7 @@ from operator import itemgetter
 from pathlib import Path
 from typing import Any, BinaryIO, NamedTuple
 
-from mcap.reader import make_reader
+from mcap.reader import NonSeekingReader, make_reader
 from pydantic import ValidationError
 
 from otonav.record.fastreader import ChunkDamageError, read_raw_messages
@@ -86,9 +86,19 @@ def load_recording(path: Path, topics: Collection[str] | None) -> Recording:
         if f.read(len(MAGIC)) != MAGIC:
             raise ReplayInputError(f"{path}: not an MCAP file (no MCAP magic at its start)")
         f.seek(0)
+        if not _has_header(f):  # the magic alone (issue 27: "Invalid argument")
+            size = f.seek(0, 2)
+            raise ReplayInputError(
+                f"{path}: not a complete MCAP recording: {size} bytes, the MCAP magic and "
+                "no readable header after it (an empty or cut-off file; nothing to salvage)"
+            )
+        f.seek(0)
         try:
             reader = make_reader(f)
-            summary = reader.get_summary()
+            try:
+                summary = reader.get_summary()
+            except OSError:  # too short to hold a footer: a seek before its start
+                raise _cut_off(path) from None
             if summary is None or summary.statistics is None:
                 raise _cut_off(path)
             types: dict[str, str] = {}
@@ -136,6 +146,15 @@ def _messages(f: BinaryIO, summary: Any, topics: Collection[str] | None) -> list
 
 
 _time_of = itemgetter(1)
+
+
+def _has_header(f: BinaryIO) -> bool:
+    """The MCAP header record follows the magic (``salvage`` has something to read)."""
+    try:
+        NonSeekingReader(f).get_header()
+    except CUT_OFF_ERRORS:
+        return False
+    return True
 
 
 def _unreadable(path: Path, exc: BaseException) -> ReplayInputError:

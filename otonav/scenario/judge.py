@@ -78,6 +78,9 @@ class Judge(Actor):
         self.time_to_goal: float | None = None
         self.unreachable_at: float | None = None
         """s of sim time when /nav/state first said ``unreachable``; None if never."""
+        self.hardware_fault: str | None = None
+        """A permanent hardware fault (``HardwareHealth.permanent``), as the verdict's
+        reason: the run ends on it (issue 27). None: none."""
         self.samples = 0
         self.trajectory: list[tuple[float, float, float]] = []
         self._last: tuple[float, float] | None = None
@@ -100,8 +103,11 @@ class Judge(Actor):
 
     @property
     def finished(self) -> bool:
-        """Nothing more will happen worth waiting for: the arrival checked, or given up."""
-        return self.arrival_checked_at is not None or self.gave_up
+        """Nothing more will happen worth waiting for: the arrival checked, given up, or
+        a permanent hardware fault."""
+        return (
+            self.arrival_checked_at is not None or self.gave_up or self.hardware_fault is not None
+        )
 
     def _check_arrival(self, now: float) -> None:
         problems = []
@@ -150,6 +156,13 @@ class Judge(Actor):
         clearance.update(x, y)
         self.min_clearance = clearance.min_clearance
         self.min_clearance_at = clearance.min_clearance_at
+        if self.hardware_fault is None:
+            health = self.hal.health()
+            if health.permanent:
+                self.hardware_fault = (
+                    f"hardware fault (permanent) at {health.since:.2f} s: "
+                    f"{health.fault}: {health.message}"
+                )
 
     async def on_start(self) -> None:
         self.sample(self.clock.now())

@@ -22,6 +22,7 @@ from otonav._version import __version__
 from otonav.actors import topics
 from otonav.hal import RobotHardwareInterface
 from otonav.msgs import Header, Point, Pose, PoseStamped, ScenarioVerdict, Time
+from otonav.record.diskfull import DiskFullError, is_disk_full
 from otonav.record.outlock import lock_output
 from otonav.record.writer import RecordingWriter
 from otonav.runtime import (
@@ -313,7 +314,9 @@ def run_scenario(
     Another run writing to ``out_dir`` raises :class:`~otonav.record.outlock.OutputBusyError`
     before anything is touched. An actor's crash raises
     :class:`~otonav.scenario.crash.RunCrashedError` once the artifacts are written: an
-    ``ActorCrashedError`` carrying the failed verdict.
+    ``ActorCrashedError`` carrying the failed verdict. A full disk stops the run and
+    raises :class:`~otonav.record.diskfull.DiskFullError` naming the file, once the
+    recording is closed (readable) and the world too.
 
     ``realtime=scale`` paces sim time to the wall clock times ``scale`` instead (the same
     actors, judge and artifacts; ``wall_ceiling`` does not apply); ``gui=True`` (real
@@ -460,21 +463,45 @@ def save_artifacts(
 ) -> Verdict:
     """Tear ``session`` down with the verdict appended to its recording, and draw the
     trajectory; the verdict names both files."""
-    session.close(epilogue=lambda writer: _append_verdict(writer, scenario, stack, verdict))
-    if session.writer is not None:
-        verdict = replace(verdict, recording=str(session.writer.path))
+    writer = session.writer
+    try:
+        session.close(epilogue=lambda writer: _append_verdict(writer, scenario, stack, verdict))
+    except DiskFullError:
+        if writer is None or writer.failed is None:
+            raise
+    if writer is not None:
+        if writer.failed is not None:  # the disk is full: no plot either
+            raise disk_full_stop(writer.failed, verdict.sim_time_s) from writer.failed.cause
+        verdict = replace(verdict, recording=str(writer.path))
     if out_dir is not None and plot:
-        png = plot_trajectory(
-            out_dir / "trajectory.png",
-            judge.trajectory,
-            judge.boxes,
-            (scenario.goal.x, scenario.goal.y),
-            scenario.goal_tolerance,
-            judge.min_clearance_at,
-            verdict_title(verdict.scenario, verdict.passed, verdict.reason),
-        )
+        png = out_dir / "trajectory.png"
+        try:
+            plot_trajectory(
+                png,
+                judge.trajectory,
+                judge.boxes,
+                (scenario.goal.x, scenario.goal.y),
+                scenario.goal_tolerance,
+                judge.min_clearance_at,
+                verdict_title(verdict.scenario, verdict.passed, verdict.reason),
+            )
+        except OSError as exc:
+            if not is_disk_full(exc):
+                raise
+            png.unlink(missing_ok=True)  # a cut-off PNG is no plot
+            raise DiskFullError(png, exc, "the plot was not written") from exc
         verdict = replace(verdict, plot=str(png))
     return verdict
+
+
+def disk_full_stop(error: DiskFullError, sim_time: float) -> DiskFullError:
+    """The recording's :class:`DiskFullError`, saying where the run stopped, what was
+    kept and how to get an indexed copy (issue 27)."""
+    path = error.path
+    return error.with_detail(
+        f"the run was stopped at sim time {sim_time:.2f} s; {error.detail}: "
+        f"'otonav salvage {path} OTHER_DISK/{path.name}' copies it to an indexed file"
+    )
 
 
 def _append_verdict(
@@ -579,6 +606,14 @@ def judge_verdict(
                 f"the navigator did not report the goal unreachable within "
                 f"{scenario.sim_budget:g} s (last state: {judge.nav_state})"
             )
+    if judge.hardware_fault is not None and not judge.reached:
+        outcome = False
+        reasons[:] = [judge.hardware_fault]
+    elif not outcome and (health := judge.hal.health()).faulted:
+        # A fault that outlasted the run (e.g. encoder data late the whole time).
+        reasons.append(
+            f"hardware fault since {health.since:.2f} s: {health.fault}: {health.message}"
+        )
     if not clear:
         reasons.append(
             f"came {judge.min_clearance:.3f} m from an obstacle "

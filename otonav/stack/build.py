@@ -123,6 +123,7 @@ def _can_world(config: StackConfig, world: MujocoInterface) -> CanBusInterface:
             loss_window=can.loss_window,
             recovery_delay=can.recovery_delay,
             max_recovery_attempts=can.max_recovery_attempts,
+            recovery_reset=can.recovery_reset,
         )
         return CanBusInterface(
             host,

@@ -277,7 +277,8 @@ class CanConfig(_Section):
     startup_timeout: _CanTimeout = 1.0
     heartbeat_timeout: _CanTimeout = 0.25
     encoder_timeout: _CanTimeout = 0.05
-    """Must be longer than ``encoder_period``."""
+    """s: an encoder estimate older than this (none arrived, or its frame's timestamp is
+    that old) is a fault for as long as it lasts. Must be longer than ``encoder_period``."""
     max_frame_loss: Annotated[float, _within(0.0, 1.0)] = 0.2
     """Fraction of encoder frames that may be lost over ``loss_window`` s."""
     loss_window: _CanTimeout = 0.5
@@ -285,6 +286,11 @@ class CanConfig(_Section):
     recovery_delay: _CanDelay = 0.3
     """s a fault's cause must stay clear before recovery starts."""
     max_recovery_attempts: Annotated[int, _within(0, limits.MAX_RECOVERY_ATTEMPTS)] = 3
+    """Recovery attempts per drive, whatever the fault; then the fault is permanent and
+    a scenario run ends on it."""
+    recovery_reset: _CanTimeout = 5.0
+    """s a drive must run without a fault before its count of recovery attempts starts
+    again from zero."""
     command_keepalive: _CanDelay = 0.1
     """s: an unchanged wheel setpoint is sent again only this often (0: at every base
     tick). Keep it well under the drives' watchdog timeout."""

@@ -116,6 +116,10 @@ class StackSession:
                 self.recorder = Recorder(self.writer)
             first = [self.recorder] if self.recorder is not None else []
             self.system = System([*first, *actors], clock=realtime, restart=restart)
+            if self.recorder is not None:
+                # A full disk stops the run cleanly (every on_stop runs); the owner of
+                # the session raises the writer's DiskFullError once it is closed.
+                self.recorder.on_disk_full = lambda _exc: self.system.stop()
             attach_rosout(self.system)
         except BaseException:
             try:

@@ -1,11 +1,16 @@
 """``results.jsonl``: one JSON object per finished run, appended and flushed as it
 finishes, so an interrupted sweep (Ctrl-C, SIGTERM, a kill) loses no finished result.
 A kill in the middle of a write leaves at most one partial last line; reading drops it
-(and the next append starts on a fresh line)."""
+(and the next append starts on a fresh line).
+
+A run retried with ``--retry-errors`` appends its new record; once the sweep ends (and
+when a later ``--resume`` finds one left by a killed sweep) the file is rewritten with
+one line per run, the latest, so ``jq`` or pandas see no duplicates (issue 27)."""
 
 from __future__ import annotations
 
 import json
+import os
 import shlex
 from collections.abc import Iterable
 from pathlib import Path
@@ -37,6 +42,27 @@ def read_results(path: Path) -> list[dict[str, Any]]:
 def latest_by_run(records: Iterable[dict[str, Any]]) -> dict[str, dict[str, Any]]:
     """run_id -> its last record (a retried run appends a newer one)."""
     return {r["run_id"]: r for r in records}
+
+
+def compact_results(path: Path) -> int:
+    """Rewrite ``path`` with one line per run, its latest record, where the latest
+    stands in the file (atomically: a kill leaves the old file or the new one). Returns
+    how many superseded lines were dropped (0: the file is left untouched)."""
+    records = read_results(path)
+    latest: dict[str, dict[str, Any]] = {}
+    for record in records:
+        latest.pop(record["run_id"], None)  # the newer one takes the later place
+        latest[record["run_id"]] = record
+    dropped = len(records) - len(latest)
+    if dropped == 0:
+        return 0
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "w") as f:
+        f.writelines(json.dumps(r, sort_keys=True) + "\n" for r in latest.values())
+        f.flush()
+        os.fsync(f.fileno())
+    os.replace(tmp, path)
+    return dropped
 
 
 def repro_command(task: RunTask, scenario_file: str | None) -> str | None:

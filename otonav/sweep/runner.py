@@ -22,6 +22,7 @@ from otonav.sweep.results import (
     RESULTS,
     RUNS,
     ResultsFile,
+    compact_results,
     latest_by_run,
     make_record,
     read_results,
@@ -46,6 +47,8 @@ class Prepared:
     """The runs still to do (all of them unless resuming)."""
     finished: dict[str, dict[str, Any]]
     """run_id -> record of the runs finished by an earlier, interrupted invocation."""
+    resumed: bool = False
+    """``out`` held this sweep's results already (a retried run may append a second line)."""
 
 
 def prepare(
@@ -77,6 +80,7 @@ def prepare(
                 f"--resume: {out} holds a different sweep (its runs are not this sweep's); "
                 "resume it with the sweep file that started it, or choose another --out"
             )
+        compact_results(results_file)  # a killed retry may have left two lines for a run
         ids = {t.run_id for t in tasks}
         finished = {
             rid: r
@@ -88,7 +92,8 @@ def prepare(
         json.dumps({**(meta or {}), "runs": len(tasks), "fingerprint": print_}, indent=2) + "\n"
     )
     pending = tuple(t for t in tasks if t.run_id not in finished)
-    return Prepared(out, tuple(tasks), pending, finished)
+    resumed = results_file.exists()
+    return Prepared(out, tuple(tasks), pending, finished, resumed)
 
 
 def _write_artifacts(
@@ -141,6 +146,8 @@ def execute(
             backend.run(prepared.pending, emit, stop)
     finally:
         results.close()
+        if prepared.resumed:
+            compact_results(prepared.out / RESULTS)  # a retried run: its latest line only
     return records
 
 

@@ -578,7 +578,7 @@ async def test_delayed_frames_are_detected() -> None:
         _delay(0.08),
         _delay(0.0),
         fault={"encoder_stale"},
-        names="no encoder estimate for",
+        names="newest encoder estimate",
         estop=False,
     )
 

@@ -216,9 +216,13 @@ def test_crashed_and_hung_workers_are_errors_then_resume_retries_only_them(
     assert len(read_results(out / "results.jsonl")) == 4
     assert main([*argv, "--retry-errors"]) == 1  # stuck still fails
     records = read_results(out / "results.jsonl")
-    assert len(records) == 6  # exactly the 2 errors ran again
-    assert {r["run_id"] for r in records[4:]} == errors
-    assert all(r["status"] == "passed" for r in records[4:])
+    # Exactly the 2 errors ran again, and their new records replaced the old ones: one
+    # line per run (issue 27: the file kept both, and jq or pandas saw the run twice).
+    assert len(records) == 4
+    assert Counter(r["run_id"] for r in records) == Counter({r["run_id"]: 1 for r in first})
+    assert {r["run_id"] for r in records[2:]} == errors
+    assert all(r["status"] == "passed" for r in records[2:])
+    assert records[:2] == healthy
     summary = json.loads((out / "summary.json").read_text())
     assert summary["pass_rate"]["errors"] == 0
     assert summary["finished"] == summary["planned"] == 4
@@ -370,3 +374,15 @@ def test_ray_gives_the_serial_results_and_survives_a_dead_worker(
     kept = [r for r in records if r["status"] == "failed"]
     assert all((tmp_path / "ray" / r["artifacts"] / "recording.mcap").exists() for r in kept)
     assert not (local_ray / ".ray").exists()  # Ray's token stayed out of the home
+    # --retry-errors after the killed workers: the retried runs' records replace the
+    # errors, one line per run in results.jsonl (it used to keep both).
+    out = tmp_path / "ray"
+    retried = execute(
+        prepare(out, tasks_of(sweep), resume=True, retry_errors=True), make_backend("inline")
+    )
+    assert {r["run_id"] for r in retried} == crashed
+    lines = (out / "results.jsonl").read_text().splitlines()
+    assert Counter(json.loads(line)["run_id"] for line in lines) == Counter(
+        {t.run_id: 1 for t in tasks_of(sweep)}
+    )
+    assert {r["status"] for r in read_results(out / "results.jsonl")} == {"passed", "failed"}

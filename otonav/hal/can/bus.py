@@ -104,6 +104,12 @@ class CanEndpoint:
         # exactly what it holds instead of ending on an empty recv(0), which raises and
         # catches queue.Empty inside python-can (1.1 us, at every bus instant).
         self._rx_queue: queue.Queue[can.Message] | None = None
+        self.sim_stamps = isinstance(bus, VirtualBus) and bool(
+            getattr(bus, "preserve_timestamps", False)
+        )
+        """The frames' timestamps are the senders' sim times (a virtual bus that keeps
+        them): :meth:`poll` can report them, and a receiver can tell how old a frame
+        is. On other buses they are the kernel's wall-clock receive times."""
         # On a virtual bus, one Message per endpoint for its data frames, refilled:
         # VirtualBus.send deep-copies it for every receiver before returning, so nothing
         # keeps it (~1.5 us less per frame than a new Message, measured). Its flags
@@ -151,8 +157,11 @@ class CanEndpoint:
         except can.CanError as exc:
             raise BusError(f"CAN send on {self.channel} failed: {exc}") from exc
 
-    def poll(self) -> list[RawFrame]:
-        """Every frame received since the last poll, in arrival order; never blocks."""
+    def poll(self, stamps: list[float] | None = None) -> list[RawFrame]:
+        """Every frame received since the last poll, in arrival order; never blocks.
+
+        ``stamps``: if given, each frame's timestamp is appended to it (the sender's sim
+        time where :attr:`sim_stamps`)."""
         recv = self._bus.recv
         # A virtual bus: exactly as many frames as its queue holds; others: until empty.
         n = -1 if self._rx_queue is None else self._rx_queue.qsize()
@@ -171,6 +180,8 @@ class CanEndpoint:
                         message.is_remote_frame,
                     )
                 )
+                if stamps is not None:
+                    stamps.append(message.timestamp)
                 n -= 1
         except can.CanError as exc:
             raise BusError(f"CAN receive on {self.channel} failed: {exc}") from exc

@@ -165,6 +165,9 @@ class CanBusInterface(RobotHardwareInterface):
         self._serviced_at = -1  # the tick of the last bus instant
         self._sent = False  # frames sent since then (the peer must hear them)
         self._tick = sensors.tick
+        # The received frames' sim-time stamps, where the bus keeps them (virtual): an
+        # encoder estimate is as old as its frame's stamp, not its arrival (issue 27).
+        self._stamps: list[float] | None = [] if endpoint.sim_stamps else None
         # The sensor readings are the source's own: bound here, they skip a delegating
         # call each (the bridge and the judge read them at every 10 ms instant).
         self.read_imu = sensors.read_imu  # type: ignore[method-assign]
@@ -226,13 +229,16 @@ class CanBusInterface(RobotHardwareInterface):
             self._peer.exchange(now)
             if repeat_instant:
                 return
+        stamps = self._stamps
         try:
-            frames = self._endpoint.poll()
+            frames = self._endpoint.poll(stamps)
         except BusError as exc:
             monitor.bus_off(t, str(exc))
             frames = []
         if frames:
             self._receive(frames, t)
+        if stamps is not None:
+            stamps.clear()
         actions = monitor.check(t)
         if actions:
             self._apply(actions, t)
@@ -250,18 +256,21 @@ class CanBusInterface(RobotHardwareInterface):
         encoder = self.monitor.encoder
         pos, vel = self._pos, self._vel
         fresh = False
-        for frame in frames:
+        stamps = self._stamps
+        for k, frame in enumerate(frames):
             ident, data, is_error, is_remote = frame
             axis = None if is_error or is_remote else encoder_axis.get(ident)
             if axis is None:
                 self._receive_other(frame, t)
                 continue
             i, node_id, scale = axis
-            encoder(node_id, t)
             try:
                 position, velocity = _unpack_two_f32(data)
             except struct.error:  # a short payload: ignored, like a bad frame on the wire
+                encoder(node_id, t, t)  # as before issue 27: counted as arrived
                 continue
+            # Measured when its frame was sent (a stamp from the future: arrival).
+            encoder(node_id, t, t if stamps is None else min(stamps[k], t))
             pos[i] = position / scale
             vel[i] = velocity / scale
             fresh = True
@@ -286,7 +295,7 @@ class CanBusInterface(RobotHardwareInterface):
                 error, state = p.unpack_heartbeat(frame.data)
                 monitor.heartbeat(node, error, state, t)
             elif cmd == p.CMD_GET_ENCODER_ESTIMATES:  # a node we do not drive
-                monitor.encoder(node, t)
+                monitor.encoder(node, t, t)
         except struct.error:  # a short payload: ignored
             return
 

@@ -18,13 +18,21 @@ fault              detected when                                           actio
 startup_timeout    a node does not report closed loop within the timeout   Estop all
 heartbeat_lost     a node's heartbeat is older than ``heartbeat_timeout``  Estop all
 axis_error         a heartbeat shows an error, or a state not closed loop  Estop all
-encoder_stale      a node's encoder estimate is older than the timeout     zero vel
+encoder_stale      a node's newest encoder estimate is older than the         zero vel
+                   timeout: none arrived, or it was measured that long ago
 frame_loss         encoder frames lost over ``loss_window`` > max          zero vel
 bus_off            an error frame says bus-off, or a send fails            zero vel
 =================  ======================================================  ==========
 
 A fault latches; recovery starts only once its cause has been clear for
-``recovery_delay`` s, at most ``max_recovery_attempts`` times in a row.
+``recovery_delay`` s. Recovery attempts are counted per drive, whatever the fault's
+kind, and a drive's count starts again from zero only after ``recovery_reset`` s of
+running without a fault: a drive that faults again soon after each recovery (an axis
+error, then a stale encoder, then an axis error...) gets ``max_recovery_attempts`` in
+all. Then, or at once for a fault no recovery can clear (a wrong node id: the expected
+drive is silent while another answers), the fault is *permanent*
+(:attr:`HardwareHealth.permanent`): the monitor stops trying, and a scenario run ends
+with the fault as its verdict (issue 27).
 """
 
 from __future__ import annotations
@@ -80,6 +88,8 @@ class MonitorLimits:
     loss_window: float = 0.5
     recovery_delay: float = 0.3
     max_recovery_attempts: int = 3
+    recovery_reset: float = 5.0
+    """s of running without a fault after which each drive's attempts count from 0."""
 
 
 class _Node:
@@ -107,7 +117,10 @@ class DriveMonitor:
         self._fault = ""
         self._fault_message = ""
         self._clear_since: float | None = None
-        self._attempts = 0
+        self._attempts: dict[int, int] = {}  # recovery attempts per drive (node id)
+        self._fault_nodes: tuple[int, ...] = ()  # the drives the current fault is about
+        self.permanent = False
+        """The fault will not be recovered from (gave up, or a wrong node id)."""
         self._bus_off = False
         self._bus_restarted = False
         self._loss_due = -math.inf
@@ -137,19 +150,21 @@ class DriveMonitor:
         if error or state != _CLOSED_LOOP:
             self._quiet_until = -math.inf  # an axis error: the next check must see it
 
-    def encoder(self, node_id: int, now: float) -> None:
+    def encoder(self, node_id: int, now: float, measured: float | None = None) -> None:
+        """An encoder frame of ``node_id`` arrived at ``now``; its estimate was measured
+        at ``measured`` (its frame's timestamp; None: ``now``)."""
         node = self._nodes.get(node_id)
         if node is None:
             self._foreign.add(node_id)
             return
-        node.encoder_at = now
+        node.encoder_at = now if measured is None else measured
         node.arrivals.append(now)
 
     def bus_off(self, now: float, detail: str) -> None:
         self._bus_off = True
         self._bus_restarted = False
         if self.phase is not Phase.FAULT or self._fault != "bus_off":
-            self._enter_fault(now, "bus_off", f"CAN bus-off: {detail}")
+            self._enter_fault(now, "bus_off", f"CAN bus-off: {detail}", tuple(self._nodes))
 
     def bus_restarted(self, now: float) -> None:
         if self._bus_off:
@@ -197,7 +212,6 @@ class DriveMonitor:
             self.phase = Phase.RUNNING
             self._running_since = now
             self._quiet_until = -math.inf
-            self._attempts = 0
             for node in nodes:
                 node.arrivals.clear()
             names = ", ".join(str(n.label) for n in nodes)
@@ -212,13 +226,19 @@ class DriveMonitor:
             self._fault = self._fault_message = ""
             return ()
         if now - self._requested_at > self.limits.startup_timeout + 1e-9:
+            silent = tuple(n.label.node_id for n in nodes if n.heartbeat_at <= self._requested_at)
             if self.phase is Phase.RECOVERING:
-                fault = self._fault
+                fault, faulted = self._fault, self._fault_nodes
                 cause = self._fault_message.split("; recovery from")[0]
                 message = f"{cause}; recovery from {fault} failed: {self._startup_message(now)}"
             else:
                 fault, message = "startup_timeout", self._startup_message(now)
-            self._enter_fault(now, fault, message)
+                faulted = tuple(n.label.node_id for n in nodes if not self._in_closed_loop(n))
+            self._enter_fault(now, fault, message, faulted)
+            if silent and self._foreign:
+                # Our drive is silent while another node answers: a wrong node id (or a
+                # drive on the wrong bus). No Clear_Errors will change that.
+                self._give_up(now, "permanent: no drive answers on that node id")
             return (Action.ESTOP_ALL,)
         return ()
 
@@ -264,6 +284,7 @@ class DriveMonitor:
                     "heartbeat_lost",
                     f"{node.label}: no heartbeat for {age:.3f} s of sim time "
                     f"(timeout {limits.heartbeat_timeout:g} s)",
+                    (node.label.node_id,),
                 )
                 return (Action.ESTOP_ALL,)
             if node.error or node.state != AxisState.CLOSED_LOOP_CONTROL:
@@ -272,6 +293,7 @@ class DriveMonitor:
                     "axis_error",
                     f"{node.label}: axis error 0x{node.error:08x} "
                     f"({error_names(node.error)}), state {_state_name(node.state)}",
+                    (node.label.node_id,),
                 )
                 return (Action.ESTOP_ALL,)
             age = now - node.encoder_at
@@ -279,8 +301,9 @@ class DriveMonitor:
                 self._enter_fault(
                     now,
                     "encoder_stale",
-                    f"{node.label}: no encoder estimate for {age:.3f} s of sim time "
+                    f"{node.label}: newest encoder estimate {age:.3f} s old in sim time "
                     f"(timeout {limits.encoder_timeout:g} s; frames delayed or lost)",
+                    (node.label.node_id,),
                 )
                 return (Action.ZERO_ALL,)
             # The loss is judged ten times per window, not at every instant.
@@ -293,6 +316,7 @@ class DriveMonitor:
                     "frame_loss",
                     f"{node.label}: {loss:.0%} of encoder frames lost over the last "
                     f"{limits.loss_window:g} s (max {limits.max_frame_loss:.0%})",
+                    (node.label.node_id,),
                 )
                 return (Action.ZERO_ALL,)
         if now >= self._loss_due:
@@ -329,43 +353,54 @@ class DriveMonitor:
 
     def _check_fault(self, now: float) -> tuple[Action, ...]:
         limits = self.limits
-        if not self._cause_clear(now):
+        if self.permanent or not self._cause_clear(now):
             self._clear_since = None
             return ()
         if self._clear_since is None:
             self._clear_since = now
         if now - self._clear_since < limits.recovery_delay - 1e-9:
             return ()
-        if self._attempts >= limits.max_recovery_attempts:
-            if "gave up" not in self.health.message:
-                self._set(
-                    now,
-                    HealthLevel.ERROR,
-                    False,
-                    self._fault,
-                    f"{self._fault_message}; gave up after {self._attempts} recovery "
-                    "attempts: restart the drives",
-                )
+        attempts = self._attempts
+        worst = max(self._fault_nodes, key=lambda n: attempts.get(n, 0), default=None)
+        if worst is not None and attempts.get(worst, 0) >= limits.max_recovery_attempts:
+            self._give_up(
+                now,
+                f"gave up after {attempts.get(worst, 0)} recovery attempts of "
+                f"{self._nodes[worst].label}: restart the drives",
+            )
             return ()
-        self._attempts += 1
+        for node_id in self._fault_nodes:
+            attempts[node_id] = attempts.get(node_id, 0) + 1
         self.phase = Phase.RECOVERING
         self._requested_at = now
         self._bus_restarted = False
+        attempt = max((attempts[n] for n in self._fault_nodes), default=0)
         self._set(
             now,
             HealthLevel.WARN,
             False,
             self._fault,
-            f"recovering from {self._fault} (attempt {self._attempts}): cause clear for "
+            f"recovering from {self._fault} (attempt {attempt}): cause clear for "
             f"{now - self._clear_since:.2f} s; Clear_Errors and CLOSED_LOOP_CONTROL sent to "
             + ", ".join(str(n.label) for n in self._nodes.values()),
         )
         self._clear_since = None
         return (Action.START_ALL,)
 
-    def _enter_fault(self, now: float, fault: str, message: str) -> None:
+    def _give_up(self, now: float, why: str) -> None:
+        """The fault is permanent: no more recovery, a run ends on it."""
+        self.permanent = True
+        self._set(now, HealthLevel.ERROR, False, self._fault, f"{self._fault_message}; {why}")
+
+    def _enter_fault(self, now: float, fault: str, message: str, nodes: tuple[int, ...]) -> None:
+        if (
+            self.phase is Phase.RUNNING
+            and now - self._running_since >= self.limits.recovery_reset - 1e-9
+        ):
+            self._attempts.clear()  # ran long enough without a fault: a fresh start
         self.phase = Phase.FAULT
         self._fault, self._fault_message = fault, message
+        self._fault_nodes = nodes
         self._clear_since = None
         self._set(now, HealthLevel.ERROR, False, fault, message)
 
@@ -383,6 +418,7 @@ class DriveMonitor:
             fault=fault,
             message=message,
             since=now,
+            permanent=self.permanent,
             values=(("phase", self.phase.value), *values),
         )
         self.drivable = self.health.drivable

@@ -142,8 +142,8 @@ class DriveEmulator:
         self._sent_at = -1  # last tick whose cyclic frames went out
         self._updated_at = -1  # last tick the axes were updated and the wheels driven
         self._seq = 0
-        # Delayed frames: (due tick, seq, outbound?, frame).
-        self._held: list[tuple[int, int, bool, RawFrame]] = []
+        # Delayed frames: (due tick, seq, outbound?, frame, sim time it was sent).
+        self._held: list[tuple[int, int, bool, RawFrame, float]] = []
         self._last_cmd = (math.nan, math.nan)
         self.frames_sent = 0
         self.frames_received = 0
@@ -211,11 +211,15 @@ class DriveEmulator:
                 changed |= self._handle(frame, t)
         held = self._held
         while held and held[0][0] <= now:
-            _, _, outbound, frame = heapq.heappop(held)
+            _, _, outbound, frame, sent_at = heapq.heappop(held)
             if self._bus_off:
                 continue
             if outbound:
-                self._endpoint.send(frame, t)
+                # It keeps the time its drive sent it: the delay stands for a queue
+                # between the controller that stamped the frame and the host (a USB
+                # adapter's buffer, a socket nobody drains), which SocketCAN's receive
+                # timestamps show. The host judges the data's age by it (issue 27).
+                self._endpoint.send(frame, sent_at)
                 self.frames_sent += 1
             else:
                 changed |= self._handle(frame, t)
@@ -259,7 +263,7 @@ class DriveEmulator:
             extra = faults.jitter * rng.random() if faults.jitter > 0.0 else 0.0
             due = now + max(1, round((faults.delay + extra) / self._tick))
             self._seq += 1
-            heapq.heappush(self._held, (due, self._seq, outbound, frame))
+            heapq.heappush(self._held, (due, self._seq, outbound, frame, now * self._tick))
             faults.delayed += 1
             return True
         return False

@@ -15,6 +15,9 @@ the user's home: unless the caller set ``RAY_AUTH_MODE``, ``RAY_AUTH_TOKEN`` or
 ``RAY_AUTH_TOKEN_PATH``, it gets a random token in the environment (``RAY_AUTH_TOKEN``,
 inherited by the cluster's processes) instead of Ray writing ``~/.ray/auth_token``
 (docs/adr/0029-sweep-memory-and-ray-state.md).
+
+On Linux such a cluster dies with the process that started it, even by SIGKILL: a small
+watcher process kills what is left of it (:mod:`otonav.sweep.backends.reaper`).
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ import logging
 import os
 import secrets
 import shutil
+import sys
 import tempfile
 import threading
 import time
@@ -50,6 +54,10 @@ def init_local(num_cpus: int, **kwargs: Any) -> None:
         # finds this token instead of writing one. Process-wide on purpose: the
         # cluster's processes inherit it, and Ray's token loader caches what it read.
         os.environ["RAY_AUTH_TOKEN"] = secrets.token_hex(32)
+    if sys.platform == "linux":
+        from otonav.sweep.backends.reaper import start_reaper
+
+        start_reaper()  # the cluster dies with this process, SIGKILL included
     options: dict[str, Any] = {
         "include_dashboard": False,
         "logging_level": logging.WARNING,
