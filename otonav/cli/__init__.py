@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from otonav.errors import UsageError
-from otonav.record.diskfull import DISK_FULL_EXIT, DiskFullError, is_disk_full
+from otonav.record import diskfull as _diskfull
 
 if TYPE_CHECKING:
     from otonav.cli.loading import load_scenario, load_stack
@@ -103,9 +103,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("otonav: interrupted; the recording was finished and is readable", file=sys.stderr)
         return 130
     except Exception as exc:
-        if isinstance(exc, DiskFullError) or is_disk_full(exc):
+        if isinstance(exc, _diskfull.DiskFullError) or _diskfull.is_disk_full(exc):
             print(f"otonav: error: {_disk_full_line(exc)}", file=sys.stderr)
-            return DISK_FULL_EXIT
+            return _diskfull.DISK_FULL_EXIT
         if isinstance(exc, UsageError):  # bad input: every kind derives from it
             print(f"otonav: error: {exc}", file=sys.stderr)
             return USAGE_ERROR
