@@ -14,6 +14,7 @@ import anyio
 import numpy as np
 
 from otonav.actors import topics
+from otonav.actors.odometry_error import OdometryError
 from otonav.control import Pose2D, integrate_odometry
 from otonav.hal import HardwareHealth, HealthLevel, ImuSample, RobotHardwareInterface
 from otonav.hal import WheelCommand as HalWheelCommand
@@ -194,6 +195,7 @@ class Bridge(Actor):
         scan_hz: float = 10.0,
         diagnostics_hz: float = 1.0,
         initial_pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        odometry_error: OdometryError | None = None,
         name: str = "bridge",
     ) -> None:
         super().__init__(name)
@@ -222,6 +224,7 @@ class Bridge(Actor):
         self._imu_sample: ImuSample | None = None
         self._imu_time = -1.0
         self._pending: deque[tuple[Publisher[Any], Any]] = deque()
+        self._odometry_error = odometry_error
 
     async def on_start(self) -> None:
         """/tf_static: base_link -> laser and base_link -> imu_link (latched), so a
@@ -335,6 +338,8 @@ class Bridge(Actor):
                 * ((wheels.left_position - left0) + (wheels.right_position - right0))
                 / 2
             )
+            if self._odometry_error is not None:
+                distance, gyro_z = self._odometry_error.apply(distance, gyro_z)
             v = self._v = distance / dt
             self._pose = integrate_odometry(self._pose, v, gyro_z, dt)
         pose = self._pose

@@ -1,0 +1,212 @@
+"""The localizer's map: an occupancy grid built from scans at their corrected poses, and
+the distance field the scan matcher (:mod:`otonav.nav.scan_match`) aligns scans to.
+
+Frames and units: map, m. The grid is a square of ``2 * half_size`` m centred on
+``(centre_x, centre_y)``, ``resolution`` m per cell, rows along y.
+
+* **Occupancy** (what ``/map`` shows): per cell log-odds, raised by ``HIT`` where a
+  return falls and lowered by ``MISS`` along each beam up to one cell short of its
+  return, clamped to +-``CLAMP``. A cell no beam touched is unknown.
+* **Distance field** (what scans are matched to): for every cell, the distance from
+  its centre to the centre of the nearest cell that ever held a return, capped at
+  ``max_distance``. A new occupied cell stamps a precomputed disk (``np.minimum`` on a
+  window, as :class:`otonav.nav.costmap.ClearanceMap` does); a cell already occupied
+  costs nothing. The field never forgets (a static world; the occupancy does).
+* :meth:`ScanMap.distance` reads the field with bilinear interpolation between cell
+  centres, and its gradient: continuous, so Gauss-Newton can refine a pose below one
+  cell (Hector SLAM's interpolated map access, on distances instead of probabilities).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ("CLAMP", "HIT", "MISS", "ScanMap")
+
+Array = NDArray[np.float64]
+
+HIT = 0.85
+"""Log-odds added to a cell a return falls in (p = 0.7)."""
+MISS = 0.4
+"""Log-odds taken from a cell a beam passes through (p = 0.4)."""
+CLAMP = 5.0
+"""Log-odds bound, both ways: a cell can change its mind within ~6-12 scans."""
+
+
+class ScanMap:
+    """Occupancy log-odds and the capped distance field of one localizer. Mutable,
+    plain computation (no I/O, no clock)."""
+
+    def __init__(
+        self,
+        centre_x: float,
+        centre_y: float,
+        *,
+        half_size: float = 10.0,
+        resolution: float = 0.05,
+        max_distance: float = 0.3,
+    ) -> None:
+        for name, value in (
+            ("half_size", half_size),
+            ("resolution", resolution),
+            ("max_distance", max_distance),
+        ):
+            if not (math.isfinite(value) and value > 0.0):
+                raise ValueError(f"ScanMap.{name} must be finite and > 0 m, got {value!r}")
+        if resolution > half_size:
+            raise ValueError(f"resolution {resolution} m must be <= half_size {half_size} m")
+        self.resolution = resolution
+        self.max_distance = max_distance
+        self.size = max(1, round(2.0 * half_size / resolution))
+        self.origin_x = centre_x - half_size
+        self.origin_y = centre_y - half_size
+        n = self.size
+        self.occupied = np.zeros((n, n), dtype=np.bool_)
+        self.log_odds = np.zeros((n, n), dtype=np.float32)
+        self.known = np.zeros((n, n), dtype=np.bool_)
+        k = math.ceil(max_distance / resolution)
+        self._k = k
+        self._pad = k + 1
+        width = n + 2 * self._pad
+        self._width = width
+        self._field = np.full((width, width), max_distance, dtype=np.float64)
+        self._flat = self._field.reshape(-1)
+        self._offsets = np.arange(-k, k + 1, dtype=np.float64) * resolution
+        self.cells = 0
+        """How many cells have held a return."""
+
+    # -- building ----------------------------------------------------------------------
+
+    def insert(self, sensor_x: float, sensor_y: float, x: Array, y: Array) -> int:
+        """Add one scan: its returns at ``(x, y)`` (map, m) seen from the sensor at
+        ``(sensor_x, sensor_y)``. Returns how many cells held a return for the first
+        time (each stamps the distance field)."""
+        self._misses(sensor_x, sensor_y, x, y)
+        row, col, inside = self._cells(x, y)
+        flat = (row * self.size + col)[inside]
+        if flat.size == 0:
+            return 0
+        odds = self.log_odds.reshape(-1)
+        hit = np.zeros(odds.shape[0], dtype=np.bool_)
+        hit[flat] = True
+        odds[hit] = np.minimum(odds[hit] + HIT, CLAMP)
+        self.known.reshape(-1)[hit] = True
+        occupied = self.occupied.reshape(-1)
+        fresh = flat[~occupied[flat]]
+        if fresh.size == 0:
+            return 0
+        # Each new cell's first return (the first of the scan's in it): its distances
+        # to the window's cell centres, capped, stamped with np.minimum.
+        order = np.argsort(fresh, kind="stable")
+        cells, first = np.unique(fresh[order], return_index=True)
+        index = np.flatnonzero(inside)[~occupied[flat]][order[first]]
+        span, offsets, field, n = 2 * self._k + 1, self._offsets, self._field, self.size
+        res, cap = self.resolution, self.max_distance
+        for cell, px, py in zip(cells.tolist(), x[index].tolist(), y[index].tolist(), strict=True):
+            occupied[cell] = True
+            r, c = divmod(cell, n)  # the window's corner: (r + pad - k, c + pad - k)
+            # the point relative to its cell's centre, then to every window centre
+            ox = px - (self.origin_x + (c + 0.5) * res)
+            oy = py - (self.origin_y + (r + 0.5) * res)
+            disk = np.hypot(offsets[None, :] - ox, offsets[:, None] - oy)
+            np.minimum(disk, cap, out=disk)
+            window = field[r + 1 : r + 1 + span, c + 1 : c + 1 + span]
+            np.minimum(window, disk, out=window)
+        self.cells += int(cells.size)
+        return int(cells.size)
+
+    def _misses(self, sx: float, sy: float, x: Array, y: Array) -> None:
+        """Lower the log-odds of every cell a beam crosses before its return's cell
+        (each cell once per scan), sampled every half cell."""
+        if x.shape[0] == 0:
+            return
+        dx, dy = x - sx, y - sy
+        length = np.hypot(dx, dy)
+        step = 0.5 * self.resolution
+        count = math.ceil(float(length.max()) / step)
+        if count <= 0:
+            return
+        t = np.arange(count, dtype=np.float64) * step
+        keep = t[None, :] < (length - self.resolution)[:, None]
+        scale = np.divide(
+            t[None, :],
+            length[:, None],
+            where=length[:, None] > 0,
+            out=np.zeros((length.shape[0], count)),
+        )
+        px = (sx + dx[:, None] * scale)[keep]
+        py = (sy + dy[:, None] * scale)[keep]
+        row, col, inside = self._cells(px, py)
+        flat = (row * self.size + col)[inside]
+        if flat.size == 0:
+            return
+        odds = self.log_odds.reshape(-1)
+        crossed = np.zeros(odds.shape[0], dtype=np.bool_)
+        crossed[flat] = True
+        odds[crossed] = np.maximum(odds[crossed] - MISS, -CLAMP)
+        self.known.reshape(-1)[crossed] = True
+
+    def _cells(
+        self, x: Array, y: Array
+    ) -> tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.bool_]]:
+        inv, n = 1.0 / self.resolution, self.size
+        col = np.floor((x - self.origin_x) * inv).astype(np.intp)
+        row = np.floor((y - self.origin_y) * inv).astype(np.intp)
+        inside = (col >= 0) & (col < n) & (row >= 0) & (row < n)
+        return row, col, inside
+
+    # -- reading -----------------------------------------------------------------------
+
+    def nearest(self, x: Array, y: Array) -> Array:
+        """The distance field at the cell each point falls in (no interpolation), m;
+        ``max_distance`` outside the map. The correlative search's lookup."""
+        inv, pad, hi = 1.0 / self.resolution, self._pad, self._width - 1
+        col = np.clip(np.floor((x - self.origin_x) * inv) + pad, 0, hi).astype(np.intp)
+        row = np.clip(np.floor((y - self.origin_y) * inv) + pad, 0, hi).astype(np.intp)
+        out: Array = self._flat[row * self._width + col]
+        return out
+
+    def distance(self, x: Array, y: Array) -> tuple[Array, Array, Array]:
+        """The distance field at the points, interpolated bilinearly between cell
+        centres, and its gradient (d/dx, d/dy), m and m/m. Points outside the map read
+        ``max_distance`` with a zero gradient."""
+        inv, pad, hi = 1.0 / self.resolution, self._pad, self._width - 2
+        u = (x - self.origin_x) * inv - 0.5 + pad
+        v = (y - self.origin_y) * inv - 0.5 + pad
+        u0 = np.floor(u)
+        v0 = np.floor(v)
+        fx, fy = u - u0, v - v0
+        outside = (u0 < 0) | (u0 > hi) | (v0 < 0) | (v0 > hi)
+        c0 = np.clip(u0, 0, hi).astype(np.intp)
+        r0 = np.clip(v0, 0, hi).astype(np.intp)
+        base = r0 * self._width + c0
+        f = self._flat
+        d00, d01 = f[base], f[base + 1]
+        d10, d11 = f[base + self._width], f[base + self._width + 1]
+        bottom = d00 + fx * (d01 - d00)
+        top = d10 + fx * (d11 - d10)
+        d = bottom + fy * (top - bottom)
+        gx = ((1.0 - fy) * (d01 - d00) + fy * (d11 - d10)) * inv
+        gy = (top - bottom) * inv
+        if outside.any():
+            d = np.where(outside, self.max_distance, d)
+            gx = np.where(outside, 0.0, gx)
+            gy = np.where(outside, 0.0, gy)
+        return d, gx, gy
+
+    def occupancy(self) -> tuple[int, int, int, int, NDArray[np.int8]]:
+        """The known part of the map as ``nav_msgs/OccupancyGrid`` data: (row0, col0,
+        height, width, cells), cells row-major from the lowest row, -1 unknown, else
+        0-100 (the probability of occupied, %). Empty (0 x 0) with nothing known."""
+        rows = np.flatnonzero(self.known.any(axis=1))
+        cols = np.flatnonzero(self.known.any(axis=0))
+        if rows.size == 0:
+            return 0, 0, 0, 0, np.empty(0, dtype=np.int8)
+        r0, r1, c0, c1 = int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
+        odds = self.log_odds[r0:r1, c0:c1].astype(np.float64)
+        percent = np.rint(100.0 / (1.0 + np.exp(-odds))).astype(np.int8)
+        cells = np.where(self.known[r0:r1, c0:c1], percent, np.int8(-1)).astype(np.int8)
+        return r0, c0, r1 - r0, c1 - c0, cells.reshape(-1)
