@@ -24,7 +24,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ("CLAMP", "HIT", "MISS", "ScanMap")
+__all__ = ("CLAMP", "HIT", "MISS", "ScanMap", "normals")
 
 Array = NDArray[np.float64]
 
@@ -34,6 +34,29 @@ MISS = 0.4
 """Log-odds taken from a cell a beam passes through (p = 0.4)."""
 CLAMP = 5.0
 """Log-odds bound, both ways: a cell can change its mind within ~6-12 scans."""
+
+
+def normals(x: Array, y: Array, resolution: float) -> tuple[Array, Array]:
+    """Unit normals of a scan's returns (in beam order) from their two neighbours:
+    perpendicular to the chord from the previous return to the next when both lie
+    within ``4 * resolution + 10 %`` of the return's distance from them (one surface);
+    (0, 0) where they do not (an edge, a lone return)."""
+    n = x.shape[0]
+    out_x, out_y = np.zeros(n), np.zeros(n)
+    if n < 3:
+        return out_x, out_y
+    tx = x[2:] - x[:-2]
+    ty = y[2:] - y[:-2]
+    chord = np.hypot(tx, ty)
+    back = np.hypot(x[1:-1] - x[:-2], y[1:-1] - y[:-2])
+    ahead = np.hypot(x[2:] - x[1:-1], y[2:] - y[1:-1])
+    limit = 4.0 * resolution
+    # one surface: both neighbours near, and the middle return close to the chord
+    straight = (back < limit) & (ahead < limit) & (chord > 0.0) & (back + ahead < 1.1 * chord)
+    safe = np.where(chord > 0.0, chord, 1.0)
+    out_x[1:-1] = np.where(straight, -ty / safe, 0.0)
+    out_y[1:-1] = np.where(straight, tx / safe, 0.0)
+    return out_x, out_y
 
 
 class ScanMap:
@@ -74,6 +97,14 @@ class ScanMap:
         self._width = width
         self._field = np.full((width, width), max_distance, dtype=np.float64)
         self._flat = self._field.reshape(-1)
+        # Per cell, the index of the nearest stored return (-1: none within the cap);
+        # the stored returns (the first one of each occupied cell) and their normals.
+        self._nearest = np.full((width, width), -1, dtype=np.intp)
+        self._nearest_flat = self._nearest.reshape(-1)
+        self._px = np.zeros(1024, dtype=np.float64)
+        self._py = np.zeros(1024, dtype=np.float64)
+        self._nx = np.zeros(1024, dtype=np.float64)
+        self._ny = np.zeros(1024, dtype=np.float64)
         self._offsets = np.arange(-k, k + 1, dtype=np.float64) * resolution
         self.cells = 0
         """How many cells have held a return."""
@@ -98,25 +129,47 @@ class ScanMap:
         fresh = flat[~occupied[flat]]
         if fresh.size == 0:
             return 0
-        # Each new cell's first return (the first of the scan's in it): its distances
-        # to the window's cell centres, capped, stamped with np.minimum.
+        # Each new cell keeps the first of the scan's returns in it, with its normal:
+        # its distances to the window's cell centres, capped, stamped with np.minimum,
+        # and where it is now the nearest, its index.
         order = np.argsort(fresh, kind="stable")
         cells, first = np.unique(fresh[order], return_index=True)
         index = np.flatnonzero(inside)[~occupied[flat]][order[first]]
+        nx, ny = normals(x, y, self.resolution)
         span, offsets, field, n = 2 * self._k + 1, self._offsets, self._field, self.size
-        res, cap = self.resolution, self.max_distance
-        for cell, px, py in zip(cells.tolist(), x[index].tolist(), y[index].tolist(), strict=True):
+        res, cap, nearest = self.resolution, self.max_distance, self._nearest
+        count = self.cells
+        self._grow(count + int(cells.size))
+        self._px[count : count + cells.size] = x[index]
+        self._py[count : count + cells.size] = y[index]
+        self._nx[count : count + cells.size] = nx[index]
+        self._ny[count : count + cells.size] = ny[index]
+        for i, (cell, px, py) in enumerate(
+            zip(cells.tolist(), x[index].tolist(), y[index].tolist(), strict=True)
+        ):
             occupied[cell] = True
             r, c = divmod(cell, n)  # the window's corner: (r + pad - k, c + pad - k)
             # the point relative to its cell's centre, then to every window centre
             ox = px - (self.origin_x + (c + 0.5) * res)
             oy = py - (self.origin_y + (r + 0.5) * res)
             disk = np.hypot(offsets[None, :] - ox, offsets[:, None] - oy)
-            np.minimum(disk, cap, out=disk)
             window = field[r + 1 : r + 1 + span, c + 1 : c + 1 + span]
+            closer = disk < window
+            np.minimum(disk, cap, out=disk)
             np.minimum(window, disk, out=window)
+            nearest[r + 1 : r + 1 + span, c + 1 : c + 1 + span][closer] = count + i
         self.cells += int(cells.size)
         return int(cells.size)
+
+    def _grow(self, need: int) -> None:
+        if need <= self._px.shape[0]:
+            return
+        size = max(need, 2 * self._px.shape[0])
+        for name in ("_px", "_py", "_nx", "_ny"):
+            old = getattr(self, name)
+            new = np.zeros(size, dtype=np.float64)
+            new[: old.shape[0]] = old
+            setattr(self, name, new)
 
     def _misses(self, sx: float, sy: float, x: Array, y: Array) -> None:
         """Lower the log-odds of every cell a beam crosses before its return's cell
@@ -168,6 +221,18 @@ class ScanMap:
         row = np.clip(np.floor((y - self.origin_y) * inv) + pad, 0, hi).astype(np.intp)
         out: Array = self._flat[row * self._width + col]
         return out
+
+    def correspond(self, x: Array, y: Array) -> tuple[Array, Array, Array, Array, Array]:
+        """For each point, the stored return nearest its cell (within ``max_distance``)
+        and that return's unit normal (0, 0 where the scan could not tell one): x, y,
+        normal x, normal y, and whether there is one at all."""
+        inv, pad, hi = 1.0 / self.resolution, self._pad, self._width - 1
+        col = np.clip(np.floor((x - self.origin_x) * inv) + pad, 0, hi).astype(np.intp)
+        row = np.clip(np.floor((y - self.origin_y) * inv) + pad, 0, hi).astype(np.intp)
+        index = self._nearest_flat[row * self._width + col]
+        found = index >= 0
+        index = np.where(found, index, 0)
+        return self._px[index], self._py[index], self._nx[index], self._ny[index], found
 
     def distance(self, x: Array, y: Array) -> tuple[Array, Array, Array]:
         """The distance field at the points, interpolated bilinearly between cell

@@ -168,27 +168,48 @@ def correlative_search(
     return best, best_cost
 
 
-def _cost(
+class _Linearized(NamedTuple):
+    cost: float
+    r: Array
+    """per point residual, m (0 for outliers)"""
+    jx: Array
+    jy: Array
+    """d r / d (x, y) per point"""
+    inliers: NDArray[np.bool_]
+
+
+def _linearize(
     grid: ScanMap, points: Array, pose: Pose, prediction: Pose, params: MatchParams
-) -> tuple[float, Array, Array, Array, NDArray[np.bool_]]:
-    """The refinement's cost at ``pose``, and per point: distance, gradient, inlier."""
+) -> _Linearized:
+    """The refinement's cost at ``pose``: each point against the stored return nearest
+    its cell (:meth:`ScanMap.correspond`), along that return's normal (point to line)
+    or, where it has none, straight (point to point); points with no return within
+    ``max_distance`` are left out. Plus the prior."""
     px, py = transform(pose, points)
-    d, gx, gy = grid.distance(px, py)
-    inlier = d < params.max_distance
-    r: Array = np.where(inlier, d, 0.0)
-    ex, ey = pose[0] - prediction[0], pose[1] - prediction[1]
+    qx, qy, nx, ny, found = grid.correspond(px, py)
+    ex, ey = px - qx, py - qy
+    dist = np.hypot(ex, ey)
+    inliers = found & (dist < params.max_distance)
+    has_normal = (nx != 0.0) | (ny != 0.0)
+    safe = np.where(dist > 1e-9, dist, 1.0)
+    jx = np.where(has_normal, nx, ex / safe)
+    jy = np.where(has_normal, ny, ey / safe)
+    r: Array = np.where(inliers, np.where(has_normal, nx * ex + ny * ey, dist), 0.0)
+    jx = np.where(inliers, jx, 0.0)
+    jy = np.where(inliers, jy, 0.0)
+    ex0, ey0 = pose[0] - prediction[0], pose[1] - prediction[1]
     ea = params.yaw_scale * wrap_angle(pose[2] - prediction[2])
-    cost = float(r @ r) + params.prior * (ex * ex + ey * ey + ea * ea)
-    return cost, r, gx, gy, inlier
+    cost = float(r @ r) + params.prior * (ex0 * ex0 + ey0 * ey0 + ea * ea)
+    return _Linearized(cost, r, jx, jy, inliers)
 
 
 def refine(
     grid: ScanMap, points: Array, start: Pose, prediction: Pose, params: MatchParams
 ) -> tuple[Pose, int]:
-    """Gauss-Newton (damped) from ``start`` (module docstring); the pose and the
-    number of steps taken."""
+    """Damped Gauss-Newton from ``start`` (module docstring), the correspondences
+    looked up again at every step (ICP); the pose and the number of steps taken."""
     pose = start
-    cost, r, gx, gy, inlier = _cost(grid, points, pose, prediction, params)
+    lin = _linearize(grid, points, pose, prediction, params)
     damping = 0.0
     prior = params.prior
     w2 = prior * params.yaw_scale**2
@@ -198,12 +219,9 @@ def refine(
         # d(point)/d(yaw) = R'(yaw) p
         dpx = -s * points[:, 0] - c * points[:, 1]
         dpy = c * points[:, 0] - s * points[:, 1]
-        m = inlier.astype(np.float64)
-        jx, jy = gx * m, gy * m
-        ja = jx * dpx + jy * dpy
-        J = np.stack((jx, jy, ja), axis=1)
+        J = np.stack((lin.jx, lin.jy, lin.jx * dpx + lin.jy * dpy), axis=1)
         H = J.T @ J
-        g = J.T @ r
+        g = J.T @ lin.r
         ex, ey = pose[0] - prediction[0], pose[1] - prediction[1]
         ea = wrap_angle(pose[2] - prediction[2])
         H += np.diag((prior, prior, w2))
@@ -213,9 +231,9 @@ def refine(
             A = H + damping * np.diag(np.diag(H))
             delta = np.linalg.solve(A, -g)
             trial = (pose[0] + delta[0], pose[1] + delta[1], wrap_angle(pose[2] + delta[2]))
-            t_cost, t_r, t_gx, t_gy, t_in = _cost(grid, points, trial, prediction, params)
-            if t_cost <= cost:
-                pose, cost, r, gx, gy, inlier = trial, t_cost, t_r, t_gx, t_gy, t_in
+            t_lin = _linearize(grid, points, trial, prediction, params)
+            if t_lin.cost <= lin.cost:
+                pose, lin = trial, t_lin
                 damping = damping * 0.1 if damping > 1e-6 else 0.0
                 accepted = True
                 break
@@ -236,10 +254,8 @@ def match_scan(grid: ScanMap, points: Array, prediction: Pose, params: MatchPara
         return MatchResult(prediction, False, 0.0, math.nan, 0)
     coarse, _ = correlative_search(grid, points, prediction, params)
     pose, steps = refine(grid, points, coarse, prediction, params)
-    px, py = transform(pose, points)
-    d, _, _ = grid.distance(px, py)
-    inlier = d < params.max_distance
-    share = float(inlier.mean())
-    rms = float(np.sqrt((d[inlier] ** 2).mean())) if inlier.any() else math.nan
+    lin = _linearize(grid, points, pose, prediction, params)
+    share = float(lin.inliers.mean())
+    rms = float(np.sqrt((lin.r[lin.inliers] ** 2).mean())) if lin.inliers.any() else math.nan
     ok = share >= params.min_inliers
     return MatchResult(pose if ok else prediction, ok, share, rms, steps)
