@@ -24,7 +24,6 @@ import asyncio
 import math
 import statistics
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -33,8 +32,16 @@ from otonav.actors.localizer import Localizer
 from otonav.hal import RobotHardwareInterface
 from otonav.msgs import Header, NavState, Point, Pose, PoseStamped, Time
 from otonav.nav.geometry import wrap_angle
-from otonav.runtime import LATCHED_QOS, Actor, Input, Output, QoS, Reliability
-from otonav.runtime import until, virtual_loop_factory
+from otonav.runtime import (
+    LATCHED_QOS,
+    Actor,
+    Input,
+    Output,
+    QoS,
+    Reliability,
+    until,
+    virtual_loop_factory,
+)
 from otonav.scenario.builtin import CLUTTERED
 from otonav.scenario.run import scenario_world
 from otonav.stack import StackConfig, build_actors
@@ -109,7 +116,7 @@ class Route(Actor):
         )
 
 
-def _probe(nav: Any, hal: RobotHardwareInterface, figures: Figures) -> Callable[[], None]:
+def _probe(nav: Any, hal: RobotHardwareInterface, figures: Figures) -> None:
     """After each navigator step: its pose (odom, or map with localization) against
     ground truth."""
     step = nav._step
@@ -125,7 +132,6 @@ def _probe(nav: Any, hal: RobotHardwareInterface, figures: Figures) -> Callable[
         figures.yaw_errors.append(abs(math.degrees(wrap_angle(pose[2] - truth.yaw))))
 
     nav._step = probed
-    return probed
 
 
 def _timed(localizer: Localizer, figures: Figures) -> None:
@@ -186,7 +192,7 @@ def main() -> None:
         "gyro_noise": args.gyro_noise,
         "seed": args.seed,
     }
-    runs = (
+    runs: tuple[tuple[str, dict[str, Any], bool], ...] = (
         ("odometry as simulated", {}, False),
         ("odometry error, no localization", error, False),
         ("odometry error, localization", error, True),
@@ -210,11 +216,7 @@ def main() -> None:
             f"pose error end {errors[-1]:.3f} m / {yaws[-1]:.2f} deg, "
             f"median {statistics.median(errors):.3f} m, max {max(errors):.3f} m  "
             f"reached {figures.reached}, false {len(figures.false_reached)}"
-            + (
-                f" (up to {max(figures.false_reached):.2f} m off)"
-                if figures.false_reached
-                else ""
-            )
+            + (f" (up to {max(figures.false_reached):.2f} m off)" if figures.false_reached else "")
             + f"  RTF {sim / wall:.1f}"
         )
         if figures.costs:

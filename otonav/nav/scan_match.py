@@ -10,13 +10,17 @@ base_link. Two stages, both deterministic:
    plus a small pull toward the prediction (``prior``): where the map cannot tell
    poses apart (a corridor's length) the prediction wins, and an exact tie goes to the
    candidate nearest it.
-2. **Gauss-Newton** (Hector SLAM's refinement) from the best candidate, on the
-   interpolated distance field (:meth:`ScanMap.distance`): minimise
-   ``sum(d_i^2) + prior * |pose - prediction|^2`` (yaw weighted by ``yaw_scale`` m per
-   rad); points farther than ``max_distance`` from any mapped cell (new ground, or
-   outliers) are left out. The prior keeps a direction the scan does not constrain at
-   the prediction instead of letting it wander (a corridor, a single wall). Each step
-   is accepted only if it lowers the cost (Levenberg-Marquardt damping otherwise).
+2. **Gauss-Newton** (Hector SLAM's refinement, on point-to-line residuals as in
+   point-to-plane ICP), from the prediction and, when the search found another best
+   candidate, from that one too; the lower final cost wins. Each scan point is paired
+   with the stored return nearest its cell (:meth:`ScanMap.correspond`, looked up again
+   at every step) and its residual is the distance along that return's normal;
+   minimise ``sum(r_i^2) + prior * |pose - prediction|^2`` (yaw weighted by
+   ``yaw_scale`` m per rad). Points farther than ``max_distance`` from any stored
+   return (new ground, outliers) are left out. The prior keeps a direction the scan
+   does not constrain at the prediction instead of letting it wander (a corridor, a
+   single wall). Each step is accepted only if it lowers the cost
+   (Levenberg-Marquardt damping otherwise).
 
 A match is trusted (``ok``) when at least ``min_inliers`` of the points lie within
 ``max_distance`` of the map; otherwise the caller keeps its prediction.
@@ -182,21 +186,17 @@ def _linearize(
     grid: ScanMap, points: Array, pose: Pose, prediction: Pose, params: MatchParams
 ) -> _Linearized:
     """The refinement's cost at ``pose``: each point against the stored return nearest
-    its cell (:meth:`ScanMap.correspond`), along that return's normal (point to line)
-    or, where it has none, straight (point to point); points with no return within
-    ``max_distance`` are left out. Plus the prior."""
+    its cell (:meth:`ScanMap.correspond`), along that return's normal (point to line);
+    points with no return within ``max_distance``, or whose return has no normal (an
+    edge, a lone return: point to point would invent constraints along a wall from
+    where the returns happened to fall), are left out. Plus the prior."""
     px, py = transform(pose, points)
     qx, qy, nx, ny, found = grid.correspond(px, py)
     ex, ey = px - qx, py - qy
-    dist = np.hypot(ex, ey)
-    inliers = found & (dist < params.max_distance)
-    has_normal = (nx != 0.0) | (ny != 0.0)
-    safe = np.where(dist > 1e-9, dist, 1.0)
-    jx = np.where(has_normal, nx, ex / safe)
-    jy = np.where(has_normal, ny, ey / safe)
-    r: Array = np.where(inliers, np.where(has_normal, nx * ex + ny * ey, dist), 0.0)
-    jx = np.where(inliers, jx, 0.0)
-    jy = np.where(inliers, jy, 0.0)
+    inliers = found & (np.hypot(ex, ey) < params.max_distance) & ((nx != 0.0) | (ny != 0.0))
+    r: Array = np.where(inliers, nx * ex + ny * ey, 0.0)
+    jx = np.where(inliers, nx, 0.0)
+    jy = np.where(inliers, ny, 0.0)
     ex0, ey0 = pose[0] - prediction[0], pose[1] - prediction[1]
     ea = params.yaw_scale * wrap_angle(pose[2] - prediction[2])
     cost = float(r @ r) + params.prior * (ex0 * ex0 + ey0 * ey0 + ea * ea)
@@ -253,8 +253,15 @@ def match_scan(grid: ScanMap, points: Array, prediction: Pose, params: MatchPara
     if n == 0 or grid.cells == 0:
         return MatchResult(prediction, False, 0.0, math.nan, 0)
     coarse, _ = correlative_search(grid, points, prediction, params)
-    pose, steps = refine(grid, points, coarse, prediction, params)
+    pose, steps = refine(grid, points, prediction, prediction, params)
     lin = _linearize(grid, points, pose, prediction, params)
+    if coarse != prediction:
+        # the search's best may be another basin: refine it too, keep the lower cost
+        # (where the map cannot tell, the prior makes that the prediction's)
+        other, other_steps = refine(grid, points, coarse, prediction, params)
+        other_lin = _linearize(grid, points, other, prediction, params)
+        if other_lin.cost < lin.cost:
+            pose, steps, lin = other, other_steps, other_lin
     share = float(lin.inliers.mean())
     rms = float(np.sqrt((lin.r[lin.inliers] ** 2).mean())) if lin.inliers.any() else math.nan
     ok = share >= params.min_inliers

@@ -1,0 +1,312 @@
+"""The localization math (otonav.nav.scan_map, otonav.nav.scan_match): a known transform
+is recovered from synthetic scans of a known world, a corridor's unconstrained length
+stays at the prediction, an empty or foreign map is not trusted, and the map's fields
+hold what they say."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from numpy.typing import NDArray
+
+from otonav.nav.scan_map import CLAMP, HIT, MISS, ScanMap, normals
+from otonav.nav.scan_match import (
+    MatchParams,
+    compose,
+    correlative_search,
+    inverse,
+    match_scan,
+    refine,
+    transform,
+)
+
+pytestmark = pytest.mark.unit
+
+Segment = tuple[float, float, float, float]
+
+
+def box(cx: float, cy: float, hx: float, hy: float) -> list[Segment]:
+    c = [(cx - hx, cy - hy), (cx + hx, cy - hy), (cx + hx, cy + hy), (cx - hx, cy + hy)]
+    return [(*c[i], *c[(i + 1) % 4]) for i in range(4)]
+
+
+def scan(
+    segments: list[Segment], pose: tuple[float, float, float], beams: int = 360
+) -> NDArray[np.float64]:
+    """The returns (base_link, ``(N, 2)``) of a 360-degree lidar at ``pose`` among
+    ``segments``: exact ray casting, 8 m range."""
+    x, y, yaw = pose
+    a = np.arange(beams) * 2 * math.pi / beams
+    dx, dy = np.cos(a + yaw), np.sin(a + yaw)
+    s = np.asarray(segments, dtype=np.float64)
+    ex, ey = s[:, 2] - s[:, 0], s[:, 3] - s[:, 1]
+    den = dx[:, None] * ey[None, :] - dy[:, None] * ex[None, :]
+    wx, wy = s[None, :, 0] - x, s[None, :, 1] - y
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (wx * ey[None, :] - wy * ex[None, :]) / den
+        u = (wx * dy[:, None] - wy * dx[:, None]) / den
+    ok = (np.abs(den) > 1e-12) & (t > 0) & (u >= 0) & (u <= 1)
+    r = np.where(ok, t, np.inf).min(axis=1)
+    hit = r <= 8.0
+    return np.stack((r[hit] * np.cos(a[hit]), r[hit] * np.sin(a[hit])), axis=1)
+
+
+ROOM = box(0, 0, 5, 5) + box(1, 1, 0.4, 0.3) + box(-2, 2, 0.5, 0.5) + box(2, -2.5, 0.3, 0.8)
+CORRIDOR: list[Segment] = [(-20, -1, 20, -1), (-20, 1, 20, 1)]
+
+
+def mapped(world: list[Segment], *poses: tuple[float, float, float], half: float = 8.0) -> ScanMap:
+    grid = ScanMap(0.0, 0.0, half_size=half, resolution=0.05, max_distance=0.3)
+    for pose in poses:
+        x, y = transform(pose, scan(world, pose))
+        grid.insert(pose[0], pose[1], x, y)
+    return grid
+
+
+def error(a: tuple[float, float, float], b: tuple[float, float, float]) -> tuple[float, float]:
+    return math.hypot(a[0] - b[0], a[1] - b[1]), abs(math.remainder(a[2] - b[2], math.tau))
+
+
+# -- poses ------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("a", [(0.0, 0.0, 0.0), (1.5, -2.0, 0.7), (-3.0, 0.5, -2.9)])
+def test_compose_with_the_inverse_is_the_identity(a: tuple[float, float, float]) -> None:
+    for pose in (compose(a, inverse(a)), compose(inverse(a), a)):
+        assert pose == pytest.approx((0.0, 0.0, 0.0), abs=1e-12)
+
+
+def test_compose_moves_then_turns_in_the_first_frame() -> None:
+    assert compose((1.0, 2.0, math.pi / 2), (1.0, 0.0, 0.5)) == pytest.approx(
+        (1.0, 3.0, math.pi / 2 + 0.5)
+    )
+    assert compose((0.0, 0.0, 3.0), (0.0, 0.0, 0.5))[2] == pytest.approx(3.5 - math.tau)
+
+
+def test_transform_agrees_with_compose() -> None:
+    pose = (0.3, -1.2, 2.1)
+    pts = np.array([[1.0, 0.0], [0.5, -2.0], [0.0, 0.0]])
+    x, y = transform(pose, pts)
+    for i in range(3):
+        expected = compose(pose, (pts[i, 0], pts[i, 1], 0.0))
+        assert (x[i], y[i]) == pytest.approx(expected[:2])
+
+
+# -- the map ----------------------------------------------------------------------------
+
+
+def test_the_distance_field_is_the_distance_to_the_stored_return_capped() -> None:
+    grid = ScanMap(0.0, 0.0, half_size=2.0, resolution=0.1, max_distance=0.35)
+    assert grid.insert(-1.0, 0.0, np.array([0.03]), np.array([0.01])) == 1
+    # cell centres at 0.05 + 0.1 k: (0.05, 0.05) is 0.0283 from the return
+    d = grid.nearest(np.array([0.05, 0.25, 0.05, 1.0]), np.array([0.05, 0.05, -0.15, 1.0]))
+    assert d == pytest.approx(
+        [math.hypot(0.02, 0.04), math.hypot(0.22, 0.04), math.hypot(0.02, 0.16), 0.35]
+    )
+    assert grid.cells == 1
+    # the same cell again: no new cell, the field unchanged
+    assert grid.insert(-1.0, 0.0, np.array([0.07]), np.array([0.08])) == 0
+    assert grid.nearest(np.array([0.05]), np.array([0.05]))[0] == pytest.approx(
+        math.hypot(0.02, 0.04)
+    )
+
+
+def test_correspond_gives_the_nearest_stored_return_and_none_beyond_the_cap() -> None:
+    grid = ScanMap(0.0, 0.0, half_size=2.0, resolution=0.1, max_distance=0.3)
+    grid.insert(-1.0, 0.0, np.array([0.02, 0.51]), np.array([0.0, 0.0]))
+    qx, qy, _, _, found = grid.correspond(np.array([0.1, 0.4, 1.5]), np.array([0.0, 0.0, 0.0]))
+    assert found.tolist() == [True, True, False]
+    assert qx[:2].tolist() == [0.02, 0.51]
+    assert qy[:2].tolist() == [0.0, 0.0]
+
+
+def test_normals_of_a_straight_wall_are_perpendicular_and_an_edge_has_none() -> None:
+    x = np.array([0.0, 0.05, 0.1, 0.15, 2.0])
+    y = np.array([1.0, 1.0, 1.0, 1.0, 1.0])
+    nx, ny = normals(x, y, 0.05)
+    assert nx[1:3] == pytest.approx([0.0, 0.0])
+    assert np.abs(ny[1:3]) == pytest.approx([1.0, 1.0])
+    # ends, and a return whose neighbour is 1.85 m away, have none
+    assert (nx[[0, 3, 4]] == 0).all()
+    assert (ny[[0, 3, 4]] == 0).all()
+
+
+def test_normals_of_a_corner_are_left_out() -> None:
+    x = np.array([0.0, 0.1, 0.1])
+    y = np.array([0.0, 0.0, 0.1])
+    nx, ny = normals(x, y, 0.05)
+    assert nx[1] == 0.0
+    assert ny[1] == 0.0
+
+
+def test_occupancy_hits_misses_and_unknown() -> None:
+    grid = ScanMap(0.0, 0.0, half_size=1.0, resolution=0.1, max_distance=0.3)
+    grid.insert(-0.95, 0.05, np.array([0.55]), np.array([0.05]))
+    row0, col0, height, width, cells = grid.occupancy()
+    # the beam's row, from the sensor's cell (col 0) to the return's (col 15)
+    assert (row0, col0, height, width) == (10, 0, 1, 16)
+    expected_hit = round(100 / (1 + math.exp(-HIT)))
+    expected_miss = round(100 / (1 + math.exp(MISS)))
+    assert cells[-1] == expected_hit
+    assert (cells[:-1] == expected_miss).all()
+    for _ in range(20):
+        grid.insert(-0.95, 0.05, np.array([0.55]), np.array([0.05]))
+    odds = grid.log_odds[10]
+    assert odds[15] == pytest.approx(CLAMP)
+    assert odds[0] == pytest.approx(-CLAMP)
+    assert grid.occupancy()[4][-1] == round(100 / (1 + math.exp(-CLAMP)))
+
+
+def test_an_empty_map_knows_nothing() -> None:
+    grid = ScanMap(0.0, 0.0, half_size=1.0, resolution=0.1)
+    assert grid.occupancy()[:4] == (0, 0, 0, 0)
+    assert grid.nearest(np.array([0.0]), np.array([0.0]))[0] == grid.max_distance
+
+
+@pytest.mark.parametrize(
+    ("name", "kwargs"),
+    [("half_size", {"half_size": 0.0}), ("resolution", {"resolution": math.nan})],
+)
+def test_bad_map_settings_are_refused(name: str, kwargs: dict[str, float]) -> None:
+    with pytest.raises(ValueError, match=name):
+        ScanMap(0.0, 0.0, **kwargs)
+
+
+# -- matching ---------------------------------------------------------------------------
+
+TRUE = (0.3, -0.2, 0.2)
+
+
+@pytest.mark.parametrize(
+    "offset",
+    [
+        (0.0, 0.0, 0.0),
+        (0.07, -0.04, 0.03),
+        (-0.09, 0.08, -0.05),
+        (0.1, 0.1, 0.06),
+        (0.02, 0.0, -0.01),
+    ],
+)
+def test_a_known_transform_is_recovered(offset: tuple[float, float, float]) -> None:
+    grid = mapped(ROOM, (0.0, 0.0, 0.0))
+    points = scan(ROOM, TRUE)
+    prediction = (TRUE[0] + offset[0], TRUE[1] + offset[1], TRUE[2] + offset[2])
+    result = match_scan(grid, points, prediction, MatchParams())
+    assert result.ok
+    assert result.inliers > 0.9
+    distance, yaw = error(result.pose, TRUE)
+    assert distance < 0.01
+    assert yaw < 0.005
+
+
+def test_the_match_is_deterministic() -> None:
+    grid = mapped(ROOM, (0.0, 0.0, 0.0))
+    points = scan(ROOM, TRUE)
+    prediction = (0.37, -0.24, 0.23)
+    assert match_scan(grid, points, prediction, MatchParams()) == match_scan(
+        grid, points, prediction, MatchParams()
+    )
+
+
+def test_a_scan_from_the_mapped_pose_matches_exactly() -> None:
+    pose = (0.5, 0.5, 0.3)
+    grid = mapped(ROOM, pose)
+    result = match_scan(grid, scan(ROOM, pose), (0.55, 0.47, 0.33), MatchParams())
+    distance, yaw = error(result.pose, pose)
+    # a cell keeps its first return only: the others match it along its normal
+    assert distance < 3e-3
+    assert yaw < 1e-3
+    assert result.rms < 0.01
+
+
+def test_the_correlative_search_lands_within_one_step_of_the_truth() -> None:
+    grid = mapped(ROOM, (0.0, 0.0, 0.0))
+    params = MatchParams()
+    prediction = (TRUE[0] + 0.1, TRUE[1] - 0.1, TRUE[2] + 0.06)
+    best, cost = correlative_search(grid, scan(ROOM, TRUE), prediction, params)
+    distance, yaw = error(best, TRUE)
+    assert distance <= math.sqrt(2) * params.linear_step / 2 + 0.01
+    assert yaw <= params.angular_step / 2 + 1e-9
+    # it improved on the prediction's own cost
+    _, at_prediction = correlative_search(
+        grid,
+        scan(ROOM, TRUE),
+        prediction,
+        MatchParams(linear_window=0.0, angular_window=0.0),
+    )
+    assert cost < at_prediction
+
+
+def test_a_corridor_keeps_its_length_from_the_prediction_and_fixes_the_rest() -> None:
+    grid = mapped(CORRIDOR, (0.0, 0.0, 0.0), half=10.0)
+    truth = (0.5, 0.1, 0.05)
+    prediction = (0.65, 0.15, 0.03)  # 15 cm too far along the corridor, 5 cm across
+    result = match_scan(grid, scan(CORRIDOR, truth), prediction, MatchParams())
+    assert result.ok
+    x, y, yaw = result.pose
+    assert y == pytest.approx(truth[1], abs=0.005)  # across: measured
+    assert yaw == pytest.approx(truth[2], abs=0.003)
+    assert x == pytest.approx(prediction[0], abs=0.01)  # along: the prediction, no drift
+
+
+def test_refinement_without_the_prior_may_slide_along_a_corridor_but_not_with_it() -> None:
+    grid = mapped(CORRIDOR, (0.0, 0.0, 0.0), half=10.0)
+    truth = (0.5, 0.0, 0.0)
+    prediction = (0.62, 0.04, 0.0)
+    pose, steps = refine(grid, scan(CORRIDOR, truth), prediction, prediction, MatchParams())
+    assert steps >= 1
+    assert pose[0] == pytest.approx(prediction[0], abs=0.005)
+    assert pose[1] == pytest.approx(0.0, abs=0.005)
+
+
+def test_an_empty_map_is_not_trusted() -> None:
+    grid = ScanMap(0.0, 0.0, half_size=5.0)
+    prediction = (1.0, 2.0, 0.3)
+    result = match_scan(grid, scan(ROOM, TRUE), prediction, MatchParams())
+    assert not result.ok
+    assert result.pose == prediction
+
+
+def test_a_scan_of_another_world_is_not_trusted() -> None:
+    grid = mapped(box(0, 0, 5, 5), (0.0, 0.0, 0.0))
+    elsewhere = [(-1.5, -3.0, -1.5, 3.0), (1.7, -3.0, 1.7, 3.0)]  # nowhere near the walls
+    prediction = (0.0, 0.0, 0.0)
+    result = match_scan(grid, scan(elsewhere, prediction), prediction, MatchParams())
+    assert not result.ok
+    assert result.inliers < MatchParams().min_inliers
+    assert result.pose == prediction
+
+
+def test_no_points_is_not_trusted() -> None:
+    grid = mapped(ROOM, (0.0, 0.0, 0.0))
+    result = match_scan(grid, np.empty((0, 2)), (0.1, 0.0, 0.0), MatchParams())
+    assert not result.ok
+    assert result.pose == (0.1, 0.0, 0.0)
+
+
+def test_refinement_recovers_what_the_search_window_does_not_cover() -> None:
+    grid = mapped(ROOM, (0.0, 0.0, 0.0))
+    prediction = (TRUE[0] + 0.04, TRUE[1] - 0.03, TRUE[2] + 0.02)
+    result = match_scan(
+        grid, scan(ROOM, TRUE), prediction, MatchParams(linear_window=0.0, angular_window=0.0)
+    )
+    assert error(result.pose, TRUE)[0] < 0.01
+    assert result.iterations >= 1
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [
+        ("linear_step", 0.0),
+        ("angular_step", -1.0),
+        ("max_distance", math.inf),
+        ("prior", -1.0),
+        ("min_inliers", 1.5),
+        ("iterations", -1),
+    ],
+)
+def test_bad_match_settings_are_refused(field: str, value: float) -> None:
+    with pytest.raises(ValueError, match=field):
+        MatchParams(**{field: value})  # type: ignore[arg-type]
