@@ -53,8 +53,8 @@ class OdometryErrorConfig(_Section):
     /tf odom -> base_link). /imu and ground truth are untouched."""
 
     scale: float = Field(0.0, ge=-0.2, le=0.2)
-    """Fraction added to every distance the wheels report (a wheel radius off by that
-    fraction), dimensionless, in [-0.2, 0.2]."""
+    """m added per m driven: every distance the wheels report is scaled by 1 + scale (a
+    wheel radius off by that fraction), in [-0.2, 0.2]."""
     gyro_bias: float = Field(0.0, ge=-0.5, le=0.5)
     """rad/s added to the yaw rate odometry integrates (heading drifts by it), in
     [-0.5, 0.5]."""

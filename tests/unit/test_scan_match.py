@@ -9,6 +9,7 @@ import math
 
 import numpy as np
 import pytest
+from synthetic_scans import CORRIDOR, ROOM, Segment, box, scan
 
 from otonav.nav.scan_map import CLAMP, HIT, MISS, ScanMap, normals
 from otonav.nav.scan_match import (
@@ -20,7 +21,6 @@ from otonav.nav.scan_match import (
     refine,
     transform,
 )
-from tests.unit.synthetic_scans import CORRIDOR, ROOM, Segment, box, scan
 
 pytestmark = pytest.mark.unit
 

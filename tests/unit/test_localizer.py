@@ -8,6 +8,8 @@ import math
 import anyio
 import numpy as np
 import pytest
+from numpy.typing import NDArray
+from synthetic_scans import ROOM, box, scan
 
 from otonav.actors import Bridge, topics
 from otonav.actors.localized_navigator import LocalizedNavigator
@@ -20,7 +22,6 @@ from otonav.nav.scan_match import compose, inverse
 from otonav.record.cdr import encode
 from otonav.record.cdr_decode import decode
 from otonav.runtime import QoS, Reliability, System, virtual_loop_factory
-from tests.unit.synthetic_scans import ROOM, box, scan
 
 pytestmark = pytest.mark.unit
 
@@ -53,9 +54,12 @@ def test_the_first_scan_is_taken_where_odometry_says_and_the_map_grows_on_motion
         LocalizerParams(update_distance=0.2, update_angle=0.5), laser_offset_x=0.1
     )
 
-    def seen(pose: tuple[float, float, float]) -> np.ndarray:
+    def seen(pose: tuple[float, float, float]) -> NDArray[np.float64]:
         """The scan from the laser 0.1 m ahead, in base_link."""
-        return scan(ROOM, compose(pose, (0.1, 0.0, 0.0))) + np.array([0.1, 0.0])
+        points: NDArray[np.float64] = scan(ROOM, compose(pose, (0.1, 0.0, 0.0))) + np.array(
+            [0.1, 0.0]
+        )
+        return points
 
     start = (0.5, -0.5, 0.4)
     assert localizer.update(start, seen(start)) == start
