@@ -174,28 +174,32 @@ class ScanMap:
             setattr(self, name, new)
 
     def _misses(self, sx: float, sy: float, x: Array, y: Array) -> None:
-        """Lower the log-odds of every cell a beam crosses before its return's cell
-        (each cell once per scan), sampled every half cell."""
+        """Lower the log-odds of the cells each beam crosses before its return's cell
+        (each cell once per scan), sampled every cell along the beam (a beam may skip
+        a cell it only clips: this is the picture on /map, not what scans match to)."""
         if x.shape[0] == 0:
             return
-        dx, dy = x - sx, y - sy
-        length = np.hypot(dx, dy)
-        step = 0.5 * self.resolution
-        count = math.ceil(float(length.max()) / step)
-        if count <= 0:
+        inv, n = 1.0 / self.resolution, self.size
+        # in cells from the map's origin
+        u0, v0 = (sx - self.origin_x) * inv, (sy - self.origin_y) * inv
+        du, dv = (x - sx) * inv, (y - sy) * inv
+        length = np.hypot(du, dv)
+        # samples at 0, 1, ... cells along the beam, up to one cell short of the return
+        counts = (np.floor(length - 1.0) + 1.0).clip(0).astype(np.intp)
+        total = int(counts.sum())
+        if total == 0:
             return
-        t = np.arange(count, dtype=np.float64) * step
-        keep = t[None, :] < (length - self.resolution)[:, None]
-        scale = np.divide(
-            t[None, :],
-            length[:, None],
-            where=length[:, None] > 0,
-            out=np.zeros((length.shape[0], count)),
-        )
-        px = (sx + dx[:, None] * scale)[keep]
-        py = (sy + dy[:, None] * scale)[keep]
-        row, col, inside = self._cells(px, py)
-        flat = (row * self.size + col)[inside]
+        beam = np.repeat(np.arange(x.shape[0]), counts)
+        k = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+        scale = k / length[beam]
+        u = u0 + du[beam] * scale
+        v = v0 + dv[beam] * scale
+        # (a sample one cell short of a diagonal beam's end may share its cell)
+        end = np.floor(v0 + dv) * n + np.floor(u0 + du)
+        inside = (u >= 0.0) & (u < n) & (v >= 0.0) & (v < n)
+        flat = v.astype(np.intp) * n + u.astype(np.intp)
+        inside &= flat != end[beam]
+        flat = flat[inside]
         if flat.size == 0:
             return
         odds = self.log_odds.reshape(-1)

@@ -227,7 +227,7 @@ def refine(
         H += np.diag((prior, prior, w2))
         g += np.array((prior * ex, prior * ey, w2 * ea))
         accepted = False
-        while damping <= 1e6:
+        while damping <= 1.0:
             A = H + damping * np.diag(np.diag(H))
             delta = np.linalg.solve(A, -g)
             trial = (pose[0] + delta[0], pose[1] + delta[1], wrap_angle(pose[2] + delta[2]))
@@ -241,7 +241,7 @@ def refine(
         if not accepted:
             break
         steps += 1
-        if abs(delta[0]) < 1e-5 and abs(delta[1]) < 1e-5 and abs(delta[2]) < 1e-5:
+        if abs(delta[0]) < 1e-4 and abs(delta[1]) < 1e-4 and abs(delta[2]) < 1e-4:
             break
     return pose, steps
 
