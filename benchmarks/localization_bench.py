@@ -13,7 +13,8 @@ For each: metres driven, sim time, the pose error at the end and its median and
 maximum along the way (position, m; yaw, deg; the navigator's pose against ground
 truth, sampled at every scan), the waypoints the navigator called ``reached`` and how
 many of those were false (the robot's true centre farther than the scenarios'
-0.15 m tolerance from the waypoint), the RTF, and with localization the CPU time of
+0.15 m tolerance from the waypoint), whether the navigator gave up (``unreachable``:
+the run then ends), the RTF, and with localization the CPU time of
 one localizer update (match + map update) per scan: median, p99, max.
 """
 
@@ -62,6 +63,7 @@ class Figures:
     false_reached: list[float] = field(default_factory=list)
     costs: list[float] = field(default_factory=list)
     done: bool = False
+    gave_up: str = ""
 
 
 class Route(Actor):
@@ -89,6 +91,10 @@ class Route(Actor):
                 self.figures.driven += math.hypot(x - self._last[0], y - self._last[1])
             self._last = (x, y)
             for state in self.state_in.drain():
+                if state.state == "unreachable":  # lost: its map smeared by the drift
+                    self.figures.gave_up = f"unreachable at {self.clock.now():.0f} s"
+                    self.figures.done = True
+                    return
                 if state.state != "reached":
                     left = True
                     continue
@@ -217,6 +223,7 @@ def main() -> None:
             f"median {statistics.median(errors):.3f} m, max {max(errors):.3f} m  "
             f"reached {figures.reached}, false {len(figures.false_reached)}"
             + (f" (up to {max(figures.false_reached):.2f} m off)" if figures.false_reached else "")
+            + (f"  gave up: {figures.gave_up}" if figures.gave_up else "")
             + f"  RTF {sim / wall:.1f}"
         )
         if figures.costs:
