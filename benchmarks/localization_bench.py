@@ -15,7 +15,9 @@ truth, sampled at every scan), the waypoints the navigator called ``reached`` an
 many of those were false (the robot's true centre farther than the scenarios'
 0.15 m tolerance from the waypoint), whether the navigator gave up (``unreachable``:
 the run then ends), the RTF, and with localization the CPU time of
-one localizer update (match + map update) per scan: median, p99, max.
+one localizer update (match + map update) per scan: median, p99, max. Last, the wall
+time of the built-in ``cluttered`` scenario with localization on over off (``--reps``
+runs each, interleaved).
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ from otonav.runtime import (
     until,
     virtual_loop_factory,
 )
+from otonav.scenario import run_scenario
 from otonav.scenario.builtin import CLUTTERED
 from otonav.scenario.run import scenario_world
 from otonav.stack import StackConfig, build_actors
@@ -178,6 +181,26 @@ def run(stack: StackConfig, distance: float, budget: float) -> tuple[Figures, fl
     return figures, sim, time.perf_counter() - wall
 
 
+def cost_ratio(reps: int) -> None:
+    """Wall time of the built-in ``cluttered`` scenario with localization on / off,
+    interleaved in this process (the first run of each a discarded warm-up)."""
+    off = StackConfig()
+    on = StackConfig.model_validate({"nav": {"localization": {"enabled": True}}})
+    walls: dict[str, list[float]] = {"off": [], "on": []}
+    for rep in range(reps + 1):
+        for label, stack in (("off", off), ("on", on)):
+            verdict = run_scenario(CLUTTERED, stack, record=False, plot=False)
+            if not verdict.passed:
+                print(f"  cluttered with localization {label} failed: {verdict.reason}")
+            if rep > 0:
+                walls[label].append(verdict.wall_time_s)
+    on_s, off_s = statistics.median(walls["on"]), statistics.median(walls["off"])
+    print(
+        f"'cluttered' wall median, localization on {on_s:.3f} s / off {off_s:.3f} s "
+        f"= {on_s / off_s:.2f} ({reps} runs each, interleaved)"
+    )
+
+
 def _ms(values: list[float], q: float) -> float:
     ordered = sorted(values)
     return 1e3 * ordered[min(len(ordered) - 1, math.ceil(q * len(ordered)) - 1)]
@@ -190,6 +213,7 @@ def main() -> None:
     parser.add_argument("--scale", type=float, default=0.01, help="distance scale error")
     parser.add_argument("--gyro-noise", type=float, default=0.01, help="rad/s per sample")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--reps", type=int, default=3, help="runs of the cost ratio")
     args = parser.parse_args()
     budget = args.distance / 0.1 + 60.0
     error = {
@@ -232,6 +256,7 @@ def main() -> None:
                 f"{_ms(figures.costs, 0.5):.2f} ms, p99 {_ms(figures.costs, 0.99):.2f} ms, "
                 f"max {1e3 * max(figures.costs):.2f} ms"
             )
+    cost_ratio(args.reps)
 
 
 if __name__ == "__main__":
