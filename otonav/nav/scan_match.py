@@ -189,17 +189,22 @@ def _linearize(
     its cell (:meth:`ScanMap.correspond`), along that return's normal (point to line);
     points with no return within ``max_distance``, or whose return has no normal (an
     edge, a lone return: point to point would invent constraints along a wall from
-    where the returns happened to fall), are left out. Plus the prior."""
+    where the returns happened to fall), are left out of the fit; those with no return
+    near count ``max_distance^2`` each in the cost. Plus the prior."""
     px, py = transform(pose, points)
     qx, qy, nx, ny, found = grid.correspond(px, py)
     ex, ey = px - qx, py - qy
-    inliers = found & (np.hypot(ex, ey) < params.max_distance) & ((nx != 0.0) | (ny != 0.0))
+    near = found & (np.hypot(ex, ey) < params.max_distance)
+    inliers = near & ((nx != 0.0) | (ny != 0.0))
     r: Array = np.where(inliers, nx * ex + ny * ey, 0.0)
+    # a point with no return near counts as far as the cap (a truncated quadratic):
+    # else a pose that leaves more points unmatched would look better
+    missed = params.max_distance**2 * float(points.shape[0] - int(near.sum()))
     jx = np.where(inliers, nx, 0.0)
     jy = np.where(inliers, ny, 0.0)
     ex0, ey0 = pose[0] - prediction[0], pose[1] - prediction[1]
     ea = params.yaw_scale * wrap_angle(pose[2] - prediction[2])
-    cost = float(r @ r) + params.prior * (ex0 * ex0 + ey0 * ey0 + ea * ea)
+    cost = float(r @ r) + missed + params.prior * (ex0 * ex0 + ey0 * ey0 + ea * ea)
     return _Linearized(cost, r, jx, jy, inliers)
 
 

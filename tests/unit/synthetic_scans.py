@@ -39,3 +39,11 @@ def scan(
 
 ROOM = box(0, 0, 5, 5) + box(1, 1, 0.4, 0.3) + box(-2, 2, 0.5, 0.5) + box(2, -2.5, 0.3, 0.8)
 CORRIDOR: list[Segment] = [(-20, -1, 20, -1), (-20, 1, 20, 1)]
+
+
+def circle(radius: float, sides: int = 360) -> list[Segment]:
+    """A round room centred on the origin (a polygon of ``sides`` sides): a scan from
+    its centre says where the robot is, but not which way it faces."""
+    a = np.arange(sides + 1) * 2 * math.pi / sides
+    x, y = radius * np.cos(a), radius * np.sin(a)
+    return [(x[i], y[i], x[i + 1], y[i + 1]) for i in range(sides)]

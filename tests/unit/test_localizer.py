@@ -166,3 +166,10 @@ def test_the_localized_navigator_works_in_the_map_frame() -> None:
     assert nav._in_frame((1.0, 0.0, 0.0)) == (1.0, 0.0, 0.0)  # no correction yet
     nav.correction = (0.5, -0.2, math.pi / 2)
     assert nav._in_frame((1.0, 0.0, 0.0)) == pytest.approx((0.5, 0.8, math.pi / 2))
+
+
+def test_the_stack_config_defaults_are_the_localizers() -> None:
+    from otonav.stack import StackConfig
+    from otonav.stack.build import localizer_params
+
+    assert localizer_params(StackConfig()) == LocalizerParams()

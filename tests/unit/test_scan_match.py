@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 import pytest
-from synthetic_scans import CORRIDOR, ROOM, Segment, box, scan
+from synthetic_scans import CORRIDOR, ROOM, Segment, box, circle, scan
 
 from otonav.nav.scan_map import CLAMP, HIT, MISS, ScanMap, normals
 from otonav.nav.scan_match import (
@@ -197,6 +197,8 @@ def test_the_correlative_search_lands_within_one_step_of_the_truth() -> None:
     distance, yaw = error(best, TRUE)
     assert distance <= math.sqrt(2) * params.linear_step / 2 + 0.01
     assert yaw <= params.angular_step / 2 + 1e-9
+    # the points fit there: a mean squared distance of a few cm^2 (cell centres)
+    assert cost / scan(ROOM, TRUE).shape[0] < 0.01
     # it improved on the prediction's own cost
     _, at_prediction = correlative_search(
         grid,
@@ -252,6 +254,62 @@ def test_no_points_is_not_trusted() -> None:
     result = match_scan(grid, np.empty((0, 2)), (0.1, 0.0, 0.0), MatchParams())
     assert not result.ok
     assert result.pose == (0.1, 0.0, 0.0)
+    assert result.inliers == 0.0
+    assert result.iterations == 0
+    assert math.isnan(result.rms)
+
+
+def test_with_no_inliers_required_any_match_is_trusted() -> None:
+    grid = mapped(box(0, 0, 5, 5), (0.0, 0.0, 0.0))
+    elsewhere = [(-1.5, -3.0, -1.5, 3.0), (1.7, -3.0, 1.7, 3.0)]
+    result = match_scan(
+        grid, scan(elsewhere, (0.0, 0.0, 0.0)), (0.0, 0.0, 0.0), MatchParams(min_inliers=0.0)
+    )
+    assert result.ok
+    assert result.inliers == 0.0
+
+
+def test_what_a_round_room_cannot_tell_stays_at_the_prediction() -> None:
+    # from the centre of a round room: position measured, heading not
+    room = circle(3.0)
+    grid = mapped(room, (0.0, 0.0, 0.0))
+    prediction = (0.06, -0.04, 0.3)
+    result = match_scan(grid, scan(room, (0.0, 0.0, 0.0)), prediction, MatchParams())
+    assert result.ok
+    assert result.pose[0] == pytest.approx(0.0, abs=0.005)
+    assert result.pose[1] == pytest.approx(0.0, abs=0.005)
+    assert result.pose[2] == pytest.approx(0.3, abs=0.005)
+
+
+def test_refinement_converges_in_a_few_steps() -> None:
+    grid = mapped(ROOM, (0.0, 0.0, 0.0))
+    truth = (0.3, -0.2, 1.2)  # turned well away from the map's axes
+    for offset in ((0.0, 0.0, 0.03), (0.03, -0.02, 0.0), (0.02, 0.02, -0.02)):
+        prediction = (truth[0] + offset[0], truth[1] + offset[1], truth[2] + offset[2])
+        pose, steps = refine(grid, scan(ROOM, truth), prediction, prediction, MatchParams())
+        assert error(pose, truth)[0] < 0.002
+        assert error(pose, truth)[1] < 5e-4
+        assert 1 <= steps <= 4
+
+
+def test_no_refinement_steps_leave_the_start() -> None:
+    grid = mapped(ROOM, (0.0, 0.0, 0.0))
+    start = (TRUE[0] + 0.03, TRUE[1], TRUE[2])
+    pose, steps = refine(grid, scan(ROOM, TRUE), start, start, MatchParams(iterations=0))
+    assert (pose, steps) == (start, 0)
+
+
+@pytest.mark.parametrize(
+    "params",
+    [
+        {"iterations": 0},
+        {"min_inliers": 0.0},
+        {"min_inliers": 1.0},
+        {"linear_window": 0.0, "angular_window": 0.0, "prior": 0.0, "yaw_scale": 0.0},
+    ],
+)
+def test_boundary_settings_are_accepted(params: dict[str, float]) -> None:
+    MatchParams(**params)  # type: ignore[arg-type]
 
 
 def test_refinement_recovers_what_the_search_window_does_not_cover() -> None:
@@ -278,3 +336,29 @@ def test_refinement_recovers_what_the_search_window_does_not_cover() -> None:
 def test_bad_match_settings_are_refused(field: str, value: float) -> None:
     with pytest.raises(ValueError, match=field):
         MatchParams(**{field: value})  # type: ignore[arg-type]
+
+
+def fence() -> list[Segment]:
+    """Two long walls and, between them, a row of posts every 0.4 m (-2.8 to 2.8 m):
+    along the row, only the posts (and where the row ends) say where the robot is."""
+    world: list[Segment] = [(-6, -1.5, 6, -1.5), (-6, 1.5, 6, 1.5)]
+    for k in range(-7, 8):
+        world += box(0.4 * k, 0.8, 0.05, 0.05)
+    return world
+
+
+@pytest.mark.parametrize("along", [0.25, -0.25])
+def test_the_search_finds_the_right_post_where_refinement_alone_takes_the_wrong_one(
+    along: float,
+) -> None:
+    world = fence()
+    grid = mapped(world, (0.0, 0.0, 0.0))
+    params = MatchParams(linear_window=0.3)
+    points = scan(world, (0.0, 0.0, 0.0))
+    prediction = (along, 0.02, 0.01)  # nearer the next post than the right one
+    alone, _ = refine(grid, points, prediction, prediction, params)
+    assert abs(alone[0]) > 0.2  # Gauss-Newton from the prediction: not the right post
+    result = match_scan(grid, points, prediction, params)
+    assert result.ok
+    assert abs(result.pose[0]) < 0.03
+    assert abs(result.pose[1]) < 0.005
