@@ -362,3 +362,27 @@ def test_the_search_finds_the_right_post_where_refinement_alone_takes_the_wrong_
     assert result.ok
     assert abs(result.pose[0]) < 0.03
     assert abs(result.pose[1]) < 0.005
+
+
+def test_the_search_tries_the_prediction_first_then_outward() -> None:
+    from otonav.nav.scan_match import _offsets
+
+    assert _offsets(0.1, 0.05).tolist() == pytest.approx([0.0, 0.05, -0.05, 0.1, -0.1])
+    assert _offsets(0.0, 0.05).tolist() == [0.0]
+    assert _offsets(0.12, 0.05).tolist() == pytest.approx([0.0, 0.05, -0.05, 0.1, -0.1])
+
+
+def test_a_heavy_prior_keeps_the_search_at_the_prediction() -> None:
+    grid = mapped(ROOM, (0.0, 0.0, 0.0))
+    prediction = (TRUE[0] + 0.1, TRUE[1] - 0.05, TRUE[2] + 0.04)
+    points = scan(ROOM, TRUE)
+    best, cost = correlative_search(grid, points, prediction, MatchParams(prior=1e6))
+    assert best == pytest.approx(prediction)
+    light, _ = correlative_search(grid, points, prediction, MatchParams(prior=1e-3))
+    assert error(light, TRUE)[0] < 0.05
+    # the prior's share of the cost is zero at the prediction
+    assert cost == pytest.approx(
+        correlative_search(
+            grid, points, prediction, MatchParams(linear_window=0.0, angular_window=0.0)
+        )[1]
+    )
