@@ -386,3 +386,65 @@ def test_a_heavy_prior_keeps_the_search_at_the_prediction() -> None:
             grid, points, prediction, MatchParams(linear_window=0.0, angular_window=0.0)
         )[1]
     )
+
+
+def test_a_beam_along_a_column_frees_that_column_only() -> None:
+    grid = ScanMap(0.0, 0.0, half_size=1.0, resolution=0.1, max_distance=0.3)
+    grid.insert(0.35, -0.85, np.array([0.35]), np.array([0.65]))
+    known_rows, known_cols = np.nonzero(grid.known)
+    assert set(known_cols.tolist()) == {13}
+    assert sorted(known_rows.tolist()) == list(range(1, 17))  # sensor's cell to return's
+    assert grid.log_odds[16, 13] > 0.0  # the return's cell: occupied
+    assert (grid.log_odds[1:16, 13] < 0.0).all()  # the cells before it: free
+
+
+def test_a_diagonal_beam_frees_the_cells_it_crosses_and_not_its_return() -> None:
+    grid = ScanMap(0.0, 0.0, half_size=1.0, resolution=0.1, max_distance=0.3)
+    grid.insert(-0.75, -0.75, np.array([0.45]), np.array([0.45]))
+    free = {(int(r), int(c)) for r, c in zip(*np.nonzero(grid.log_odds < 0.0), strict=True)}
+    assert {(k, k) for k in range(2, 14)} <= free  # the diagonal's cells
+    assert all(abs(r - c) <= 1 for r, c in free)  # nothing off the line
+    assert grid.log_odds[14, 14] > 0.0
+    assert (14, 14) not in free
+    # a return late in its cell: the last sample, one cell short along the diagonal,
+    # falls in the same cell, and must not count as a miss there
+    late = ScanMap(0.0, 0.0, half_size=1.0, resolution=0.1, max_distance=0.3)
+    late.insert(-0.75, -0.75, np.array([0.099]), np.array([0.099]))
+    assert late.log_odds[10, 10] == pytest.approx(HIT)
+
+
+def test_a_beam_leaving_the_map_marks_only_what_is_inside() -> None:
+    grid = ScanMap(0.0, 0.0, half_size=1.0, resolution=0.1, max_distance=0.3)
+    # the return just past the edge (column 20 of 0-19), then one far beyond
+    assert grid.insert(0.05, 0.05, np.array([1.05]), np.array([0.05])) == 0
+    assert grid.insert(0.05, 0.05, np.array([3.0]), np.array([0.05])) == 0
+    assert grid.cells == 0
+    rows, cols = np.nonzero(grid.known)
+    assert rows.tolist() == [10] * 10
+    assert cols.tolist() == list(range(10, 20))
+    grid.insert(-0.05, 0.05, np.array([-3.0]), np.array([0.05]))  # and the other way
+    assert np.nonzero(grid.known[10])[0].tolist() == list(range(20))
+    assert grid.known.sum() == 20
+
+
+def test_normals_need_neighbours_within_four_cells() -> None:
+    x = np.array([0.0, 0.19, 0.38, 0.6, 0.82])
+    y = np.zeros(5)
+    nx, ny = normals(x, y, 0.05)  # 0.19 m apart: one surface; 0.22 m: not
+    assert abs(ny[1]) == pytest.approx(1.0)
+    assert ny[2] == 0.0
+    assert ny[3] == 0.0
+    assert nx.tolist() == [0.0] * 5
+
+
+def test_the_map_stores_more_returns_than_its_first_allocation() -> None:
+    grid = ScanMap(0.0, 0.0, half_size=5.0, resolution=0.05, max_distance=0.3)
+    rows = np.arange(1.0, 4.6, 0.5)  # 8 walls of 160 cells
+    x = np.tile(np.linspace(-4.0, 4.0, 400), rows.shape[0])
+    y = np.repeat(rows, 400)
+    assert grid.insert(0.0, 0.0, x, y) > 1024
+    qx, qy, _, ny, found = grid.correspond(np.array([-3.88, 3.88]), np.array([1.02, 1.02]))
+    assert found.all()
+    assert qx == pytest.approx([-3.88, 3.88], abs=0.05)  # the first return in its cell
+    assert qy == pytest.approx([1.0, 1.0])
+    assert np.abs(ny) == pytest.approx([1.0, 1.0])
