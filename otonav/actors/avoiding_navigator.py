@@ -31,6 +31,9 @@ class AvoidingNavigator(GoalNavigator):
     commands zero and its state is ``fault``."""
 
     diagnostics = Output(topics.NAV_DIAGNOSTICS, NavDiagnostics, topics.COMMAND_QOS)
+    frame_id = "odom"
+    """The frame the navigator works in (poses, goal, map): odom here; ``map`` for
+    :class:`~otonav.actors.localized_navigator.LocalizedNavigator`."""
 
     def __init__(
         self,
@@ -61,10 +64,15 @@ class AvoidingNavigator(GoalNavigator):
     def _take_goal(self, goal: tuple[float, float]) -> None:
         self.nav.set_goal(goal)
 
+    def _in_frame(self, pose: tuple[float, float, float]) -> tuple[float, float, float]:
+        """An odometry pose in :attr:`frame_id` (here: itself)."""
+        return pose
+
     def _take_scan(self, scan: LaserScan) -> None:
         pose = self._history.pose_at(scan.header.stamp.to_seconds())
         if pose is None:
             return
+        pose = self._in_frame(pose)
         moved = self._points_pose is None or (
             abs(pose[0] - self._points_pose[0]) + abs(pose[1] - self._points_pose[1]) > 1e-3
             or abs(pose[2] - self._points_pose[2]) > 1e-3
@@ -83,7 +91,8 @@ class AvoidingNavigator(GoalNavigator):
         if latest is None:
             await self._publish(NavOutput(0.0, 0.0, "idle", "no odometry", math.inf, 0.0))
             return
-        _, pose, v0, omega0 = latest
+        _, odom_pose, v0, omega0 = latest
+        pose = self._in_frame(odom_pose)
         if self._hardware_fault:
             await self._publish(NavOutput(0.0, 0.0, "fault", "hardware fault", math.inf, 0.0))
             return
@@ -107,7 +116,7 @@ class AvoidingNavigator(GoalNavigator):
 
     async def _publish(self, out: NavOutput) -> None:
         stamp = Time.from_seconds(self.clock.now())
-        header = Header.fast(stamp=stamp, frame_id="odom")
+        header = Header.fast(stamp=stamp, frame_id=self.frame_id)
         dwa = out.dwa
         closest = dwa.clearance if dwa is not None else math.inf
         await self._publish_command(

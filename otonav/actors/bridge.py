@@ -14,6 +14,7 @@ import anyio
 import numpy as np
 
 from otonav.actors import topics
+from otonav.actors.odometry_error import OdometryError
 from otonav.control import OdometryEstimate, Pose2D, estimate_odometry
 from otonav.hal import HardwareHealth, HealthLevel, ImuSample, RobotHardwareInterface, WheelSetpoint
 from otonav.msgs import (
@@ -193,6 +194,7 @@ class Bridge(Actor):
         scan_hz: float = 10.0,
         diagnostics_hz: float = 1.0,
         initial_pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
+        odometry_error: OdometryError | None = None,
         name: str = "bridge",
     ) -> None:
         super().__init__(name)
@@ -218,6 +220,7 @@ class Bridge(Actor):
         self._imu_sample: ImuSample | None = None
         self._imu_time = -1.0
         self._pending: deque[tuple[Publisher[Any], Any]] = deque()
+        self._odometry_error = odometry_error
 
     async def on_start(self) -> None:
         """/tf_static: base_link -> laser and base_link -> imu_link (latched), so a
@@ -326,6 +329,7 @@ class Bridge(Actor):
         hal = self.hal
         wheels = hal.read_wheels()
         gyro_z = self._imu_at(now).angular_velocity[2]
+        error = self._odometry_error
         odometry = self._odometry = estimate_odometry(
             self._odometry,
             wheels.left_position,
@@ -333,8 +337,11 @@ class Bridge(Actor):
             gyro_z,
             now,
             hal.geometry.wheel_radius,
+            error=None if error is None else error.apply,
         )
         pose, v = odometry.pose, odometry.v
+        if error is not None:  # /odom's twist is what the mis-calibrated odometry believes
+            gyro_z = odometry.yaw_rate
         qz, qw = math.sin(pose.yaw / 2), math.cos(pose.yaw / 2)  # Quaternion.from_yaw's
         self._send(self.odom, ODOM(sec, nanosec, pose.x, pose.y, qz, qw, v, gyro_z))
         self._send(self.tf, TF(sec, nanosec, pose.x, pose.y, qz, qw))

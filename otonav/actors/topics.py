@@ -10,6 +10,8 @@ IMU = "/imu"
 SCAN = "/scan"
 TF = "/tf"
 TF_STATIC = "/tf_static"
+#: The localizer's map (nav_msgs/OccupancyGrid, latched).
+MAP = "/map"
 CMD_VEL = "/cmd_vel"
 #: The planner's command, before the safety layer (Nav2: cmd_vel_nav -> collision monitor).
 CMD_VEL_NAV = "/cmd_vel_nav"

@@ -9,6 +9,7 @@ caller passes the readings and their sim time.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import NamedTuple
 
 from otonav.control.kinematics import Pose2D, integrate_odometry
@@ -29,6 +30,13 @@ class OdometryEstimate(NamedTuple):
     """rad, the right wheel's position at ``time``."""
     time: float
     """s, sim time of the readings this estimate used."""
+    yaw_rate: float = 0.0
+    """rad/s, the yaw rate the last interval was integrated with."""
+
+
+OdometryErrorModel = Callable[[float, float], tuple[float, float]]
+"""``(distance m, yaw rate rad/s) -> (distance, yaw rate)`` as a mis-calibrated
+odometry sees them (simulation only: ``world.odometry_error``)."""
 
 
 def estimate_odometry(
@@ -38,17 +46,22 @@ def estimate_odometry(
     yaw_rate: float,
     now: float,
     wheel_radius: float,
+    error: OdometryErrorModel | None = None,
 ) -> OdometryEstimate:
     """One odometry step from wheel positions ``left``/``right`` (rad) and the gyro's
     ``yaw_rate`` (rad/s) read at sim time ``now`` (s), for wheels of ``wheel_radius`` m.
 
     When ``now`` is not after ``last.time`` (the same instant read again, or a real-time
     world that ran past two instants at once) there is no interval to measure: ``last``
-    is returned unchanged, its speed the same estimate.
+    is returned unchanged, its speed the same estimate. ``error``, when given, turns the
+    interval's distance and yaw rate into what a mis-calibrated odometry reports.
     """
     dt = now - last.time
     if not dt > 0:
         return last
     distance = wheel_radius * ((left - last.left) + (right - last.right)) / 2
+    if error is not None:
+        distance, yaw_rate = error(distance, yaw_rate)
     v = distance / dt
-    return OdometryEstimate(integrate_odometry(last.pose, v, yaw_rate, dt), v, left, right, now)
+    pose = integrate_odometry(last.pose, v, yaw_rate, dt)
+    return OdometryEstimate(pose, v, left, right, now, yaw_rate)

@@ -27,7 +27,14 @@ from otonav.msgs.otonav_msgs import (
     ScenarioVerdict,
     WheelCommand,
 )
-from otonav.msgs.sensors import Imu, LaserScan, Odometry, TFMessage
+from otonav.msgs.sensors import (
+    Imu,
+    LaserScan,
+    MapMetaData,
+    OccupancyGrid,
+    Odometry,
+    TFMessage,
+)
 from otonav.msgs.std import Clock, Header, Log, Time
 
 __all__ = (
@@ -41,9 +48,11 @@ __all__ = (
     "KeyValue",
     "LaserScan",
     "Log",
+    "MapMetaData",
     "Message",
     "NavDiagnostics",
     "NavState",
+    "OccupancyGrid",
     "Odometry",
     "Point",
     "Pose",

@@ -6,13 +6,14 @@ from typing import ClassVar
 
 from otonav.msgs._base import Message
 from otonav.msgs.geometry import (
+    Pose,
     PoseWithCovariance,
     Quaternion,
     TransformStamped,
     TwistWithCovariance,
     Vector3,
 )
-from otonav.msgs.std import Header
+from otonav.msgs.std import Header, Time
 
 _ZERO9 = (0.0,) * 9
 
@@ -64,3 +65,28 @@ class TFMessage(Message):
 
     ros_type: ClassVar[str] = "tf2_msgs/msg/TFMessage"
     transforms: tuple[TransformStamped, ...] = ()
+
+
+class MapMetaData(Message):
+    """nav_msgs/msg/MapMetaData: a grid's resolution, size and where its cell (0, 0)
+    sits (``origin``: the corner of that cell, in the map's frame)."""
+
+    ros_type: ClassVar[str] = "nav_msgs/msg/MapMetaData"
+    map_load_time: Time = Time()
+    resolution: float = 0.0
+    """m per cell."""
+    width: int = 0
+    """cells along x."""
+    height: int = 0
+    """cells along y."""
+    origin: Pose = Pose()
+
+
+class OccupancyGrid(Message):
+    """nav_msgs/msg/OccupancyGrid: row-major cells from ``info.origin``, -1 unknown,
+    else the probability of occupied in percent (0-100); e.g. ``/map``."""
+
+    ros_type: ClassVar[str] = "nav_msgs/msg/OccupancyGrid"
+    header: Header = Header()
+    info: MapMetaData = MapMetaData()
+    data: tuple[int, ...] = ()

@@ -34,9 +34,11 @@ from otonav.msgs import (
     KeyValue,
     LaserScan,
     Log,
+    MapMetaData,
     Message,
     NavDiagnostics,
     NavState,
+    OccupancyGrid,
     Odometry,
     Point,
     Pose,
@@ -212,6 +214,20 @@ _KNOWN: Final[dict[type[Message], tuple[tuple[Field, ...], tuple[Constant, ...]]
         (),
     ),
     TFMessage: ((_F("transforms", TransformStamped, SEQUENCE),), ()),
+    MapMetaData: (
+        (
+            _F("map_load_time", Time),
+            _F("resolution", "float32"),
+            _F("width", "uint32"),
+            _F("height", "uint32"),
+            _F("origin", Pose),
+        ),
+        (),
+    ),
+    OccupancyGrid: (
+        (_HEADER, _F("info", MapMetaData), _F("data", "int8", SEQUENCE)),
+        (),
+    ),
     WheelCommand: ((_HEADER, _F("left", "float64"), _F("right", "float64")), ()),
     NavState: (
         (

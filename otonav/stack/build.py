@@ -18,6 +18,9 @@ from otonav.actors import (
     SafetyLayer,
     topics,
 )
+from otonav.actors.localized_navigator import LocalizedNavigator
+from otonav.actors.localizer import Localizer, LocalizerParams
+from otonav.actors.odometry_error import OdometryError
 from otonav.control import DiffDriveGeometry
 from otonav.hal import BoxObstacle, RobotGeometry, RobotHardwareInterface
 from otonav.hal.mujoco import MujocoInterface
@@ -26,6 +29,7 @@ from otonav.nav.dwa import DwaParams
 from otonav.nav.footprint import centre_clearance
 from otonav.nav.navigation import NavigationParams
 from otonav.nav.safety import SafetyParams
+from otonav.nav.scan_match import MatchParams
 from otonav.runtime import Actor
 from otonav.stack.config import StackConfig
 from otonav.stack.files import ConfigFileError
@@ -166,6 +170,7 @@ def build_actors(
             imu_hz=rates.imu_hz,
             scan_hz=rates.scan_hz,
             initial_pose=initial_pose,
+            odometry_error=odometry_error(config),
         ),
         BaseController(
             DiffDriveGeometry(geometry.wheel_radius, geometry.wheel_separation),
@@ -182,6 +187,14 @@ def build_actors(
             # First: actors stop in reverse order, so the tap stops after the bridge
             # and its on_stop records the drives' IDLE frames (ADR 0028).
             actors.insert(0, CanFrameTap(hal))
+    if nav.localization.enabled:
+        actors.append(
+            Localizer(
+                localizer_params(config),
+                laser_offset_x=geometry.laser_offset_x,
+                start=(initial_pose[0], initial_pose[1]),
+            )
+        )
     if navigator:
         remap = {topics.CMD_VEL: topics.CMD_VEL_NAV} if config.safety.enabled else None
         if nav.planner == "stop":
@@ -202,8 +215,9 @@ def build_actors(
                 )
             )
         elif nav.planner == "dwa":
+            navigator_class = LocalizedNavigator if nav.localization.enabled else AvoidingNavigator
             actors.append(
-                AvoidingNavigator(
+                navigator_class(
                     navigation_params(config, geometry),
                     laser_offset_x=geometry.laser_offset_x,
                     start=(initial_pose[0], initial_pose[1]),
@@ -292,6 +306,34 @@ def navigation_params(config: StackConfig, geometry: RobotGeometry) -> Navigatio
         approach_radius=nav.approach_radius,
         kp_lin=nav.kp_lin,
         kp_ang=nav.kp_ang,
+    )
+
+
+def odometry_error(config: StackConfig) -> OdometryError | None:
+    """The simulated odometry error of ``world.odometry_error`` (None when off)."""
+    error = config.world.odometry_error
+    if not error.enabled:
+        return None
+    return OdometryError(
+        scale=error.scale, gyro_bias=error.gyro_bias, gyro_noise=error.gyro_noise, seed=error.seed
+    )
+
+
+def localizer_params(config: StackConfig) -> LocalizerParams:
+    """The localizer's settings from ``nav.localization.*``."""
+    loc = config.nav.localization
+    return LocalizerParams(
+        match=MatchParams(
+            linear_window=loc.linear_window,
+            linear_step=loc.resolution,
+            angular_window=loc.angular_window,
+            max_distance=loc.max_distance,
+        ),
+        resolution=loc.resolution,
+        half_size=loc.half_size,
+        update_distance=loc.update_distance,
+        update_angle=loc.update_angle,
+        map_period=loc.map_period,
     )
 
 

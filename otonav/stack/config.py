@@ -47,6 +47,28 @@ _NodeId = Annotated[int, _within(0, 63)]
 """An ODrive CAN Simple node id: 6 bits."""
 
 
+class OdometryErrorConfig(_Section):
+    """A deterministic odometry error model for simulation (all zero: off): what a
+    mis-calibrated wheel radius and a biased, noisy gyro do to the bridge's /odom (and
+    /tf odom -> base_link). /imu and ground truth are untouched."""
+
+    scale: float = Field(0.0, ge=-0.2, le=0.2)
+    """m added per m driven: every distance the wheels report is scaled by 1 + scale (a
+    wheel radius off by that fraction), in [-0.2, 0.2]."""
+    gyro_bias: float = Field(0.0, ge=-0.5, le=0.5)
+    """rad/s added to the yaw rate odometry integrates (heading drifts by it), in
+    [-0.5, 0.5]."""
+    gyro_noise: float = Field(0.0, ge=0.0, le=1.0)
+    """rad/s, standard deviation of white noise on that yaw rate, per odometry
+    sample, in [0, 1]."""
+    seed: int = Field(0, ge=0, le=limits.MAX_SEED)
+    """Seeds the noise (the same seed, the same drift)."""
+
+    @property
+    def enabled(self) -> bool:
+        return self.scale != 0.0 or self.gyro_bias != 0.0 or self.gyro_noise != 0.0
+
+
 class WorldConfig(_Section):
     """The simulated world (``otonav.hal.mujoco``)."""
 
@@ -61,6 +83,8 @@ class WorldConfig(_Section):
     """m, returns closer than this read as -inf (below range), < ``lidar_range_max``."""
     lidar_range_max: PositiveFloat = Field(8.0, le=limits.MAX_LIDAR_RANGE_M)
     """m, at most 1 km: ranges are float32 in the recording."""
+    odometry_error: OdometryErrorConfig = OdometryErrorConfig()
+    """Simulated odometry drift (off by default): see :class:`OdometryErrorConfig`."""
 
 
 class RatesConfig(_Section):
@@ -179,6 +203,34 @@ class RecoveryConfig(_Section):
     never), in [0, 20]."""
 
 
+class LocalizationConfig(_Section):
+    """Scan-to-map localization (``otonav.actors.localizer``, ADR 0053): a map built
+    from the scans at their corrected poses, each scan matched to it; publishes
+    ``map -> odom`` on /tf and the map on /map; the ``dwa`` navigator then works in the
+    map frame (its ``reached`` is judged on the localized pose)."""
+
+    enabled: bool = False
+    """Run the localizer and navigate on its pose (false: odometry alone)."""
+    resolution: float = Field(0.05, ge=0.01, le=0.2)
+    """m, the map's cell, in [0.01, 0.2]."""
+    half_size: float = Field(10.0, gt=0.0, le=100.0)
+    """m, the map spans this far from the start pose in x and y, in (0, 100]."""
+    linear_window: float = Field(0.1, ge=0.0, le=1.0)
+    """m, the correlative search spans +- this in x and y around the odometry's
+    prediction, in [0, 1]."""
+    angular_window: float = Field(0.06, ge=0.0, le=0.5)
+    """rad, it spans +- this in yaw, in [0, 0.5]."""
+    max_distance: float = Field(0.3, gt=0.0, le=2.0)
+    """m, a return farther than this from the map is not matched (new ground), in
+    (0, 2]."""
+    update_distance: float = Field(0.1, ge=0.0, le=5.0)
+    """m the robot moves before a scan is added to the map, in [0, 5]."""
+    update_angle: float = Field(0.1, ge=0.0, le=math.pi)
+    """rad it turns before a scan is added to the map, in [0, pi]."""
+    map_period: float = Field(5.0, gt=0.0, le=600.0)
+    """s of sim time between /map messages (only when the map changed), in (0, 600]."""
+
+
 class NavConfig(_Section):
     """Navigator: which planner, go-to-goal gains (``stop``), limits, footprint,
     clearance, and the avoiding planner's sections."""
@@ -213,6 +265,7 @@ class NavConfig(_Section):
     dwa: DwaConfig = DwaConfig()
     map: MapConfig = MapConfig()
     recovery: RecoveryConfig = RecoveryConfig()
+    localization: LocalizationConfig = LocalizationConfig()
 
 
 class SafetyConfig(_Section):

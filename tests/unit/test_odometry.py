@@ -51,3 +51,22 @@ def test_steps_compose_from_the_readings_they_were_given() -> None:
     two = estimate_odometry(one, 12.0, -2.0, 0.0, 1.5, 0.05)
     assert two.pose.x == pytest.approx(0.1)  # the same 2 rad as in one step
     assert two.v == pytest.approx(0.2)
+
+
+def test_an_error_model_sees_the_interval_and_its_answer_is_integrated() -> None:
+    # world.odometry_error: the model gets the interval's distance and yaw rate and
+    # what it returns is what the pose integrates (and what /odom's twist reports).
+    seen: list[tuple[float, float]] = []
+
+    def model(distance: float, yaw_rate: float) -> tuple[float, float]:
+        seen.append((distance, yaw_rate))
+        return distance * 1.5, yaw_rate + 0.2
+
+    after = estimate_odometry(START, 12.0, -2.0, 0.0, 1.5, 0.05, error=model)
+    assert seen == [pytest.approx((0.1, 0.0))]
+    assert after.v == pytest.approx(0.3)
+    assert after.yaw_rate == pytest.approx(0.2)
+    assert after.pose.yaw == pytest.approx(0.1)
+    # no interval (the same instant again): no new sample of the error model
+    assert estimate_odometry(after, 12.0, -2.0, 0.0, 1.5, 0.05, error=model) is after
+    assert len(seen) == 1

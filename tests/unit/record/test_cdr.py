@@ -32,8 +32,10 @@ from otonav.msgs import (
     Imu,
     LaserScan,
     Log,
+    MapMetaData,
     Message,
     NavState,
+    OccupancyGrid,
     Odometry,
     Point,
     Pose,
@@ -116,6 +118,7 @@ def reference_bytes(message: Message) -> bytes:
 
 
 FLOAT32_FIELDS: dict[type[Message], frozenset[str]] = {
+    MapMetaData: frozenset({"resolution"}),
     LaserScan: frozenset(
         {
             "angle_min",
@@ -130,7 +133,8 @@ FLOAT32_FIELDS: dict[type[Message], frozenset[str]] = {
         }
     ),
 }
-"""Fields ROS 2 holds as float32 (sensor_msgs/LaserScan); all other floats are float64."""
+"""Fields ROS 2 holds as float32 (sensor_msgs/LaserScan, nav_msgs/MapMetaData); all other
+floats are float64."""
 
 
 def assert_same(decoded: Any, original: Message, where: str = "") -> None:
@@ -316,6 +320,22 @@ def samples() -> dict[type[Message], list[Message]]:
                 closest_ahead=0.35,
             )
             for h, state in zip(HEADERS, ("idle", "driving", "blocked", "reached"), strict=False)
+        ],
+        MapMetaData: [
+            MapMetaData(),
+            MapMetaData(
+                map_load_time=STAMPS[2], resolution=0.05, width=3, height=2, origin=POSES[1]
+            ),
+        ],
+        OccupancyGrid: [
+            OccupancyGrid(),
+            OccupancyGrid(
+                header=HEADERS[1],
+                info=MapMetaData(
+                    map_load_time=STAMPS[1], resolution=0.1, width=3, height=2, origin=POSES[0]
+                ),
+                data=(-1, 0, 100, 50, -1, 7),
+            ),
         ],
         Empty: [Empty()],
         Everything: [
