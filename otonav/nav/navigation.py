@@ -60,8 +60,12 @@ def _resolve(points: Points) -> NDArray[np.float64]:
     return points() if callable(points) else points
 
 
-TURN_CREDIT = 0.25
-"""m of progress per radian turned toward the target (a half turn: 0.8 m)."""
+TURN_CREDIT = 0.4
+"""m of progress per radian turned toward the target while it is more than the DWA's
+``rotate_threshold`` off the heading (a half turn: (pi - 0.6) x 0.4 = 1.0 m). Nearer
+than that the robot is meant to drive: turning does not count (issue 24: at a U
+trap's outer corner the DWA turned ever slower toward a target through the wall, at
+v = 0, and the credit for that turn kept the progress check quiet for 6 s)."""
 
 LADDER = ("spin", "backup", "follow")
 """The recovery stages, in order."""
@@ -302,9 +306,10 @@ class Navigation:
         to_go = self._to_go(pose, distance)
         target = self._target(pose)
         # Turning toward the way on counts too (a robot facing away from a new path
-        # turns in place first): TURN_CREDIT m per radian of bearing to the target.
+        # turns in place first): TURN_CREDIT m per radian of bearing to the target
+        # beyond the DWA's rotate threshold (nearer, it should drive).
         bearing = abs(wrap_angle(math.atan2(target[1] - y, target[0] - x) - yaw))
-        measure = to_go + TURN_CREDIT * bearing
+        measure = to_go + TURN_CREDIT * max(bearing - self.params.dwa.rotate_threshold, 0.0)
         if self._new_path:  # new knowledge is not progress, and not a lack of it
             self._new_path = False
             self._checker.rebase(measure)

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+from otonav.record.reader import read_messages
 from otonav.replay import replay_recording
 from otonav.replay.nodes import stack_actor_names
 from otonav.scenario import GoalSpec, ScenarioConfig, StartSpec, run_scenario
@@ -46,6 +47,39 @@ def test_goes_around_and_reaches_the_goal(world: str) -> None:
     verdict = run_scenario(scenario, plot=False, record=False, wall_ceiling=120)
     assert verdict.passed, verdict.reason
     assert verdict.min_clearance_m >= 0.3
+
+
+def test_at_the_u_traps_outer_corner_no_stall_outlasts_the_progress_window(
+    otonav_artifacts: Path,
+) -> None:
+    """Issue 24: inside a U with the goal behind its bottom, the robot turns out and
+    around; at the U's outer corner the DWA stops (v = 0) and turns ever slower toward
+    a target through the corner. What the robot does decides: it is in recovery within
+    the progress window of standing still, and the verdict names the rung and why."""
+    scenario = ScenarioConfig(
+        name="u_trap_corner", scene="empty", obstacles=WORLDS["u_trap"],
+        start=StartSpec(x=-1.5, y=0.0), goal=GoalSpec(x=1.5, y=0.0), sim_budget=60.0,
+    )  # fmt: skip
+    verdict = run_scenario(scenario, out_dir=otonav_artifacts, plot=False, wall_ceiling=120)
+    assert verdict.passed, verdict.reason
+    assert verdict.recoveries, verdict.reason
+    assert verdict.recoveries[0].startswith("spin at "), verdict.recoveries
+    assert "rung 1/3, under 0.3 m of progress along the path in 3.5 s" in verdict.recoveries[0]
+    assert f"recoveries: {verdict.recoveries[0]}" in verdict.reason
+    window = StackConfig().nav.recovery.progress_window
+    assert verdict.recording is not None
+    # Standing (v ~ 0) and at most turning slowly: how long until it is in recovery?
+    # (A turn in place at speed toward the way on is progress, not a stall.)
+    still_since: float | None = None
+    stalls: list[float] = []
+    for _topic, t, diag in read_messages(verdict.recording, ["/nav/diagnostics"]):
+        if abs(diag.v) < 0.02 and abs(diag.omega) < 0.4 and diag.state != "recovering":
+            still_since = t if still_since is None else still_since
+        elif still_since is not None:
+            stalls.append(t - still_since)
+            still_since = None
+    assert max(stalls) > 2.0  # the corner stall happens (the test sees it)
+    assert max(stalls) <= window + 0.1, stalls
 
 
 def test_walled_in_goal_is_reported_unreachable_before_the_budget(otonav_artifacts: Path) -> None:
