@@ -203,7 +203,7 @@ def test_turning_toward_a_target_behind_is_progress() -> None:
     params = _params()
     nav = Navigation(params, (0.0, 0.0))
     nav.set_goal((-4.0, 0.0))  # behind
-    t, log = _drive(
+    _t, log = _drive(
         nav,
         lambda t: (0.0, 0.0, min(1.0 * t, math.pi)),  # 1 rad/s, then facing it
         params.progress_window + 0.5,
