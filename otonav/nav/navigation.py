@@ -67,6 +67,12 @@ than that the robot is meant to drive: turning does not count (issue 24: at a U
 trap's outer corner the DWA turned ever slower toward a target through the wall, at
 v = 0, and the credit for that turn kept the progress check quiet for 6 s)."""
 
+LOOKAHEAD_TIME = 2.0
+"""s of the current speed the DWA's target lies ahead along the path (0.4 m/s: 0.8 m)."""
+
+MIN_LOOKAHEAD = 0.3
+"""m, the shortest lookahead (Nav2 Regulated Pure Pursuit's ``min_lookahead_dist``)."""
+
 LADDER = ("spin", "backup", "follow")
 """The recovery stages, in order."""
 
@@ -304,7 +310,7 @@ class Navigation:
                     )
                 return self._give_up("no path to the goal in the observed map", distance, heading)
         to_go = self._to_go(pose, distance)
-        target = self._target(pose)
+        target = self._target(pose, v0)
         # Turning toward the way on counts too (a robot facing away from a new path
         # turns in place first): TURN_CREDIT m per radian of bearing to the target
         # beyond the DWA's rotate threshold (nearer, it should drive).
@@ -492,16 +498,21 @@ class Navigation:
         d = np.hypot(self.path[:, 0] - pose[0], self.path[:, 1] - pose[1])
         return self.path[int(np.argmin(d)) :]
 
-    def _target(self, pose: tuple[float, float, float]) -> tuple[float, float]:
-        """The first path point at least ``lookahead`` from the robot, after the one
-        nearest it (one distance pass serves both searches)."""
+    def _target(self, pose: tuple[float, float, float], v0: float) -> tuple[float, float]:
+        """The first path point at least the lookahead from the robot, after the one
+        nearest it (one distance pass serves both searches). The lookahead scales with
+        the speed, like Nav2's Regulated Pure Pursuit: ``LOOKAHEAD_TIME`` s of the
+        current speed, within [``MIN_LOOKAHEAD``, ``lookahead``] m. A slow robot aims
+        at the path near it: in a door at the passable limit it lines up on the path
+        instead of heading for a point beyond the door past its corner (issue 24)."""
         assert self.goal is not None
         path = self.path
         if path is None:
             return self.goal
         d = np.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1])
         i = int(d.argmin())  # (the array methods: no np.argmin/np.flatnonzero wrappers)
-        beyond = d[i:] >= self.params.lookahead
+        lookahead = min(max(abs(v0) * LOOKAHEAD_TIME, MIN_LOOKAHEAD), self.params.lookahead)
+        beyond = d[i:] >= lookahead
         j = i + int(beyond.argmax())  # the first True, or i when there is none
         if not beyond[j - i]:
             return self.goal
