@@ -140,8 +140,8 @@ def safe_command(
     pts, dn = points[near], d0[near]
     allowed = np.minimum(p.radius, dn - 1e-4)  # inside the radius: no closer than now
     scales = np.linspace(1.0, 0.0, p.scales)
-    v_t = np.append(scales * v_cmd, 0.0)
-    w_t = np.append(np.full(p.scales, omega_cmd), 0.0)
+    v_t = scales * v_cmd
+    w_t = np.full(p.scales, omega_cmd)
     top_v = np.maximum(np.abs(v_t), abs(v0)) + p.max_accel * p.latency
     top_w = np.maximum(np.abs(w_t), abs(omega0)) + p.max_alpha * p.latency
     duration = p.latency + max(float(top_v.max()) / p.max_accel, float(top_w.max()) / p.max_alpha)

@@ -106,3 +106,21 @@ def test_params_name_the_field_and_bound() -> None:
     assert SafetyParams(scales=2).scales == 2
     with pytest.raises(ValueError, match="scales must be an integer >= 2"):
         SafetyParams(scales=2.0)  # type: ignore[arg-type]
+
+
+def test_an_empty_scan_lets_every_command_through() -> None:
+    r = safe_command(0.5, -1.0, 0.0, 0.0, np.empty((0, 2)), SafetyParams())
+    assert (r.v, r.omega, r.scale, r.nearest, r.reason) == (0.5, -1.0, 1.0, math.inf, "clear")
+
+
+def test_params_and_results_are_frozen_and_slotted() -> None:
+    import dataclasses
+
+    p = SafetyParams()
+    r = safe_command(0.1, 0.0, 0.0, 0.0, np.empty((0, 2)), p)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        p.radius = 1.0  # type: ignore[misc]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        r.v = 1.0  # type: ignore[misc]
+    assert not hasattr(p, "__dict__")
+    assert not hasattr(r, "__dict__")
