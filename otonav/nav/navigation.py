@@ -18,7 +18,8 @@ Each :meth:`Navigation.step` (at the navigator's rate):
    that kept only what the scans still show);
 3. within ``approach_radius`` of the goal, a proportional controller finishes, forward
    or in reverse (an overshoot is backed out of, not turned around); farther away,
-   **DWA** (:mod:`otonav.nav.dwa`) toward a point ``lookahead`` m along the path:
+   **DWA** (:mod:`otonav.nav.dwa`) toward a point along the path (``LOOKAHEAD_TIME``
+   s of the current speed ahead, within [``MIN_LOOKAHEAD``, ``lookahead``] m):
    ``driving``, or ``avoiding`` when the chosen arc passes near a return; ``blocked``
    when no arc is admissible;
 4. **progress** (:class:`~otonav.nav.recovery.ProgressChecker`): when it fails, the next
@@ -50,7 +51,16 @@ from otonav.nav.plan_grid import best_points, free_threshold, pooled
 from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
 from otonav.nav.scan import ScanRays
 
-__all__ = ("LADDER", "TURN_CREDIT", "NavOutput", "Navigation", "NavigationParams", "Points")
+__all__ = (
+    "LADDER",
+    "LOOKAHEAD_TIME",
+    "MIN_LOOKAHEAD",
+    "TURN_CREDIT",
+    "NavOutput",
+    "Navigation",
+    "NavigationParams",
+    "Points",
+)
 
 Points = NDArray[np.float64] | Callable[[], NDArray[np.float64]]
 """Scan returns in base_link, ``(N, 2)`` m, or a function that computes them."""
@@ -89,7 +99,8 @@ class NavigationParams:
         plan_resolution: global planner cell, m (a multiple of ``map_resolution``).
         plan_penalty: extra cost per cell near obstacles (0: shortest path).
         replan_period: blocked-path check period, s.
-        lookahead: the DWA's target is this far along the path, m.
+        lookahead: the DWA's target is at most this far along the path (at full
+            speed; nearer when slower, see ``LOOKAHEAD_TIME``), m.
         max_expansions: A* gives up (no proof either way) after this many cells.
         expansions_per_tick: A* expands at most this many cells per step; a search
             that needs more goes on at the next step (the robot follows the previous
