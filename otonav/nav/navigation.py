@@ -80,7 +80,7 @@ v = 0, and the credit for that turn kept the progress check quiet for 6 s)."""
 LOOKAHEAD_TIME = 2.0
 """s of the current speed the DWA's target lies ahead along the path (0.4 m/s: 0.8 m)."""
 
-MIN_LOOKAHEAD = 0.3
+MIN_LOOKAHEAD = 0.4
 """m, the shortest lookahead (Nav2 Regulated Pure Pursuit's ``min_lookahead_dist``)."""
 
 LADDER = ("spin", "backup", "follow")

@@ -244,7 +244,7 @@ def test_the_spin_rung_clears_the_map_around_the_robot() -> None:
 
 
 def test_the_lookahead_scales_with_the_speed_like_regulated_pure_pursuit() -> None:
-    """A slow robot aims at the path near it (0.3 m), a fast one 2 s of its speed
+    """A slow robot aims at the path near it (0.4 m), a fast one 2 s of its speed
     ahead up to ``nav.map.lookahead``: at a door at the limit, standing off its axis,
     the robot lines up on the path instead of heading past the door's corner."""
     params = _params()
@@ -252,7 +252,7 @@ def test_the_lookahead_scales_with_the_speed_like_regulated_pure_pursuit() -> No
     nav.set_goal((4.0, 0.0))
     _settle(nav, (0.0, 0.0, 0.0))
     assert nav.path is not None
-    for v0, want in ((0.0, 0.3), (-0.05, 0.3), (0.25, 0.5), (0.4, 0.8), (0.5, 0.8)):
+    for v0, want in ((0.0, 0.4), (-0.05, 0.4), (0.25, 0.5), (0.4, 0.8), (0.5, 0.8)):
         tx, ty = nav._target((0.0, 0.0, 0.0), v0)
         assert ty == pytest.approx(0.0, abs=0.06)
         assert want <= tx <= want + 0.15, (v0, tx)
