@@ -148,7 +148,7 @@ class MapConfig(_Section):
     """s, how often the path ahead is checked for new obstacles, in (0, 60]."""
     lookahead: float = Field(_NAV.lookahead, gt=0.0, le=10.0)
     """m, the DWA heads for the path point this far ahead at full speed (2 s of the
-    current speed when slower, at least 0.3 m: Nav2 RPP's scaled lookahead), in (0, 10]."""
+    current speed when slower, at least 0.4 m: Nav2 RPP's scaled lookahead), in (0, 10]."""
     max_expansions: int = Field(_NAV.max_expansions, ge=100, le=10_000_000)
     """A* gives up (no proof either way) after this many cells, in [100, 1e7]."""
     expansions_per_tick: int = Field(_NAV.expansions_per_tick, ge=10, le=10_000_000)
