@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: run test lint bench docs test-docs clean image test-image test-versions
+.PHONY: run test lint bench docs test-docs clean image test-image test-versions mutation
 
 $(STAMP): pyproject.toml constraints.txt
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -31,6 +31,11 @@ lint: $(STAMP)
 ## recording, CAN, planner, replay, sweep, Ray, ROS 2, robots)
 bench: $(STAMP)
 	$(PY) -m otonav bench
+
+## AST mutation testing of the nav math (safety, DWA, A*, plan grid, recovery) against
+## the unit layer: prints the kill rate per module (a report, not part of `make test`)
+mutation: $(STAMP)
+	$(PY) scripts/mutation.py --show-survivors
 
 ## build the docs site into site/ (--strict: a broken link or reference fails; the
 ## reference pages and sample outputs are generated from the code and a real run)

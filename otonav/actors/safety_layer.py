@@ -11,7 +11,7 @@ from otonav.actors import topics
 from otonav.actors.odom_history import OdomHistory
 from otonav.actors.scan_cache import nearest_bound_of, nearest_of, points_of
 from otonav.msgs import Header, LaserScan, Odometry, SafetyState, Time, Twist, Vector3
-from otonav.nav.safety import SafetyParams, safe_command
+from otonav.nav.safety import SafetyParams, safe_command, stopping_reach
 from otonav.nav.scan import to_frame
 from otonav.runtime import Actor, Input, Output
 
@@ -129,7 +129,7 @@ class SafetyLayer(Actor):
             # the longest stopping path out of the radius cannot matter (no transform).
             moved = math.hypot(pose[0] - scan_pose[0], pose[1] - scan_pose[1])
             fastest = max(abs(v_in), abs(v0))
-            reach = fastest * p.latency + fastest * fastest / (2.0 * p.max_accel) + 0.05
+            reach = stopping_reach(fastest, p)
             # A bound on the nearest return first (the shortest range less the laser
             # offset, ~1/6 of the exact distance's cost): when it clears, the exact
             # distance does too, and is only computed if a report goes out.

@@ -28,7 +28,7 @@ from otonav.control import (
 from otonav.hal import RobotHardwareInterface, WheelSetpoint
 from otonav.nav import GoToGoalParams, GuardParams, go_to_goal, guard_blocked
 from otonav.nav.navigation import Navigation
-from otonav.nav.safety import safe_command
+from otonav.nav.safety import safe_command, stopping_reach
 from otonav.nav.scan import scan_points, to_frame
 from otonav.stack import BaseConfig, StackConfig
 from otonav.stack.build import navigation_params, safety_params
@@ -228,9 +228,7 @@ def run_bare_stack(
             else:
                 moved_by = math.hypot(here[0] - points_pose[0], here[1] - points_pose[1])
                 fastest = max(abs(v_in), abs(odom_v))
-                reach = (
-                    fastest * safety.latency + fastest * fastest / (2.0 * safety.max_accel) + 0.05
-                )
+                reach = stopping_reach(fastest, safety)
                 if nearest - moved_by > safety.radius + reach:
                     want_v, want_omega = v_in, w_in
                 else:

@@ -27,7 +27,8 @@ One step:
    + w_speed * v / max_v``.
    The target is a point of the global path ahead of the robot (or the goal); heading
    and progress are taken at the rollout's closest approach to it, among its poses
-   before the first one under the threshold.
+   before the first one under the threshold (the heading at the last of those poses
+   when the closest approach is the start: a rollout that never gets nearer).
 
 The best admissible sample is the command. With none admissible the command is the
 braking one and the reason says so.
@@ -350,9 +351,16 @@ def dwa_step(
     np.putmask(late, columns[None, :] > last[:, None], np.inf)  # beyond the cut
     best_i = late.argmin(axis=1)
     flat = best_i + columns.size * _columns(n - 1)  # (row, best_i) in the raveled arrays
-    ex, ey = xs.ravel()[flat], ys.ravel()[flat]
     closest = to_target.ravel()[flat]
-    bearing = np.arctan2(ty - ey, tx - ex) - thu.ravel()[best_i + columns.size * rows]
+    # A rollout that never gets nearer (the target behind a robot still rolling
+    # forward) has its closest approach at the start, where every rollout has the same
+    # heading: its bearing is judged at its last free pose instead. Otherwise all tie
+    # and the first sample, the hardest right turn, won: the robot turned the long way
+    # round to a target behind on its left (issue 24, a false recovery in a U trap).
+    head_i = np.where(best_i == 0, last, best_i)
+    flat_h = head_i + columns.size * _columns(n - 1)
+    ex, ey = xs.ravel()[flat_h], ys.ravel()[flat_h]
+    bearing = np.arctan2(ty - ey, tx - ex) - thu.ravel()[head_i + columns.size * rows]
     bearing = np.abs(np.remainder(bearing + math.pi, math.tau) - math.pi)
     np.putmask(bearing, closest < 0.05, 0.0)  # at the target: no bearing to keep
     d0 = math.hypot(tx - x0, ty - y0)

@@ -114,25 +114,27 @@ class AstarSearch:
         self._pen = memoryview(pen.data).cast("B").cast("d")
         self._w, self._s, self._g = w, s, g
         self._sr, self._sc = divmod(s, w)
+        # The heuristic of every cell at once (octile distance to the start, the same
+        # floats as the per-cell formula): a buffer lookup instead of a Python call per
+        # neighbour pushed, ~25 % of the search's time (issue 24, planner tick).
+        dr = np.abs(np.arange(rows + 2, dtype=np.float64) - self._sr)[:, None]
+        dc = np.abs(np.arange(w, dtype=np.float64) - self._sc)[None, :]
+        heuristic = (dr + dc) + (_SQRT2 - 2.0) * np.minimum(dr, dc)
+        self._hv = memoryview(heuristic.data).cast("B").cast("d")
         self.max_expansions = max_expansions
         self.expansions = 0
         self._best: dict[int, float] = {g: 0.0}
         self._parent: dict[int, int] = {}
         self._closed: set[int] = set()
-        self._open: list[tuple[float, float, int]] = [(self._h(g), 0.0, g)]
+        self._open: list[tuple[float, float, int]] = [(self._hv[g], 0.0, g)]
         self.result: GridPath | None = None
-
-    def _h(self, cell: int) -> float:
-        r, c = divmod(cell, self._w)
-        dr, dc = abs(r - self._sr), abs(c - self._sc)
-        return float((dr + dc) + (_SQRT2 - 2.0) * min(dr, dc))
 
     def advance(self, budget: int) -> GridPath | None:
         """Expand up to ``budget`` more cells; the result once the search is over."""
         if self.result is not None:
             return self.result
         w, s, g = self._w, self._s, self._g
-        okl, penl, h = self._ok, self._pen, self._h
+        okl, penl, h = self._ok, self._pen, self._hv
         best, parent, closed, open_list = self._best, self._parent, self._closed, self._open
         straight = (1, -1, w, -w)
         diagonal = ((w + 1, 1, w), (w - 1, -1, w), (-w + 1, 1, -w), (-w - 1, -1, -w))
@@ -164,7 +166,7 @@ class AstarSearch:
                     if c2 < best.get(n, inf):
                         best[n] = c2
                         parent[n] = cell
-                        heappush(open_list, (c2 + h(n), c2, n))
+                        heappush(open_list, (c2 + h[n], c2, n))
             for step, side_a, side_b in diagonal:
                 n = cell + step
                 if okl[n] and okl[cell + side_a] and okl[cell + side_b] and n not in closed:
@@ -172,6 +174,6 @@ class AstarSearch:
                     if c2 < best.get(n, inf):
                         best[n] = c2
                         parent[n] = cell
-                        heappush(open_list, (c2 + h(n), c2, n))
+                        heappush(open_list, (c2 + h[n], c2, n))
         self.result = GridPath((), inf, self.expansions, True)
         return self.result

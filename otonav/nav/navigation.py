@@ -18,7 +18,8 @@ Each :meth:`Navigation.step` (at the navigator's rate):
    that kept only what the scans still show);
 3. within ``approach_radius`` of the goal, a proportional controller finishes, forward
    or in reverse (an overshoot is backed out of, not turned around); farther away,
-   **DWA** (:mod:`otonav.nav.dwa`) toward a point ``lookahead`` m along the path:
+   **DWA** (:mod:`otonav.nav.dwa`) toward a point along the path (``LOOKAHEAD_TIME``
+   s of the current speed ahead, within [``MIN_LOOKAHEAD``, ``lookahead``] m):
    ``driving``, or ``avoiding`` when the chosen arc passes near a return; ``blocked``
    when no arc is admissible;
 4. **progress** (:class:`~otonav.nav.recovery.ProgressChecker`): when it fails, the next
@@ -50,7 +51,16 @@ from otonav.nav.plan_grid import best_points, free_threshold, pooled
 from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
 from otonav.nav.scan import ScanRays
 
-__all__ = ("LADDER", "TURN_CREDIT", "NavOutput", "Navigation", "NavigationParams", "Points")
+__all__ = (
+    "LADDER",
+    "LOOKAHEAD_TIME",
+    "MIN_LOOKAHEAD",
+    "TURN_CREDIT",
+    "NavOutput",
+    "Navigation",
+    "NavigationParams",
+    "Points",
+)
 
 Points = NDArray[np.float64] | Callable[[], NDArray[np.float64]]
 """Scan returns in base_link, ``(N, 2)`` m, or a function that computes them."""
@@ -60,8 +70,18 @@ def _resolve(points: Points) -> NDArray[np.float64]:
     return points() if callable(points) else points
 
 
-TURN_CREDIT = 0.25
-"""m of progress per radian turned toward the target (a half turn: 0.8 m)."""
+TURN_CREDIT = 0.4
+"""m of progress per radian turned toward the target while it is more than the DWA's
+``rotate_threshold`` off the heading (a half turn: (pi - 0.6) x 0.4 = 1.0 m). Nearer
+than that the robot is meant to drive: turning does not count (issue 24: at a U
+trap's outer corner the DWA turned ever slower toward a target through the wall, at
+v = 0, and the credit for that turn kept the progress check quiet for 6 s)."""
+
+LOOKAHEAD_TIME = 2.0
+"""s of the current speed the DWA's target lies ahead along the path (0.4 m/s: 0.8 m)."""
+
+MIN_LOOKAHEAD = 0.4
+"""m, the shortest lookahead (Nav2 Regulated Pure Pursuit's ``min_lookahead_dist``)."""
 
 LADDER = ("spin", "backup", "follow")
 """The recovery stages, in order."""
@@ -79,7 +99,8 @@ class NavigationParams:
         plan_resolution: global planner cell, m (a multiple of ``map_resolution``).
         plan_penalty: extra cost per cell near obstacles (0: shortest path).
         replan_period: blocked-path check period, s.
-        lookahead: the DWA's target is this far along the path, m.
+        lookahead: the DWA's target is at most this far along the path (at full
+            speed; nearer when slower, see ``LOOKAHEAD_TIME``), m.
         max_expansions: A* gives up (no proof either way) after this many cells.
         expansions_per_tick: A* expands at most this many cells per step; a search
             that needs more goes on at the next step (the robot follows the previous
@@ -300,11 +321,12 @@ class Navigation:
                     )
                 return self._give_up("no path to the goal in the observed map", distance, heading)
         to_go = self._to_go(pose, distance)
-        target = self._target(pose)
+        target = self._target(pose, v0)
         # Turning toward the way on counts too (a robot facing away from a new path
-        # turns in place first): TURN_CREDIT m per radian of bearing to the target.
+        # turns in place first): TURN_CREDIT m per radian of bearing to the target
+        # beyond the DWA's rotate threshold (nearer, it should drive).
         bearing = abs(wrap_angle(math.atan2(target[1] - y, target[0] - x) - yaw))
-        measure = to_go + TURN_CREDIT * bearing
+        measure = to_go + TURN_CREDIT * max(bearing - self.params.dwa.rotate_threshold, 0.0)
         if self._new_path:  # new knowledge is not progress, and not a lack of it
             self._new_path = False
             self._checker.rebase(measure)
@@ -487,16 +509,21 @@ class Navigation:
         d = np.hypot(self.path[:, 0] - pose[0], self.path[:, 1] - pose[1])
         return self.path[int(np.argmin(d)) :]
 
-    def _target(self, pose: tuple[float, float, float]) -> tuple[float, float]:
-        """The first path point at least ``lookahead`` from the robot, after the one
-        nearest it (one distance pass serves both searches)."""
+    def _target(self, pose: tuple[float, float, float], v0: float) -> tuple[float, float]:
+        """The first path point at least the lookahead from the robot, after the one
+        nearest it (one distance pass serves both searches). The lookahead scales with
+        the speed, like Nav2's Regulated Pure Pursuit: ``LOOKAHEAD_TIME`` s of the
+        current speed, within [``MIN_LOOKAHEAD``, ``lookahead``] m. A slow robot aims
+        at the path near it: in a door at the passable limit it lines up on the path
+        instead of heading for a point beyond the door past its corner (issue 24)."""
         assert self.goal is not None
         path = self.path
         if path is None:
             return self.goal
         d = np.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1])
         i = int(d.argmin())  # (the array methods: no np.argmin/np.flatnonzero wrappers)
-        beyond = d[i:] >= self.params.lookahead
+        lookahead = min(max(abs(v0) * LOOKAHEAD_TIME, MIN_LOOKAHEAD), self.params.lookahead)
+        beyond = d[i:] >= lookahead
         j = i + int(beyond.argmax())  # the first True, or i when there is none
         if not beyond[j - i]:
             return self.goal

@@ -65,6 +65,11 @@ class Judge(Actor):
         self.nav_state = "starting"
         self.nav_reason = ""
         """The navigator's latest reason (/nav/diagnostics; empty for the stop planner)."""
+        self.recoveries: list[str] = []
+        """Each recovery rung the navigator ran, as it began: ``spin at 12.3 s (rung
+        1/3, under 0.3 m of progress along the path in 3.5 s)`` (/nav/diagnostics'
+        stage and reason; issue 24: the verdict says which rung ran and why)."""
+        self._stage = ""
         self.hal = hal
         self.goal = goal
         self.tolerance = tolerance
@@ -133,6 +138,10 @@ class Judge(Actor):
         diag = self.nav_diag_in.take_latest()
         if diag is not None:
             self.nav_reason = diag.reason
+            if diag.stage and diag.stage != self._stage:
+                why = diag.reason.removeprefix(f"{diag.stage}: ")
+                self.recoveries.append(f"{diag.stage} at {now:.1f} s ({why})")
+            self._stage = diag.stage
 
     def sample(self, now: float) -> None:
         x, y, vx, vy = self.hal.planar_truth()

@@ -88,6 +88,10 @@ class Verdict:
     """The navigator's last /nav/state (e.g. reached, unreachable)."""
     nav_reason: str = ""
     """The navigator's last reason (/nav/diagnostics), e.g. why it gave up."""
+    recoveries: list[str] = field(default_factory=list)
+    """The recovery rungs the navigator ran, in order, each with when and why (e.g.
+    ``spin at 12.3 s (rung 1/3, under 0.3 m of progress along the path in 3.5 s)``);
+    the reason names them too."""
     sim_budget_s: float = 0.0
     """s of sim time the scenario allowed (scaled to the robot's speed: ``for_robot``)."""
     clearance_floor_m: float = 0.0
@@ -626,6 +630,8 @@ def judge_verdict(
             else f"reported unreachable at {judge.unreachable_at:.1f} s, as expected, "
             "with clearance"
         )
+    if judge.recoveries:
+        reasons.append(f"recoveries: {'; '.join(judge.recoveries)}")
     return Verdict(
         scenario=scenario.name,
         passed=outcome and clear,
@@ -642,6 +648,7 @@ def judge_verdict(
         unreachable_at_s=judge.unreachable_at,
         nav_state=judge.nav_state,
         nav_reason=judge.nav_reason,
+        recoveries=list(judge.recoveries),
         sim_budget_s=scenario.sim_budget,
         clearance_floor_m=scenario.min_clearance,
         closest_xy=list(judge.min_clearance_at) if judge.min_clearance_at else None,

@@ -255,57 +255,41 @@ def external_planner(config: StackConfig) -> StackConfig:
     return config.model_copy(update={"nav": config.nav.model_copy(update={"planner": "external"})})
 
 
+_MAP_NAMES = {"half_size": "map_half_size", "resolution": "map_resolution"}
+"""``nav.map`` fields whose NavigationParams name says "map" (the others match)."""
+
+
 def navigation_params(config: StackConfig, geometry: RobotGeometry) -> NavigationParams:
-    """The avoiding navigator's settings from ``nav.*`` and the base's limits."""
+    """The avoiding navigator's settings from ``nav.*`` and the base's limits: the
+    ``nav.dwa``, ``nav.map`` and ``nav.recovery`` sections pass through by name (their
+    defaults are NavigationParams' and DwaParams', ADR 0054); what depends on the base
+    or the footprint is derived here."""
     nav, base = config.nav, robot_base(config)
-    dwa, grid, rec = nav.dwa, nav.map, nav.recovery
     radius = centre_clearance(nav.clearance, geometry.footprint_radius, nav.footprint_padding)
+    dwa = DwaParams(
+        **nav.dwa.model_dump(),
+        max_v=min(nav.max_v, base.max_v),
+        max_omega=min(nav.max_omega, base.max_omega),
+        max_accel=base.max_accel,
+        max_alpha=base.max_alpha,
+        period=1.0 / nav.rate_hz,
+        radius=radius,
+        rotate_threshold=nav.turn_in_place_threshold,
+    )
+    grid = {_MAP_NAMES.get(k, k): v for k, v in nav.map.model_dump().items()}
+    recovery = nav.recovery.model_dump()
+    fastest_v, fastest_omega = min(nav.max_v, base.max_v), min(nav.max_omega, base.max_omega)
+    for name in ("backup_speed", "follow_speed"):
+        recovery[name] = min(recovery[name], fastest_v)
+    recovery["spin_speed"] = min(recovery["spin_speed"], fastest_omega)
     return NavigationParams(
-        dwa=DwaParams(
-            max_v=min(nav.max_v, base.max_v),
-            max_omega=min(nav.max_omega, base.max_omega),
-            max_accel=base.max_accel,
-            max_alpha=base.max_alpha,
-            period=1.0 / nav.rate_hz,
-            horizon=dwa.horizon,
-            dt=dwa.dt,
-            v_samples=dwa.v_samples,
-            omega_samples=dwa.omega_samples,
-            radius=radius,
-            latency=dwa.latency,
-            clearance_cap=dwa.clearance_cap,
-            w_heading=dwa.w_heading,
-            w_progress=dwa.w_progress,
-            w_clearance=dwa.w_clearance,
-            w_speed=dwa.w_speed,
-            rotate_threshold=nav.turn_in_place_threshold,
-            fast_path=dwa.fast_path,
-            fast_margin=dwa.fast_margin,
-        ),
+        dwa=dwa,
         tolerance=nav.tolerance,
-        map_half_size=grid.half_size,
-        map_resolution=grid.resolution,
-        plan_resolution=grid.plan_resolution,
-        plan_penalty=grid.plan_penalty,
-        replan_period=grid.replan_period,
-        lookahead=grid.lookahead,
-        max_expansions=grid.max_expansions,
-        expansions_per_tick=grid.expansions_per_tick,
-        clear_range=grid.clear_range,
-        progress_distance=rec.progress_distance,
-        progress_window=rec.progress_window,
-        goal_progress_window=rec.goal_progress_window,
-        spin_angle=rec.spin_angle,
-        spin_speed=min(rec.spin_speed, nav.max_omega, base.max_omega),
-        backup_distance=rec.backup_distance,
-        backup_speed=min(rec.backup_speed, nav.max_v, base.max_v),
-        follow_time=rec.follow_time,
-        follow_speed=min(rec.follow_speed, nav.max_v, base.max_v),
-        follow_distance=rec.follow_distance,
-        clear_radius=rec.clear_radius,
         approach_radius=nav.approach_radius,
         kp_lin=nav.kp_lin,
         kp_ang=nav.kp_ang,
+        **grid,
+        **recovery,
     )
 
 

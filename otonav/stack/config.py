@@ -17,6 +17,16 @@ from pydantic import (
 )
 
 from otonav import limits
+from otonav.nav.dwa import DwaParams
+from otonav.nav.navigation import NavigationParams
+from otonav.nav.safety import SafetyParams
+
+# The nav settings' defaults have one home: the nav parameter dataclasses (issue 31,
+# ADR 0054). The sections below carry the bounds, the units and the YAML names;
+# stack.build passes each section's fields through by name.
+_DWA = DwaParams()
+_NAV = NavigationParams()
+_SAFETY = SafetyParams()
 
 
 class _Section(BaseModel):
@@ -118,56 +128,57 @@ class DwaConfig(_Section):
     """The DWA local planner (``nav.planner = dwa``; otonav.nav.dwa). Its window is
     what the base's ``max_accel`` / ``max_alpha`` reach in one nav period."""
 
-    horizon: float = Field(1.6, gt=0.0, le=10.0)
+    horizon: float = Field(_DWA.horizon, gt=0.0, le=10.0)
     """s, rollout length, in (0, 10]."""
-    dt: float = Field(0.2, gt=0.0, le=1.0)
+    dt: float = Field(_DWA.dt, gt=0.0, le=1.0)
     """s, spacing of the rollout poses, in (0, 1] and <= horizon."""
-    v_samples: int = Field(5, ge=1, le=50)
+    v_samples: int = Field(_DWA.v_samples, ge=1, le=50)
     """speed samples across the window, in [1, 50]."""
-    omega_samples: int = Field(13, ge=1, le=100)
+    omega_samples: int = Field(_DWA.omega_samples, ge=1, le=100)
     """yaw-rate samples across the window, in [1, 100]."""
-    latency: float = Field(0.1, ge=0.0, le=2.0)
+    latency: float = Field(_DWA.latency, ge=0.0, le=2.0)
     """s, command delay assumed before braking (admissibility), in [0, 2]."""
-    clearance_cap: float = Field(0.25, gt=0.0, le=5.0)
+    clearance_cap: float = Field(_DWA.clearance_cap, gt=0.0, le=5.0)
     """m, clearance beyond the centre clearance that stops scoring, in (0, 5]."""
-    w_heading: float = Field(1.0, ge=0.0, le=100.0)
+    w_heading: float = Field(_DWA.w_heading, ge=0.0, le=100.0)
     """score weight of heading to the target at the rollout's end, in [0, 100]."""
-    w_progress: float = Field(2.0, ge=0.0, le=100.0)
+    w_progress: float = Field(_DWA.w_progress, ge=0.0, le=100.0)
     """score weight of distance gained toward the target, in [0, 100]."""
-    w_clearance: float = Field(0.6, ge=0.0, le=100.0)
+    w_clearance: float = Field(_DWA.w_clearance, ge=0.0, le=100.0)
     """score weight of clearance along the rollout, in [0, 100]."""
-    w_speed: float = Field(0.3, ge=0.0, le=100.0)
+    w_speed: float = Field(_DWA.w_speed, ge=0.0, le=100.0)
     """score weight of forward speed, in [0, 100]."""
-    fast_path: bool = True
+    fast_path: bool = _DWA.fast_path
     """try the pure-pursuit arc to the target first and skip the sampling when it
     provably keeps ``fast_margin`` beyond the centre clearance (otonav.nav.dwa)."""
-    fast_margin: float = Field(0.2, ge=0.0, le=5.0)
+    fast_margin: float = Field(_DWA.fast_margin, ge=0.0, le=5.0)
     """m, clearance beyond the centre clearance the fast path's arc keeps, in [0, 5]."""
 
 
 class MapConfig(_Section):
     """The navigator's map of the scans and its global planner (A*)."""
 
-    half_size: float = Field(10.0, gt=0.0, le=100.0)
+    half_size: float = Field(_NAV.map_half_size, gt=0.0, le=100.0)
     """m, the map spans this far from the start pose in x and y, in (0, 100]."""
-    resolution: float = Field(0.05, ge=0.005, le=0.2)
+    resolution: float = Field(_NAV.map_resolution, ge=0.005, le=0.2)
     """m, map cell, in [0.005, 0.2]. Clearances read from the map are lower bounds,
     short by up to resolution * sqrt(2); 5 cm marks 4x fewer kernel cells per return
     than 2.5 cm (the map update was the planner's largest cost)."""
-    plan_resolution: float = Field(0.1, ge=0.005, le=1.0)
+    plan_resolution: float = Field(_NAV.plan_resolution, ge=0.005, le=1.0)
     """m, global planner cell (a multiple of ``resolution``), in [0.005, 1]."""
-    plan_penalty: float = Field(2.0, ge=0.0, le=100.0)
+    plan_penalty: float = Field(_NAV.plan_penalty, ge=0.0, le=100.0)
     """extra path cost per cell near obstacles (0: shortest path), in [0, 100]."""
-    replan_period: float = Field(0.5, gt=0.0, le=60.0)
+    replan_period: float = Field(_NAV.replan_period, gt=0.0, le=60.0)
     """s, how often the path ahead is checked for new obstacles, in (0, 60]."""
-    lookahead: float = Field(0.8, gt=0.0, le=10.0)
-    """m, the DWA heads for the path point this far ahead, in (0, 10]."""
-    max_expansions: int = Field(60_000, ge=100, le=10_000_000)
+    lookahead: float = Field(_NAV.lookahead, gt=0.0, le=10.0)
+    """m, the DWA heads for the path point this far ahead at full speed (2 s of the
+    current speed when slower, at least 0.4 m: Nav2 RPP's scaled lookahead), in (0, 10]."""
+    max_expansions: int = Field(_NAV.max_expansions, ge=100, le=10_000_000)
     """A* gives up (no proof either way) after this many cells, in [100, 1e7]."""
-    expansions_per_tick: int = Field(600, ge=10, le=10_000_000)
+    expansions_per_tick: int = Field(_NAV.expansions_per_tick, ge=10, le=10_000_000)
     """A* expands at most this many cells per navigator step; a longer search goes on
     at the next step (bounded tick time, ADR 0043), in [10, 1e7]."""
-    clear_range: float = Field(3.0, ge=0.0, le=100.0)
+    clear_range: float = Field(_NAV.clear_range, ge=0.0, le=100.0)
     """m, before a replan the map frees the cells within this range that the last
     scan saw through (a moved obstacle, a misread); 0: never, in [0, 100]."""
 
@@ -177,28 +188,28 @@ class RecoveryConfig(_Section):
     with the defaults the whole ladder, stuck robot to ``unreachable``, takes at most
     4 x 3.5 s of windows + 2.1 + 2.5 + 5 s of rungs = 23.6 s of sim time."""
 
-    progress_distance: float = Field(0.3, gt=0.0, le=10.0)
+    progress_distance: float = Field(_NAV.progress_distance, gt=0.0, le=10.0)
     """m, progress that counts, in (0, 10]."""
-    progress_window: float = Field(3.5, gt=0.0, le=600.0)
+    progress_window: float = Field(_NAV.progress_window, gt=0.0, le=600.0)
     """s of sim time to shrink the distance to go along the path by
     ``progress_distance`` (what the robot does, not what the planner says), in (0, 600]."""
-    goal_progress_window: float = Field(30.0, gt=0.0, le=3600.0)
+    goal_progress_window: float = Field(_NAV.goal_progress_window, gt=0.0, le=3600.0)
     """s of sim time to get ``progress_distance`` closer to the goal, in (0, 3600]."""
-    spin_angle: float = Field(math.pi / 2, gt=0.0, le=2 * math.pi)
+    spin_angle: float = Field(_NAV.spin_angle, gt=0.0, le=2 * math.pi)
     """rad, the look-around turn, in (0, 2 pi]."""
-    spin_speed: float = Field(1.0, gt=0.0, le=10.0)
+    spin_speed: float = Field(_NAV.spin_speed, gt=0.0, le=10.0)
     """rad/s, in (0, 10]."""
-    backup_distance: float = Field(0.3, gt=0.0, le=5.0)
+    backup_distance: float = Field(_NAV.backup_distance, gt=0.0, le=5.0)
     """m, in (0, 5]."""
-    backup_speed: float = Field(0.15, gt=0.0, le=2.0)
+    backup_speed: float = Field(_NAV.backup_speed, gt=0.0, le=2.0)
     """m/s, in (0, 2]."""
-    follow_time: float = Field(5.0, gt=0.0, le=600.0)
+    follow_time: float = Field(_NAV.follow_time, gt=0.0, le=600.0)
     """s, the longest boundary following, in (0, 600]."""
-    follow_speed: float = Field(0.2, gt=0.0, le=2.0)
+    follow_speed: float = Field(_NAV.follow_speed, gt=0.0, le=2.0)
     """m/s, in (0, 2]."""
-    follow_distance: float = Field(0.45, gt=0.0, le=5.0)
+    follow_distance: float = Field(_NAV.follow_distance, gt=0.0, le=5.0)
     """m, robot centre to the boundary while following, in (0, 5]."""
-    clear_radius: float = Field(1.0, ge=0.0, le=20.0)
+    clear_radius: float = Field(_NAV.clear_radius, ge=0.0, le=20.0)
     """m, the spin rung first clears the map within this distance of the robot (0:
     never), in [0, 20]."""
 
@@ -240,23 +251,23 @@ class NavConfig(_Section):
     stops in front of an obstacle (the original behaviour); ``external``: no planner
     actor, your own node publishes /cmd_vel_nav (behind the safety layer)."""
     rate_hz: PositiveFloat = 20.0
-    kp_lin: float = Field(0.8, ge=0.0)
+    kp_lin: float = Field(_NAV.kp_lin, ge=0.0)
     """Proportional gain on the distance to the goal (``stop`` planner, and the final
     approach of ``dwa``), 1/s."""
-    kp_ang: float = Field(2.0, ge=0.0)
+    kp_ang: float = Field(_NAV.kp_ang, ge=0.0)
     """Proportional gain on the heading error, 1/s."""
-    max_v: PositiveFloat = 0.4
+    max_v: PositiveFloat = _NAV.dwa.max_v
     """m/s, the fastest the navigator asks for."""
-    max_omega: PositiveFloat = 1.2
+    max_omega: PositiveFloat = _NAV.dwa.max_omega
     """rad/s, the fastest turn the navigator asks for."""
-    tolerance: PositiveFloat = 0.08
+    tolerance: PositiveFloat = _NAV.tolerance
     """m: the navigator stops within this distance of the goal (by odometry)."""
-    turn_in_place_threshold: PositiveFloat = 0.6
+    turn_in_place_threshold: PositiveFloat = _NAV.dwa.rotate_threshold
     """rad of heading error above which the robot turns in place first."""
     clearance: float = Field(0.35, ge=0.0, le=5.0)
     """m, robot centre (base_link, the judged point) to any return: what the planner
     keeps, in [0, 5]; at least ``safety.clearance``."""
-    approach_radius: float = Field(0.25, ge=0.0, le=5.0)
+    approach_radius: float = Field(_NAV.approach_radius, ge=0.0, le=5.0)
     """m (dwa planner): within this distance of the goal a proportional controller
     (``kp_lin``, ``kp_ang``) finishes, in reverse if the goal is behind, in [0, 5]."""
     footprint_padding: float = Field(0.05, ge=0.0, le=1.0)
@@ -288,7 +299,7 @@ class SafetyConfig(_Section):
     """s without /cmd_vel_nav before the command counts as zero, in (0, 10]."""
     scan_timeout: float = Field(0.35, gt=0.0, le=10.0)
     """s without /scan (or /odom) before the layer stops the robot (blind), in (0, 10]."""
-    scales: int = Field(6, ge=2, le=100)
+    scales: int = Field(_SAFETY.scales, ge=2, le=100)
     """forward-speed scales tried from 1 down to 0, in [2, 100]."""
 
 

@@ -178,6 +178,40 @@ def test_a_robot_oscillating_across_its_path_is_in_recovery_within_the_window() 
     assert "rung 1/3" in log[-1][3]
 
 
+def test_turning_slowly_while_nearly_facing_the_target_is_not_progress() -> None:
+    """Issue 24's U trap, outer corner: the robot drives 0.26 m, then stands with the
+    target 0.55 rad off (through the wall's corner) and turns ever slower toward it.
+    Turning counts only while the target is beyond the DWA's rotate threshold: the
+    robot is in recovery one window after its last real progress."""
+    params = _params()
+    nav = Navigation(params, (0.0, 0.0))
+    nav.set_goal((4.0, 0.0))
+
+    def motion(t: float) -> tuple[float, float, float]:
+        if t < 1.3:
+            return (0.2 * t, 0.0, 0.55)  # sliding ahead, facing 0.55 rad off
+        return (0.26, 0.0, 0.55 * math.exp(-(t - 1.3)))  # then turning ever slower
+
+    t, log = _drive(nav, motion, 30.0, lambda out: out.state == "recovering")
+    assert log[-1][1] == "recovering", log[-1]
+    assert t <= params.progress_window + 0.05  # (with the credit for that turn: 6.7 s)
+
+
+def test_turning_toward_a_target_behind_is_progress() -> None:
+    """A robot facing away from its target turns in place first: a half turn at the
+    DWA's rate is progress, not a stall (no recovery while it turns)."""
+    params = _params()
+    nav = Navigation(params, (0.0, 0.0))
+    nav.set_goal((-4.0, 0.0))  # behind
+    _t, log = _drive(
+        nav,
+        lambda t: (0.0, 0.0, min(1.0 * t, math.pi)),  # 1 rad/s, then facing it
+        params.progress_window + 0.5,
+        lambda out: out.state == "recovering",
+    )
+    assert all(state != "recovering" for _, state, _, _ in log), log[-1]
+
+
 def test_a_stuck_robot_climbs_the_whole_ladder_in_about_20_s_and_says_why() -> None:
     """Wheels spinning in place: every rung runs, each named with its reason in the
     diagnostics while it runs, and the verdict comes within ~24 s of sim time."""
@@ -207,3 +241,18 @@ def test_the_spin_rung_clears_the_map_around_the_robot() -> None:
     row, col, _ = nav.map.cell_of(np.array([0.6]), np.array([0.0]))
     assert not nav.map.occupied[row, col].any()  # the smear is gone
     assert 0 < int(nav.map.occupied.sum()) < far
+
+
+def test_the_lookahead_scales_with_the_speed_like_regulated_pure_pursuit() -> None:
+    """A slow robot aims at the path near it (0.4 m), a fast one 2 s of its speed
+    ahead up to ``nav.map.lookahead``: at a door at the limit, standing off its axis,
+    the robot lines up on the path instead of heading past the door's corner."""
+    params = _params()
+    nav = Navigation(params, (0.0, 0.0))
+    nav.set_goal((4.0, 0.0))
+    _settle(nav, (0.0, 0.0, 0.0))
+    assert nav.path is not None
+    for v0, want in ((0.0, 0.4), (-0.05, 0.4), (0.25, 0.5), (0.4, 0.8), (0.5, 0.8)):
+        tx, ty = nav._target((0.0, 0.0, 0.0), v0)
+        assert ty == pytest.approx(0.0, abs=0.06)
+        assert want <= tx <= want + 0.15, (v0, tx)

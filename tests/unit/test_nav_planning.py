@@ -426,8 +426,9 @@ def _dwa_reference(
         count += 1
         d = np.hypot(target[0] - xs[: last + 1], target[1] - ys[: last + 1])
         i = int(np.argmin(d - 1e-9 * np.arange(last + 1)))
+        h = i if i > 0 else last  # never nearer: the heading where it gets to
         bearing = abs(
-            math.remainder(math.atan2(target[1] - ys[i], target[0] - xs[i]) - th[i], math.tau)
+            math.remainder(math.atan2(target[1] - ys[h], target[0] - xs[h]) - th[h], math.tau)
         )
         bearing = 0.0 if d[i] < 0.05 else bearing
         gain = (math.hypot(target[0] - x0, target[1] - y0) - d[i]) / (p.max_v * p.horizon)
@@ -480,6 +481,17 @@ def test_dwa_turns_first_toward_a_target_behind() -> None:
     r = dwa_step((0.0, 0.0, 0.0), 0.0, 0.0, (-2.0, 0.1), 2.0, m.clearance, DwaParams())
     assert r.v == 0.0
     assert r.omega > 0.0
+
+
+@pytest.mark.parametrize("side", [1.0, -1.0])
+def test_dwa_still_rolling_turns_toward_the_side_of_a_target_behind(side: float) -> None:
+    """Rolling forward, every rollout gets farther from a target behind: judged at the
+    start they all tied and the first (the hardest right turn) won, so a target
+    behind on the left was turned to the long way round (issue 24's U trap)."""
+    m = _map_with(np.empty((0, 2)))
+    target = (-2.0, side * 0.8)  # behind, 2.76 rad off to one side
+    r = dwa_step((0.0, 0.0, 0.0), 0.3, 0.0, target, 2.2, m.clearance, DwaParams())
+    assert r.omega * side > 0.0, r
 
 
 def test_dwa_params_validate() -> None:

@@ -6,8 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from otonav.nav.safety import SafetyParams, safe_command
+from otonav.nav.safety import SafetyParams, safe_command, stopping_reach
 
 pytestmark = pytest.mark.unit
 
@@ -73,3 +75,38 @@ def test_params_validate() -> None:
         SafetyParams(radius=0.0)
     with pytest.raises(ValueError, match="scales"):
         SafetyParams(scales=1)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.floats(-0.5, 0.5),
+    st.floats(-1.5, 1.5),
+    st.floats(-0.5, 0.5),
+    st.floats(-1.5, 1.5),
+    st.lists(st.tuples(st.floats(-3.0, 3.0), st.floats(-3.0, 3.0)), min_size=1, max_size=20),
+)
+def test_returns_beyond_the_stopping_reach_never_change_a_command(
+    v: float, w: float, v0: float, w0: float, xy: list[tuple[float, float]]
+) -> None:
+    """The bound the safety layer and the bare benchmark skip the check on
+    (stopping_reach, issue 31): beyond it the command goes through as it came."""
+    points = np.array(xy)
+    fastest = max(abs(v), abs(v0))
+    nearest = float(np.hypot(points[:, 0], points[:, 1]).min())
+    r = safe_command(v, w, v0, w0, points, P)
+    if nearest >= P.radius + stopping_reach(fastest, P):
+        assert (r.v, r.omega, r.reason) == (v, w, "clear")
+    else:
+        assert r.reason != "clear"
+
+
+def test_the_stopping_reach_is_latency_braking_and_the_integration_slack() -> None:
+    p = SafetyParams(radius=0.3, max_accel=2.0, latency=0.1, dt=0.01)
+    assert stopping_reach(0.0, p) == pytest.approx(1e-6, abs=1e-9)
+    assert stopping_reach(0.4, p) == pytest.approx(
+        0.4 * 0.1 + 0.16 / 4.0 + 2 * 0.01 * 0.4, abs=2e-6
+    )
+    # A command just inside the reach of a wall ahead is checked (and slowed).
+    edge = p.radius + stopping_reach(0.4, p)
+    assert safe_command(0.4, 0.0, 0.4, 0.0, _wall(edge + 1e-3), p).reason == "clear"
+    assert safe_command(0.4, 0.0, 0.4, 0.0, _wall(edge - 1e-3), p).reason != "clear"

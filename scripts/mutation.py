@@ -1,0 +1,318 @@
+"""AST mutation testing of the pure navigation math against the unit layer (issue 24).
+
+    python scripts/mutation.py [MODULE ...] [--list] [--timeout S] [--show-survivors]
+
+Each mutant changes one node of one module's syntax tree:
+
+* arithmetic: ``+ <-> -``, ``* <-> /``, ``** -> *``, ``// -> /``, ``% -> //``;
+* comparisons: ``< <-> <=``, ``> <-> >=``, ``== <-> !=``, ``is <-> is not``,
+  ``in <-> not in``;
+* boolean ``and <-> or``, ``not x -> x``, unary ``-x -> x``;
+* numbers: ``0 -> 1``, ``1 -> 0``, any other ``c -> c + 1``; ``True <-> False``;
+* ``min <-> max`` calls.
+
+Docstrings and ``__all__`` are not mutated (their strings are not numbers);
+neither are type annotations (they do not run).
+
+A mutant is *killed* when its module's unit tests (the table ``TARGETS``) fail on
+it or run out of ``--timeout`` seconds (a mutated loop that never ends). Each
+mutant runs in a child forked from a parent that has imported numpy, pytest and
+hypothesis once; the child compiles the mutated source into ``sys.modules`` before
+anything imports the module, then runs pytest in-process with ``-x`` (the first
+failure kills). Prints the kill rate per module and in total; exit 0 (a report, not
+a gate: ``make mutation``).
+
+Why not mutmut or cosmic-ray (both on PyPI): mutmut 3 copies the tree into
+``mutants/`` and trampolines every function, which numpy-vectorised code and
+slotted dataclasses resist; cosmic-ray starts the test command once per mutant (~1.5
+s of imports each here). A fork per mutant after the imports costs ~0.1 s (ADR 0054).
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import os
+import signal
+import sys
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from types import CodeType
+
+ROOT = Path(__file__).resolve().parent.parent
+
+TARGETS: dict[str, tuple[str, ...]] = {
+    "otonav.nav.safety": (
+        "tests/unit/test_safety_limit.py",
+        "tests/unit/test_safety_reference.py",
+    ),
+    "otonav.nav.dwa": (
+        "tests/unit/test_nav_planning.py",
+        "tests/unit/test_nav_dwa.py",
+    ),
+    "otonav.nav.global_path": (
+        "tests/unit/test_nav_planning.py",
+        "tests/unit/test_nav_indoor.py",
+        "tests/unit/test_nav_search.py",
+    ),
+    "otonav.nav.plan_grid": ("tests/unit/test_nav_indoor.py", "tests/unit/test_nav_search.py"),
+    "otonav.nav.recovery": (
+        "tests/unit/test_nav_planning.py",
+        "tests/unit/test_nav_indoor.py",
+        "tests/unit/test_nav_search.py",
+    ),
+}
+"""Module -> the unit test files that pin it (files that do not exist are skipped)."""
+
+_DESELECT = "not imports_nothing_more"
+"""Tests that start a subprocess (the mutant is not in it): skipped."""
+
+_BINOP = {
+    ast.Add: ast.Sub,
+    ast.Sub: ast.Add,
+    ast.Mult: ast.Div,
+    ast.Div: ast.Mult,
+    ast.Pow: ast.Mult,
+    ast.FloorDiv: ast.Div,
+    ast.Mod: ast.FloorDiv,
+}
+_CMPOP = {
+    ast.Lt: ast.LtE,
+    ast.LtE: ast.Lt,
+    ast.Gt: ast.GtE,
+    ast.GtE: ast.Gt,
+    ast.Eq: ast.NotEq,
+    ast.NotEq: ast.Eq,
+    ast.Is: ast.IsNot,
+    ast.IsNot: ast.Is,
+    ast.In: ast.NotIn,
+    ast.NotIn: ast.In,
+}
+
+
+@dataclass(frozen=True, slots=True)
+class Mutant:
+    module: str
+    index: int
+    line: int
+    what: str
+
+
+def _skipped(tree: ast.Module) -> set[int]:
+    """ids of nodes not to mutate: annotations, docstrings, ``__all__``."""
+    skip: set[int] = set()
+    for node in ast.walk(tree):
+        annotations: list[ast.AST | None] = []
+        if isinstance(node, ast.AnnAssign):
+            annotations.append(node.annotation)
+        elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            annotations.append(node.returns)
+            args = node.args
+            for arg in (*args.posonlyargs, *args.args, *args.kwonlyargs, args.vararg, args.kwarg):
+                if arg is not None:
+                    annotations.append(arg.annotation)
+        elif isinstance(node, ast.Assign) and any(
+            isinstance(t, ast.Name) and t.id in ("__all__",) for t in node.targets
+        ):
+            annotations.append(node)
+        for a in annotations:
+            if a is not None:
+                skip.update(id(n) for n in ast.walk(a))
+    return skip
+
+
+def _sites(tree: ast.Module) -> Iterator[tuple[ast.AST, str, int]]:
+    """(node, description, variant) for every mutation of ``tree``, in a fixed order."""
+    skip = _skipped(tree)
+    for node in ast.walk(tree):
+        if id(node) in skip:
+            continue
+        if isinstance(node, ast.BinOp) and type(node.op) in _BINOP:
+            yield node, f"{type(node.op).__name__} -> {_BINOP[type(node.op)].__name__}", 0
+        elif isinstance(node, ast.Compare):
+            for k, op in enumerate(node.ops):
+                if type(op) in _CMPOP:
+                    yield node, f"{type(op).__name__} -> {_CMPOP[type(op)].__name__}", k
+        elif isinstance(node, ast.BoolOp):
+            yield (
+                node,
+                f"{type(node.op).__name__} -> {'Or' if isinstance(node.op, ast.And) else 'And'}",
+                0,
+            )
+        elif isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.Not, ast.USub)):
+            yield node, f"drop {type(node.op).__name__}", 0
+        elif isinstance(node, ast.Constant):
+            if isinstance(node.value, bool):
+                yield node, f"{node.value} -> {not node.value}", 0
+            elif isinstance(node.value, (int, float)):
+                yield node, f"{node.value!r} -> {_number(node.value)!r}", 0
+        elif (
+            isinstance(node, ast.Call)
+            and isinstance(node.func, ast.Name)
+            and node.func.id in ("min", "max")
+        ):
+            yield node, f"{node.func.id} -> {'max' if node.func.id == 'min' else 'min'}", 0
+
+
+def _number(value: float) -> float:
+    if value == 0:
+        return type(value)(1)
+    if value == 1:
+        return type(value)(0)
+    return value + 1
+
+
+def _apply(node: ast.AST, variant: int) -> None:
+    if isinstance(node, ast.BinOp):
+        node.op = _BINOP[type(node.op)]()
+    elif isinstance(node, ast.Compare):
+        ops = list(node.ops)
+        ops[variant] = _CMPOP[type(ops[variant])]()
+        node.ops = ops
+    elif isinstance(node, ast.BoolOp):
+        node.op = ast.Or() if isinstance(node.op, ast.And) else ast.And()
+    elif isinstance(node, ast.Constant):
+        value = node.value
+        if isinstance(value, bool):
+            node.value = not value
+        elif isinstance(value, (int, float)):
+            node.value = _number(value)
+    elif isinstance(node, ast.Call):
+        assert isinstance(node.func, ast.Name)
+        node.func.id = "max" if node.func.id == "min" else "min"
+
+
+def _drop_unary(tree: ast.Module, target: ast.UnaryOp) -> None:
+    class Drop(ast.NodeTransformer):
+        def visit_UnaryOp(self, node: ast.UnaryOp) -> ast.AST:
+            self.generic_visit(node)
+            return node.operand if node is target else node
+
+    Drop().visit(tree)
+
+
+def mutants(module: str) -> tuple[str, list[Mutant]]:
+    path = ROOT / (module.replace(".", "/") + ".py")
+    source = path.read_text()
+    tree = ast.parse(source)
+    found = [
+        Mutant(module, i, getattr(node, "lineno", 0), what)
+        for i, (node, what, _) in enumerate(_sites(tree))
+    ]
+    return source, found
+
+
+def mutated_code(module: str, source: str, index: int) -> CodeType:
+    tree = ast.parse(source)
+    for i, (node, _what, variant) in enumerate(_sites(tree)):
+        if i == index:
+            if isinstance(node, ast.UnaryOp):
+                _drop_unary(tree, node)
+            else:
+                _apply(node, variant)
+            break
+    ast.fix_missing_locations(tree)
+    path = ROOT / (module.replace(".", "/") + ".py")
+    return compile(tree, str(path), "exec")
+
+
+def _run_child(module: str, code: CodeType, tests: list[str]) -> int:
+    import importlib.util
+
+    import pytest
+
+    spec = importlib.util.find_spec(module)
+    assert spec is not None
+    assert spec.loader is not None
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[module] = mod
+    exec(code, mod.__dict__)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 1)
+    os.dup2(devnull, 2)
+    args = [*tests, "-x", "-q", "-p", "no:cacheprovider", "-k", _DESELECT]
+    # (otonav is imported already, to hold the mutant: its plugin is not rewritten)
+    args += ["-W", "ignore::pytest.PytestAssertRewriteWarning"]
+    return int(pytest.main(args))
+
+
+def run_mutant(module: str, code: CodeType, tests: list[str], timeout: float) -> str:
+    """``killed``, ``timeout`` or ``survived``."""
+    pid = os.fork()
+    if pid == 0:  # child
+        try:
+            status = _run_child(module, code, tests)
+        except BaseException:  # a mutant that breaks at import is killed
+            status = 99
+        os._exit(status)
+    deadline = time.monotonic() + timeout
+    while True:
+        done, status = os.waitpid(pid, os.WNOHANG)
+        if done:
+            code_ = os.waitstatus_to_exitcode(status)
+            return "survived" if code_ == 0 else "killed"
+        if time.monotonic() > deadline:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            return "timeout"
+        time.sleep(0.02)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("modules", nargs="*", default=list(TARGETS))
+    parser.add_argument("--list", action="store_true", help="list the mutants only")
+    parser.add_argument("--timeout", type=float, default=60.0)
+    parser.add_argument("--show-survivors", action="store_true")
+    args = parser.parse_args()
+    unknown = [m for m in args.modules if m not in TARGETS]
+    if unknown:
+        print(f"modules: {unknown} not valid ({', '.join(TARGETS)})", file=sys.stderr)
+        return 2
+    os.chdir(ROOT)
+    import hypothesis  # noqa: F401  (imported once, before the forks)
+    import numpy  # noqa: F401
+    import pytest  # noqa: F401
+
+    total_killed = total = 0
+    started = time.monotonic()
+    for module in args.modules:
+        source, found = mutants(module)
+        tests = [t for t in TARGETS[module] if (ROOT / t).exists()]
+        if args.list:
+            for m in found:
+                print(f"{m.module}:{m.line}  #{m.index}  {m.what}")
+            continue
+        path = ROOT / (module.replace(".", "/") + ".py")
+        clean = run_mutant(module, compile(source, str(path), "exec"), tests, args.timeout)
+        if clean != "survived":  # the unmutated module must pass, or nothing is measured
+            print(f"{module}: its tests fail without a mutant ({clean})", file=sys.stderr)
+            return 1
+        survivors: list[Mutant] = []
+        killed = 0
+        for m in found:
+            outcome = run_mutant(module, mutated_code(module, source, m.index), tests, args.timeout)
+            if outcome == "survived":
+                survivors.append(m)
+            else:
+                killed += 1
+        total_killed += killed
+        total += len(found)
+        pct = 100.0 * killed / len(found) if found else 100.0
+        print(f"{module}: {killed}/{len(found)} mutants killed ({pct:.1f} %) by {' '.join(tests)}")
+        if args.show_survivors:
+            for m in survivors:
+                print(f"  survived: line {m.line}: {m.what}")
+        sys.stdout.flush()
+    if total and not args.list:
+        print(
+            f"total: {total_killed}/{total} killed ({100.0 * total_killed / total:.1f} %), "
+            f"{time.monotonic() - started:.0f} s"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
