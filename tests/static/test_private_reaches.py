@@ -119,6 +119,14 @@ def private_reaches(source: str, module: object | None = None, path: str = "") -
     ``module``: the imported module, to see classes derived through otonav's own."""
     tree = ast.parse(source)
     bound = _lib_bindings(tree)
+    # `import os` then `os._exit(...)`: another module's own name, not the library's
+    other_modules = {
+        alias.asname or alias.name.split(".")[0]
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Import)
+        for alias in node.names
+        if not _is_lib(alias.name)
+    }
     lib_names = library_private_names()
     own = _defined_names(tree)
     found: list[str] = []
@@ -182,6 +190,7 @@ def private_reaches(source: str, module: object | None = None, path: str = "") -
         elif (
             node.attr in lib_names
             and node.attr not in own
+            and root not in other_modules
             # self._x: inherited from otonav's own base (a lib-derived class: rule 4)
             and not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls"))
             and (path, node.attr) not in NOT_THE_LIBRARYS
@@ -263,6 +272,12 @@ def test_the_walk_leaves_public_use_and_own_privates_alone() -> None:
         "    asyncio.get_running_loop().call_soon(print)\n    return asyncio.Handle.__slots__\n"
     )
     assert private_reaches(source) == []
+
+
+def test_another_modules_private_looking_name_is_its_own() -> None:
+    # os._exit is os's documented function, though asyncio defines an _exit too
+    assert private_reaches("import os\nos._exit(0)\n") == []
+    assert private_reaches("import asyncio\nasyncio.events._exit\n") != []
 
 
 def test_the_compat_module_is_where_the_reaches_are() -> None:
