@@ -267,31 +267,21 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
 
     guard.arm()  # from here a signal stops the run and lets it finish its artifacts
     try:
-        if args.gui or args.realtime or bridge is not None:
-            from otonav.scenario.realtime import run_scenario_realtime
-
-            verdict = run_scenario_realtime(
-                scenario,
-                stack,
-                out_dir=out,
-                record=not args.no_record,
-                scale=scale,
-                gui=args.gui,
-                on_start=on_start,
-                extra_actors=extra,
-                hold=hold if args.hold else None,
-            )
-        else:
-            verdict = run_scenario(
-                scenario,
-                stack,
-                out_dir=out,
-                record=not args.no_record,
-                progress=progress,
-                source=source,
-                on_start=on_start,
-                extra_actors=extra,
-            )
+        paced = args.gui or args.realtime or bridge is not None
+        verdict = run_scenario(
+            scenario,
+            stack,
+            out_dir=out,
+            record=not args.no_record,
+            # the progress line is for virtual time; a paced run is watched as it goes
+            progress=None if paced else progress,
+            source=source,
+            on_start=on_start,
+            extra_actors=extra,
+            realtime=scale if paced else None,
+            gui=args.gui,
+            hold=hold if paced and args.hold else None,
+        )
     except RunCrashedError as crash:
         # An actor crashed (one line on stderr from the log; the traceback is on
         # /rosout): a failed run with its verdict and artifacts, not a raw traceback.
