@@ -3,11 +3,13 @@
 A real ``otonav sweep --backend ray`` process is killed with SIGKILL once its first run
 has finished; every process below it (Ray's GCS, raylet, agents and workers, ~170 MB
 for the two agents alone, which outlived the driver by 60-120 s) must be gone. The
-test polls for their exit; its 30 s bound only catches a hang."""
+test waits on a pidfd per process (woken by its exit, no polling); its 30 s bound only
+catches a hang."""
 
 from __future__ import annotations
 
 import os
+import select
 import signal
 import subprocess
 import sys
@@ -54,6 +56,34 @@ def _alive(pid: int, started: int) -> bool:
     return int(fields[19]) == started and fields[0] != b"Z"
 
 
+def _wait_gone(tree: dict[int, tuple[int, str]], timeout: float) -> dict[int, tuple[int, str]]:
+    """Wait until every process of ``tree`` has exited, or ``timeout`` s (a hang guard);
+    return those still alive. A pidfd is readable once its process has exited."""
+    fds: dict[int, int] = {}
+    poller = select.poll()
+    try:
+        for pid, (started, _name) in tree.items():
+            try:
+                fd = os.pidfd_open(pid)
+            except ProcessLookupError:
+                continue
+            if not _alive(pid, started):  # gone, or the pid reused, before the open
+                os.close(fd)
+                continue
+            fds[fd] = pid
+            poller.register(fd, select.POLLIN)
+        deadline = time.monotonic() + timeout
+        while fds and (remaining := deadline - time.monotonic()) > 0:
+            for fd, _event in poller.poll(remaining * 1000):
+                poller.unregister(fd)
+                os.close(fd)
+                del fds[fd]
+    finally:
+        for fd in fds:
+            os.close(fd)
+    return {pid: tree[pid] for pid in fds.values() if _alive(pid, tree[pid][0])}
+
+
 def test_ray_processes_die_with_a_sigkilled_sweep(tmp_path: Path) -> None:
     (tmp_path / "worlds").mkdir()
     (tmp_path / "worlds" / "short.yaml").write_text(
@@ -96,12 +126,7 @@ def test_ray_processes_die_with_a_sigkilled_sweep(tmp_path: Path) -> None:
         assert "ray::SweepActor" in names, names
         proc.send_signal(signal.SIGKILL)
         assert proc.wait(timeout=30) == -signal.SIGKILL
-        deadline = time.monotonic() + 30.0  # a hang guard, not the figure under test
-        left = dict(tree)
-        while left and time.monotonic() < deadline:
-            left = {pid: v for pid, v in left.items() if _alive(pid, v[0])}
-            if left:
-                time.sleep(0.1)
+        left = _wait_gone(tree, timeout=30.0)  # a hang guard, not the figure under test
         assert not left, f"still alive after the sweep was SIGKILLed: {left}"
         assert len(read_results(out / "results.jsonl")) >= 1
     finally:
