@@ -28,13 +28,46 @@ Outside it nothing is known.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
 from otonav.nav.scan import ScanRays
 
-__all__ = ("ClearanceMap",)
+__all__ = ("ClearanceMap", "GridFrame", "square_grid")
+
+
+class GridFrame(NamedTuple):
+    """A square grid's cells per side and the map coordinates of its corner (m)."""
+
+    size: int
+    origin_x: float
+    origin_y: float
+
+
+def square_grid(
+    owner: str,
+    centre_x: float,
+    centre_y: float,
+    half_size: float,
+    resolution: float,
+    max_distance: float,
+) -> GridFrame:
+    """The frame of a grid of ``half_size`` m around a centre, at ``resolution`` m a cell,
+    its settings checked (``owner`` names the class in the error): the navigator's
+    clearance map and the localizer's scan map are laid out alike."""
+    for name, value in (
+        ("half_size", half_size),
+        ("resolution", resolution),
+        ("max_distance", max_distance),
+    ):
+        if not (math.isfinite(value) and value > 0.0):
+            raise ValueError(f"{owner}.{name} must be finite and > 0 m, got {value!r}")
+    if resolution > half_size:
+        raise ValueError(f"resolution {resolution} m must be <= half_size {half_size} m")
+    size = max(1, round(2.0 * half_size / resolution))
+    return GridFrame(size, centre_x - half_size, centre_y - half_size)
 
 
 class ClearanceMap:
@@ -50,20 +83,10 @@ class ClearanceMap:
         resolution: float = 0.05,
         max_distance: float = 0.6,
     ) -> None:
-        for name, value in (
-            ("half_size", half_size),
-            ("resolution", resolution),
-            ("max_distance", max_distance),
-        ):
-            if not (math.isfinite(value) and value > 0.0):
-                raise ValueError(f"ClearanceMap.{name} must be finite and > 0 m, got {value!r}")
-        if resolution > half_size:
-            raise ValueError(f"resolution {resolution} m must be <= half_size {half_size} m")
+        frame = square_grid("ClearanceMap", centre_x, centre_y, half_size, resolution, max_distance)
         self.resolution = resolution
         self.max_distance = max_distance
-        self.size = max(1, round(2.0 * half_size / resolution))
-        self.origin_x = centre_x - half_size
-        self.origin_y = centre_y - half_size
+        self.size, self.origin_x, self.origin_y = frame
         self.occupied = np.zeros((self.size, self.size), dtype=np.bool_)
         # Per cell, what clearance() answers: the distance to the nearest occupied cell
         # less the slack (0 at least; the cap stays the cap). A border of k + 1 cells

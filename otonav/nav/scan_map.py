@@ -26,6 +26,8 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from otonav.nav.costmap import square_grid
+
 __all__ = ("CLAMP", "HIT", "MISS", "ScanMap", "normals")
 
 Array = NDArray[np.float64]
@@ -74,20 +76,10 @@ class ScanMap:
         resolution: float = 0.05,
         max_distance: float = 0.3,
     ) -> None:
-        for name, value in (
-            ("half_size", half_size),
-            ("resolution", resolution),
-            ("max_distance", max_distance),
-        ):
-            if not (math.isfinite(value) and value > 0.0):
-                raise ValueError(f"ScanMap.{name} must be finite and > 0 m, got {value!r}")
-        if resolution > half_size:
-            raise ValueError(f"resolution {resolution} m must be <= half_size {half_size} m")
+        frame = square_grid("ScanMap", centre_x, centre_y, half_size, resolution, max_distance)
         self.resolution = resolution
         self.max_distance = max_distance
-        self.size = max(1, round(2.0 * half_size / resolution))
-        self.origin_x = centre_x - half_size
-        self.origin_y = centre_y - half_size
+        self.size, self.origin_x, self.origin_y = frame
         n = self.size
         self.occupied = np.zeros((n, n), dtype=np.bool_)
         self.log_odds = np.zeros((n, n), dtype=np.float32)
