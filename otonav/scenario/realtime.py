@@ -6,7 +6,6 @@ viewer: the same world, actors, judge, recording and verdict as
 from __future__ import annotations
 
 import asyncio
-import contextlib
 import time
 from collections.abc import Callable
 from dataclasses import replace
@@ -17,7 +16,6 @@ import anyio
 from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
 from otonav.limits import check_scale
-from otonav.record.outlock import lock_output
 from otonav.runtime import Actor, RealTimeClock
 from otonav.runtime.timesource import tick_rate
 from otonav.scenario.config import ScenarioConfig
@@ -27,9 +25,8 @@ from otonav.scenario.run import (
     Verdict,
     drive,
     judged_run,
+    opened_scenario,
     run_task,
-    scenario_session,
-    scenario_world,
 )
 from otonav.stack import StackConfig
 from otonav.stack.session import StackSession
@@ -120,21 +117,9 @@ def run_scenario_realtime(
         raise ValueError(problem)
     if gui:
         check_display()
-    # one run per out_dir (issue 27): a second is refused before it touches a file
-    with lock_output(out_dir) if out_dir is not None else contextlib.nullcontext():
-        scenario, stack, hal = scenario_world(scenario, stack, source=source)
-        judge = Judge(
-            hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance, progress=progress
-        )
-        session = scenario_session(
-            scenario,
-            stack,
-            hal,
-            judge,
-            realtime=scale,
-            extra_actors=extra_actors,
-            recording=out_dir / "recording.mcap" if out_dir and record else None,
-        )
+    with opened_scenario(
+        scenario, stack, out_dir, record, source, progress, extra_actors, realtime=scale
+    ) as (scenario, stack, hal, judge, session):
         viewer: ViewerHandle | None = None
         held: list[Verdict] = []
         if gui:

@@ -291,6 +291,38 @@ def _cancel_once(task: asyncio.Task[Any]) -> None:
         task.cancel()
 
 
+@contextlib.contextmanager
+def opened_scenario(
+    scenario: ScenarioConfig,
+    stack: StackConfig,
+    out_dir: Path | None,
+    record: bool,
+    source: str,
+    progress: Callable[[Judge, float], None] | None,
+    extra_actors: tuple[Actor, ...],
+    realtime: float | None = None,
+) -> Iterator[tuple[ScenarioConfig, StackConfig, RobotHardwareInterface, Judge, StackSession]]:
+    """What a judged run opens, in the virtual and the real-time runner alike: the lock
+    on ``out_dir`` (held until the block ends: one run per out_dir, issue 27, refused
+    before it touches a file), the world, the judge and the session recording to
+    ``out_dir/recording.mcap`` (with ``record``)."""
+    with lock_output(out_dir) if out_dir is not None else contextlib.nullcontext():
+        scenario, stack, hal = scenario_world(scenario, stack, source=source)
+        judge = Judge(
+            hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance, progress=progress
+        )
+        session = scenario_session(
+            scenario,
+            stack,
+            hal,
+            judge,
+            realtime=realtime,
+            extra_actors=extra_actors,
+            recording=out_dir / "recording.mcap" if out_dir and record else None,
+        )
+        yield scenario, stack, hal, judge, session
+
+
 def run_scenario(
     scenario: ScenarioConfig = ScenarioConfig(),
     stack: StackConfig = StackConfig(),
@@ -346,20 +378,9 @@ def run_scenario(
         )
     if hold is not None:
         raise ValueError("run_scenario: hold= needs gui=True (it keeps the viewer open)")
-    with lock_output(out_dir) if out_dir is not None else contextlib.nullcontext():
-        # one run per out_dir (issue 27): a second is refused before it touches a file
-        scenario, stack, hal = scenario_world(scenario, stack, source=source)
-        judge = Judge(
-            hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance, progress=progress
-        )
-        session = scenario_session(
-            scenario,
-            stack,
-            hal,
-            judge,
-            extra_actors=tuple(extra_actors),
-            recording=out_dir / "recording.mcap" if out_dir and record else None,
-        )
+    with opened_scenario(
+        scenario, stack, out_dir, record, source, progress, tuple(extra_actors)
+    ) as (scenario, stack, hal, judge, session):
         preload_lazy_imports()
         sim_time = [0.0]
 
