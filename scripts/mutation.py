@@ -1,6 +1,7 @@
 """AST mutation testing of the pure navigation math against the unit layer (issue 24).
 
     python scripts/mutation.py [MODULE ...] [--list] [--timeout S] [--show-survivors]
+                               [--ids ID,...] [--tests FILE ...]
 
 Each mutant changes one node of one module's syntax tree:
 
@@ -22,6 +23,19 @@ anything imports the module, then runs pytest in-process with ``-x`` (the first
 failure kills). Prints the kill rate per module and in total; exit 0 (a report, not
 a gate: ``make mutation``).
 
+Every mutant has a stable id: 8 hex digits of a hash of its module, the function or
+class it is in, the mutated expression's source, the change and its rank among
+identical ones there (line numbers move when code is added above; the id does not).
+``--list`` prints them; ``--ids`` runs only those mutants; ``--tests`` replaces the
+module's test files (``TARGETS``) for one run.
+
+Equivalent mutants (same behaviour as the original for every input) are listed, each
+with the one-line reason a reviewer accepted, in ``scripts/mutation_equivalent.txt``.
+They are never dropped silently: the raw rate counts them as survivors, they are
+printed on their own lines with their reason, and a second rate is printed over the
+mutants not listed. A listed mutant that is killed, or whose id no longer exists, is
+reported as a stale entry.
+
 Why not mutmut or cosmic-ray (both on PyPI): mutmut 3 copies the tree into
 ``mutants/`` and trampolines every function, which numpy-vectorised code and
 slotted dataclasses resist; cosmic-ray starts the test command once per mutant (~1.5
@@ -32,6 +46,7 @@ from __future__ import annotations
 
 import argparse
 import ast
+import hashlib
 import os
 import signal
 import sys
@@ -47,10 +62,11 @@ TARGETS: dict[str, tuple[str, ...]] = {
     "otonav.nav.safety": (
         "tests/unit/test_safety_limit.py",
         "tests/unit/test_safety_reference.py",
+        "tests/unit/test_safety_properties.py",
     ),
     "otonav.nav.dwa": (
         "tests/unit/test_nav_planning.py",
-        "tests/unit/test_nav_dwa.py",
+        "tests/unit/test_dwa_reference.py",
     ),
     "otonav.nav.global_path": (
         "tests/unit/test_nav_planning.py",
@@ -63,8 +79,17 @@ TARGETS: dict[str, tuple[str, ...]] = {
         "tests/unit/test_nav_indoor.py",
         "tests/unit/test_nav_search.py",
     ),
+    "otonav.nav.scan_match": ("tests/unit/test_scan_match.py", "tests/unit/test_localizer.py"),
+    "otonav.nav.scan_map": (
+        "tests/unit/test_scan_match.py",
+        "tests/unit/test_scan_map_reference.py",
+        "tests/unit/test_localizer.py",
+    ),
 }
 """Module -> the unit test files that pin it (files that do not exist are skipped)."""
+
+EQUIVALENT = ROOT / "scripts" / "mutation_equivalent.txt"
+"""Reviewed equivalent mutants: ``module id reason`` per line, ``#`` comments."""
 
 _DESELECT = "not imports_nothing_more"
 """Tests that start a subprocess (the mutant is not in it): skipped."""
@@ -98,6 +123,10 @@ class Mutant:
     index: int
     line: int
     what: str
+    id: str
+    """Stable id (module docstring)."""
+    where: str
+    """The enclosing function or class (dotted), and the mutated expression's source."""
 
 
 def _skipped(tree: ast.Module) -> set[int]:
@@ -193,15 +222,58 @@ def _drop_unary(tree: ast.Module, target: ast.UnaryOp) -> None:
     Drop().visit(tree)
 
 
+def _scopes(tree: ast.Module) -> dict[int, str]:
+    """id(node) -> the dotted name of the innermost function or class holding it."""
+    scope: dict[int, str] = {}
+
+    def walk(node: ast.AST, name: str) -> None:
+        for child in ast.iter_child_nodes(node):
+            inner = name
+            if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                inner = f"{name}.{child.name}" if name else child.name
+            scope[id(child)] = inner
+            walk(child, inner)
+
+    walk(tree, "")
+    return scope
+
+
 def mutants(module: str) -> tuple[str, list[Mutant]]:
     path = ROOT / (module.replace(".", "/") + ".py")
     source = path.read_text()
     tree = ast.parse(source)
-    found = [
-        Mutant(module, i, getattr(node, "lineno", 0), what)
-        for i, (node, what, _) in enumerate(_sites(tree))
-    ]
+    scope = _scopes(tree)
+    seen: dict[str, int] = {}
+    found = []
+    for i, (node, what, variant) in enumerate(_sites(tree)):
+        text = ast.unparse(node)
+        where = f"{scope.get(id(node)) or '<module>'}: {text}"
+        key = f"{module}|{where}|{what}|{variant}"
+        rank = seen.get(key, 0)
+        seen[key] = rank + 1
+        digest = hashlib.sha256(f"{key}|{rank}".encode()).hexdigest()[:8]
+        found.append(Mutant(module, i, getattr(node, "lineno", 0), what, digest, where))
     return source, found
+
+
+def equivalent_list(path: Path = EQUIVALENT) -> dict[tuple[str, str], str]:
+    """(module, id) -> reason, from the reviewed list (module docstring)."""
+    listed: dict[tuple[str, str], str] = {}
+    if not path.exists():
+        return listed
+    for number, raw in enumerate(path.read_text().splitlines(), 1):
+        line = raw.strip()
+        if not line or line.startswith("#"):
+            continue
+        parts = line.split(None, 2)
+        if len(parts) < 3:
+            raise SystemExit(f"{path}:{number}: want 'module id reason', got {raw!r}")
+        listed[(parts[0], parts[1])] = parts[2]
+    return listed
+
+
+def _short(text: str, width: int = 70) -> str:
+    return text if len(text) <= width else text[: width - 3] + "..."
 
 
 def mutated_code(module: str, source: str, index: int) -> CodeType:
@@ -266,24 +338,41 @@ def main() -> int:
     parser.add_argument("--list", action="store_true", help="list the mutants only")
     parser.add_argument("--timeout", type=float, default=60.0)
     parser.add_argument("--show-survivors", action="store_true")
+    parser.add_argument("--ids", default="", help="comma-separated mutant ids: run only these")
+    parser.add_argument("--tests", nargs="+", help="test files instead of the module's TARGETS")
     args = parser.parse_args()
     unknown = [m for m in args.modules if m not in TARGETS]
     if unknown:
         print(f"modules: {unknown} not valid ({', '.join(TARGETS)})", file=sys.stderr)
         return 2
     os.chdir(ROOT)
-    import hypothesis  # noqa: F401  (imported once, before the forks)
+    import hypothesis  # (imported once, before the forks)
     import numpy  # noqa: F401
     import pytest  # noqa: F401
 
-    total_killed = total = 0
+    # No example database (a failure found on one mutant must not be replayed on the
+    # next) and no deadline (a slow shared machine is not a kill); derandomized, so a
+    # run is repeatable. Tests' own @settings still override these defaults.
+    hypothesis.settings.register_profile("mutation", database=None, deadline=None, derandomize=True)
+    hypothesis.settings.load_profile("mutation")
+
+    listed = equivalent_list()
+    wanted = {i for i in args.ids.split(",") if i}
+    total_killed = total = total_equivalent = 0
     started = time.monotonic()
     for module in args.modules:
         source, found = mutants(module)
-        tests = [t for t in TARGETS[module] if (ROOT / t).exists()]
+        ids = {m.id for m in found}
+        for mod, mid in sorted(listed):
+            if mod == module and mid not in ids:
+                print(f"  stale: {mod} {mid} is listed equivalent but no longer a mutant")
+        if wanted:
+            found = [m for m in found if m.id in wanted]
+        tests = [t for t in (args.tests or TARGETS[module]) if (ROOT / t).exists()]
         if args.list:
             for m in found:
-                print(f"{m.module}:{m.line}  #{m.index}  {m.what}")
+                mark = "  [equivalent]" if (module, m.id) in listed else ""
+                print(f"{m.module}:{m.line}  {m.id}  {m.what}  in {_short(m.where)}{mark}")
             continue
         path = ROOT / (module.replace(".", "/") + ".py")
         clean = run_mutant(module, compile(source, str(path), "exec"), tests, args.timeout)
@@ -298,20 +387,38 @@ def main() -> int:
                 survivors.append(m)
             else:
                 killed += 1
+                if (module, m.id) in listed:
+                    print(f"  stale: {module} {m.id} is listed equivalent but was killed")
+        equivalent = [m for m in survivors if (module, m.id) in listed]
+        rest = [m for m in survivors if (module, m.id) not in listed]
         total_killed += killed
         total += len(found)
-        pct = 100.0 * killed / len(found) if found else 100.0
-        print(f"{module}: {killed}/{len(found)} mutants killed ({pct:.1f} %) by {' '.join(tests)}")
+        total_equivalent += len(equivalent)
+        print(
+            f"{module}: {killed}/{len(found)} mutants killed ({_pct(killed, len(found))}) "
+            f"by {' '.join(tests)}; {len(equivalent)} survivors listed equivalent; "
+            f"{killed}/{len(found) - len(equivalent)} of the rest killed "
+            f"({_pct(killed, len(found) - len(equivalent))})"
+        )
         if args.show_survivors:
-            for m in survivors:
-                print(f"  survived: line {m.line}: {m.what}")
+            for m in equivalent:
+                why = listed[(module, m.id)]
+                print(f"  equivalent: {m.id} line {m.line}: {m.what} in {_short(m.where)}: {why}")
+            for m in rest:
+                print(f"  survived:   {m.id} line {m.line}: {m.what} in {_short(m.where)}")
         sys.stdout.flush()
     if total and not args.list:
         print(
-            f"total: {total_killed}/{total} killed ({100.0 * total_killed / total:.1f} %), "
+            f"total: {total_killed}/{total} killed ({_pct(total_killed, total)}); "
+            f"{total_equivalent} listed equivalent; {total_killed}/{total - total_equivalent} "
+            f"of the rest ({_pct(total_killed, total - total_equivalent)}), "
             f"{time.monotonic() - started:.0f} s"
         )
     return 0
+
+
+def _pct(part: int, whole: int) -> str:
+    return f"{100.0 * part / whole:.1f} %" if whole else "-"
 
 
 if __name__ == "__main__":
