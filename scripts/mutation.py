@@ -72,12 +72,13 @@ TARGETS: dict[str, tuple[str, ...]] = {
         "tests/unit/test_nav_planning.py",
         "tests/unit/test_nav_indoor.py",
         "tests/unit/test_nav_search.py",
+        "tests/unit/test_astar_contract.py",
     ),
     "otonav.nav.plan_grid": ("tests/unit/test_nav_indoor.py", "tests/unit/test_nav_search.py"),
     "otonav.nav.recovery": (
         "tests/unit/test_nav_planning.py",
         "tests/unit/test_nav_indoor.py",
-        "tests/unit/test_nav_search.py",
+        "tests/unit/test_recovery_reference.py",
     ),
     "otonav.nav.scan_match": ("tests/unit/test_scan_match.py", "tests/unit/test_localizer.py"),
     "otonav.nav.scan_map": (
@@ -127,6 +128,8 @@ class Mutant:
     """Stable id (module docstring)."""
     where: str
     """The enclosing function or class (dotted), and the mutated expression's source."""
+    context: str = ""
+    """The expression around a short one (a number's, a comparison's), for reading."""
 
 
 def _skipped(tree: ast.Module) -> set[int]:
@@ -222,9 +225,11 @@ def _drop_unary(tree: ast.Module, target: ast.UnaryOp) -> None:
     Drop().visit(tree)
 
 
-def _scopes(tree: ast.Module) -> dict[int, str]:
-    """id(node) -> the dotted name of the innermost function or class holding it."""
+def _scopes(tree: ast.Module) -> tuple[dict[int, str], dict[int, ast.AST]]:
+    """id(node) -> the dotted name of the innermost function or class holding it, and
+    id(node) -> its parent node."""
     scope: dict[int, str] = {}
+    parent: dict[int, ast.AST] = {}
 
     def walk(node: ast.AST, name: str) -> None:
         for child in ast.iter_child_nodes(node):
@@ -232,17 +237,18 @@ def _scopes(tree: ast.Module) -> dict[int, str]:
             if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
                 inner = f"{name}.{child.name}" if name else child.name
             scope[id(child)] = inner
+            parent[id(child)] = node
             walk(child, inner)
 
     walk(tree, "")
-    return scope
+    return scope, parent
 
 
 def mutants(module: str) -> tuple[str, list[Mutant]]:
     path = ROOT / (module.replace(".", "/") + ".py")
     source = path.read_text()
     tree = ast.parse(source)
-    scope = _scopes(tree)
+    scope, parent = _scopes(tree)
     seen: dict[str, int] = {}
     found = []
     for i, (node, what, variant) in enumerate(_sites(tree)):
@@ -252,7 +258,14 @@ def mutants(module: str) -> tuple[str, list[Mutant]]:
         rank = seen.get(key, 0)
         seen[key] = rank + 1
         digest = hashlib.sha256(f"{key}|{rank}".encode()).hexdigest()[:8]
-        found.append(Mutant(module, i, getattr(node, "lineno", 0), what, digest, where))
+        around = parent.get(id(node))
+        context = ""
+        if len(text) < 16 and around is not None and not isinstance(around, ast.stmt):
+            context = ast.unparse(around)
+        elif len(text) < 16 and isinstance(around, (ast.Assign, ast.AnnAssign, ast.Return)):
+            context = ast.unparse(around).splitlines()[0]
+        line = getattr(node, "lineno", 0)
+        found.append(Mutant(module, i, line, what, digest, where, context))
     return source, found
 
 
@@ -274,6 +287,11 @@ def equivalent_list(path: Path = EQUIVALENT) -> dict[tuple[str, str], str]:
 
 def _short(text: str, width: int = 70) -> str:
     return text if len(text) <= width else text[: width - 3] + "..."
+
+
+def _show(m: Mutant) -> str:
+    around = f" (in {_short(m.context, 60)})" if m.context else ""
+    return f"line {m.line}: {m.what} in {_short(m.where)}{around}"
 
 
 def mutated_code(module: str, source: str, index: int) -> CodeType:
@@ -372,7 +390,7 @@ def main() -> int:
         if args.list:
             for m in found:
                 mark = "  [equivalent]" if (module, m.id) in listed else ""
-                print(f"{m.module}:{m.line}  {m.id}  {m.what}  in {_short(m.where)}{mark}")
+                print(f"{m.module} {m.id} {_show(m)}{mark}")
             continue
         path = ROOT / (module.replace(".", "/") + ".py")
         clean = run_mutant(module, compile(source, str(path), "exec"), tests, args.timeout)
@@ -403,9 +421,9 @@ def main() -> int:
         if args.show_survivors:
             for m in equivalent:
                 why = listed[(module, m.id)]
-                print(f"  equivalent: {m.id} line {m.line}: {m.what} in {_short(m.where)}: {why}")
+                print(f"  equivalent: {m.id} {_show(m)}\n      why: {why}")
             for m in rest:
-                print(f"  survived:   {m.id} line {m.line}: {m.what} in {_short(m.where)}")
+                print(f"  survived:   {m.id} {_show(m)}")
         sys.stdout.flush()
     if total and not args.list:
         print(

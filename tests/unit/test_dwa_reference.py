@@ -184,9 +184,13 @@ def _case(rng: np.random.Generator, p: DwaParams) -> Case:
         d = float(rng.uniform(0.5, 0.95)) * max(p.radius, 0.05)
         pts = np.array([[pose[0] + d * math.cos(a), pose[1] + d * math.sin(a)]])
         pts = np.concatenate((pts, rng.uniform(-2, 2, (3, 2))))
-    else:  # scattered returns
+    elif kind == 2:  # scattered returns
         pts = rng.uniform(-2.0, 2.0, (int(rng.integers(2, 12)), 2))
-    v0 = float(rng.uniform(0.0, p.max_v))
+    else:  # a wall across the way, near enough to cut some rollouts
+        d, a = p.radius + float(rng.uniform(0.01, 0.15)), pose[2] + float(rng.uniform(-0.5, 0.5))
+        along = np.linspace(-0.6, 0.6, 31)[:, None] * [-math.sin(a), math.cos(a)]
+        pts = np.add(along, (pose[0] + d * math.cos(a), pose[1] + d * math.sin(a)))
+    v0 = float(rng.uniform(0.5 if kind == 3 else 0.0, 1.0)) * p.max_v
     w0 = float(rng.uniform(-1.0, 1.0)) * p.max_omega
     if rng.random() < 0.15:  # beyond the limit: more than a period's change away
         w0 = math.copysign(p.max_omega + p.max_alpha * p.period * float(rng.uniform(1.5, 3)), w0)
@@ -211,6 +215,7 @@ def _same(r: DwaResult, want: DwaResult) -> None:
 def test_dwa_step_is_its_docstring_on_random_settings(seed: int) -> None:
     rng = np.random.default_rng(1000 + seed)
     seen: set[str] = set()
+    cut = 0
     for _ in range(60):
         p = _params(rng) if rng.random() < 0.8 else DwaParams()
         pose, v0, w0, target, goal, pts = _case(rng, p)
@@ -218,7 +223,9 @@ def test_dwa_step_is_its_docstring_on_random_settings(seed: int) -> None:
         r = dwa_step(pose, v0, w0, target, goal, field, p)
         _same(r, _reference(pose, v0, w0, target, goal, field, p))
         seen.add(r.reason)
+        cut += r.admissible < r.samples
     assert seen == {"toward target", "avoiding", "no admissible trajectory: braking"}
+    assert cut >= 4  # some rollouts cut short of the horizon: not admissible
 
 
 @pytest.mark.parametrize("seed", range(3))
@@ -300,3 +307,31 @@ def test_params_are_frozen_and_slotted() -> None:
     with pytest.raises(dataclasses.FrozenInstanceError):
         p.max_v = 1.0  # type: ignore[misc]
     assert not hasattr(p, "__dict__")
+
+
+@pytest.mark.parametrize("max_accel", [0.5, 2.0])
+def test_a_wall_ahead_admits_exactly_the_speeds_that_stop_in_their_free_length(
+    max_accel: float,
+) -> None:
+    """Straight at a wall: the free length is what each speed drives before its first
+    pose under the radius; a speed is admissible iff v * latency + v^2 / (2 max_accel)
+    fits in it. The window spans speeds on both sides of that line."""
+    p = DwaParams(
+        max_v=1.0,
+        max_accel=max_accel,
+        period=0.4 / max_accel,
+        v_samples=9,
+        omega_samples=1,
+        latency=0.05,
+        horizon=1.0,
+        dt=0.1,
+        radius=0.3,
+        rotate_threshold=3.0,
+        fast_path=False,
+    )
+    wall = np.stack((np.full(61, 0.5), np.linspace(-3.0, 3.0, 61)), axis=1)
+    field, _ = _clearance(wall)
+    v0 = 0.6
+    r = dwa_step((0.0, 0.0, 0.0), v0, 0.0, (3.0, 0.0), 3.0, field, p)
+    _same(r, _reference((0.0, 0.0, 0.0), v0, 0.0, (3.0, 0.0), 3.0, field, p))
+    assert 1 < r.admissible < r.samples - 1
