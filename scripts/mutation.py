@@ -80,7 +80,11 @@ TARGETS: dict[str, tuple[str, ...]] = {
         "tests/unit/test_nav_indoor.py",
         "tests/unit/test_recovery_reference.py",
     ),
-    "otonav.nav.scan_match": ("tests/unit/test_scan_match.py", "tests/unit/test_localizer.py"),
+    "otonav.nav.scan_match": (
+        "tests/unit/test_scan_match.py",
+        "tests/unit/test_scan_match_reference.py",
+        "tests/unit/test_localizer.py",
+    ),
     "otonav.nav.scan_map": (
         "tests/unit/test_scan_match.py",
         "tests/unit/test_scan_map_reference.py",
