@@ -32,10 +32,12 @@ lint: $(STAMP)
 bench: $(STAMP)
 	$(PY) -m otonav bench
 
-## AST mutation testing of the nav math (safety, DWA, A*, plan grid, recovery) against
-## the unit layer: prints the kill rate per module (a report, not part of `make test`)
+## AST mutation testing of the nav math (safety, DWA, A*, plan grid, recovery, scan
+## matching and its map) against the unit layer: prints the kill rate per module, raw and
+## over the mutants not in scripts/mutation_equivalent.txt, and every survivor (a
+## report, not part of `make test`; MUTATION_ARGS="otonav.nav.dwa --ids ..." for one)
 mutation: $(STAMP)
-	$(PY) scripts/mutation.py --show-survivors
+	$(PY) scripts/mutation.py --show-survivors $(MUTATION_ARGS)
 
 ## build the docs site into site/ (--strict: a broken link or reference fails; the
 ## reference pages and sample outputs are generated from the code and a real run)

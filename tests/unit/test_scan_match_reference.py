@@ -12,6 +12,7 @@ loops (issue 24, test rigor), on random rooms, scans and predictions:
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Iterator
 
@@ -201,3 +202,58 @@ def test_match_params_bounds_name_the_field() -> None:
         1.0,
         0,
     )
+
+
+def _far_scan() -> tuple[ScanMap, np.ndarray]:
+    """A mapped room and a scan none of whose points lies near it (new ground)."""
+    grid = ScanMap(0.0, 0.0, half_size=6.0, resolution=0.05)
+    room = box(0.0, 0.0, 1.0, 1.0)
+    x, y = transform((0.0, 0.0, 0.0), scan(room, (0.0, 0.0, 0.0), beams=90))
+    grid.insert(0.0, 0.0, x, y)
+    a = np.linspace(0.0, 2 * math.pi, 40, endpoint=False)
+    return grid, np.stack((4.5 * np.cos(a), 4.5 * np.sin(a)), axis=1)
+
+
+@pytest.mark.parametrize(
+    ("start", "prediction"),
+    [
+        ((0.3, 0.1, 0.1), (0.5, 0.8, 0.3)),
+        ((-0.2, 0.4, -0.3), (0.1, -0.3, 0.2)),
+        ((0.6, -0.5, 0.4), (-0.4, 0.2, -0.1)),
+    ],
+)
+def test_where_the_scan_matches_nothing_the_prior_brings_the_pose_to_the_prediction(
+    start: Pose, prediction: Pose
+) -> None:
+    """No point near the map: the cost is the prior alone (plus a constant), whose
+    minimum is the prediction; one Gauss-Newton step on a quadratic lands there."""
+    grid, pts = _far_scan()
+    p = MatchParams(prior=2.0, yaw_scale=1.5)
+    pose, steps = refine(grid, pts, start, prediction, p)
+    assert pose == pytest.approx(prediction, abs=1e-9)
+    assert steps >= 1
+
+
+def test_with_no_prior_an_exact_tie_in_the_search_keeps_the_prediction() -> None:
+    """Every candidate of the window costs the same (nothing near the map, no prior):
+    the tie goes to the candidate nearest the prediction, the prediction itself."""
+    grid, pts = _far_scan()
+    prediction = (0.2, -0.1, 0.4)
+    best, cost = correlative_search(grid, pts, prediction, MatchParams(prior=0.0))
+    assert best == prediction
+    assert cost == pytest.approx(pts.shape[0] * MatchParams().max_distance ** 2)
+
+
+def test_an_empty_map_takes_no_gauss_newton_step() -> None:
+    result = match_scan(
+        ScanMap(0.0, 0.0, half_size=2.0), _far_scan()[1], (0.1, 0.2, 0.3), MatchParams()
+    )
+    assert result == (((0.1, 0.2, 0.3)), False, 0.0, result.rms, 0)
+    assert math.isnan(result.rms)
+
+
+def test_match_params_are_frozen_and_slotted() -> None:
+    p = MatchParams()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        p.prior = 2.0  # type: ignore[misc]
+    assert not hasattr(p, "__dict__")
