@@ -198,3 +198,69 @@ def test_normals_are_the_chords_of_one_surface(seed: int) -> None:
     assert np.stack((nx, ny), axis=1) == pytest.approx(np.array(want), abs=1e-12)
     assert 0 < int((nx != 0.0).sum()) < 58
     assert normals(x[:2], y[:2], res)[0].tolist() == [0.0, 0.0]
+
+
+def test_far_beyond_each_edge_is_the_cap_even_beside_a_return_at_that_edge() -> None:
+    """A return in the middle of each edge row/column stamps the distance field a few
+    cells beyond the map; a point far beyond that edge reads the cap, and no return."""
+    grid = ScanMap(0.0, 0.0, half_size=1.0, resolution=0.1, max_distance=0.3)
+    xs, ys = np.array([0.05, 0.05, -0.99, 0.99]), np.array([-0.99, 0.99, 0.05, 0.05])
+    grid.insert(0.0, 0.0, xs, ys)
+    far = np.array([0.05, 0.05, -5.0, 5.0]), np.array([-5.0, 5.0, 0.05, 0.05])
+    assert grid.nearest(*far).tolist() == [0.3] * 4
+    assert not grid.correspond(*far)[4].any()
+
+
+def test_an_empty_map_has_no_occupancy_cells() -> None:
+    assert ScanMap(0.0, 0.0, half_size=1.0, resolution=0.1).occupancy()[4].size == 0
+
+
+def test_three_returns_on_a_line_give_the_middle_one_a_normal() -> None:
+    nx, ny = normals(np.array([0.0, 0.05, 0.1]), np.array([1.0, 1.0, 1.0]), 0.05)
+    assert (nx.tolist(), np.abs(ny).tolist()) == ([0.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+
+
+def test_one_scan_of_more_returns_than_twice_the_first_allocation_is_stored() -> None:
+    grid = ScanMap(0.0, 0.0, half_size=4.0, resolution=0.05)
+    c = (np.arange(3000) % 150) * 0.05 - 3.725  # cell centres
+    r = (np.arange(3000) // 150) * 0.05 - 3.725
+    assert grid.insert(0.0, 0.0, c, r) == 3000
+    qx, qy, _, _, found = grid.correspond(c, r)
+    assert found.all()
+    assert (qx.tolist(), qy.tolist()) == (c.tolist(), r.tolist())
+
+
+def _known(grid: ScanMap) -> set[tuple[int, int]]:
+    rows, cols = np.nonzero(grid.known)
+    return set(zip(rows.tolist(), cols.tolist(), strict=True))
+
+
+def test_beams_mark_exactly_the_cells_their_samples_fall_in_up_to_the_map_edges() -> None:
+    """Exact binary fractions (1/8 m cells, 16 a side, origin -1): samples land on cell
+    edges exactly, where a cell's lower edge is in it and the map's upper edge is not."""
+
+    def fresh() -> ScanMap:
+        return ScanMap(0.0, 0.0, half_size=1.0, resolution=0.125)
+
+    # along +x from the map's lower-left corner to beyond the right edge: samples at
+    # u = 0, 1, ..., 17 on row 0; the cells 0-15 of row 0, nothing past the edge
+    g = fresh()
+    g.insert(-1.0, -1.0, np.array([1.375]), np.array([-1.0]))
+    assert _known(g) == {(0, c) for c in range(16)}
+    # along +y from column 12, row 12, to beyond the top: rows 12-15 only (u = 16 is out)
+    g = fresh()
+    g.insert(0.5625, 0.5, np.array([0.5625]), np.array([1.5]))
+    assert _known(g) == {(r, 12) for r in range(12, 16)}
+    g = fresh()
+    g.insert(0.5, 0.5625, np.array([1.5]), np.array([0.5625]))
+    assert _known(g) == {(12, c) for c in range(12, 16)}
+    # one sample: a return 1.5 cells away marks the sensor's cell as a miss
+    g = fresh()
+    g.insert(0.0625, 0.0625, np.array([0.25]), np.array([0.0625]))
+    assert g.log_odds[8, 8] == pytest.approx(-MISS)
+    assert g.log_odds[8, 10] == pytest.approx(HIT)
+    assert _known(g) == {(8, 8), (8, 10)}
+    # a return under a cell away, across a cell edge: no sample, only the hit
+    g = fresh()
+    g.insert(0.1, 0.0625, np.array([0.175]), np.array([0.0625]))
+    assert _known(g) == {(8, 9)}
