@@ -222,8 +222,9 @@ def test_three_returns_on_a_line_give_the_middle_one_a_normal() -> None:
 
 def test_one_scan_of_more_returns_than_twice_the_first_allocation_is_stored() -> None:
     grid = ScanMap(0.0, 0.0, half_size=4.0, resolution=0.05)
-    c = (np.arange(3000) % 150) * 0.05 - 3.725  # cell centres
-    r = (np.arange(3000) // 150) * 0.05 - 3.725
+    k = np.arange(3000, dtype=np.float64)
+    c = (k % 150) * 0.05 - 3.725  # cell centres
+    r = (k // 150) * 0.05 - 3.725
     assert grid.insert(0.0, 0.0, c, r) == 3000
     qx, qy, _, _, found = grid.correspond(c, r)
     assert found.all()
