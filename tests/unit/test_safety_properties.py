@@ -97,7 +97,7 @@ def test_what_it_lets_through_stops_outside_the_clearance(
         assert r.reason == ("stopped" if r.scale == 0.0 else "limited")
     if r.reason == "stopped" and r.omega == 0.0:
         return  # (0, 0): braking, the best there is, may be unsafe
-    assert _worst(_path(v0, w0, r.v, r.omega, p), pts, p) >= 0.0
+    assert _worst(_path(v0, w0, r.v, r.omega, p), pts, p) >= -1e-9  # (rounding of the sums)
 
 
 @settings(max_examples=100, deadline=None)
