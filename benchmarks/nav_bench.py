@@ -42,6 +42,7 @@ from __future__ import annotations
 import argparse
 import gc
 import json
+import math
 import multiprocessing
 import statistics
 import sys
@@ -87,6 +88,8 @@ class Run:
     """The planner's work per navigator step (map update + decision), ms of CPU time."""
     gc_ms: float
     """The longest garbage collection inside one of those ticks, ms of CPU time (0: none)."""
+    slowest_at: float
+    """Sim time of the slowest tick, s."""
     rtf: float
     false_reached: bool
 
@@ -115,6 +118,7 @@ class _TickClock:
 
     def __init__(self) -> None:
         self.ticks: list[float] = []
+        self.times: list[float] = []
         self.gc_ms = 0.0
         self._pending = 0.0
         self._saved: tuple[Callable[..., Any], Callable[..., Any]] | None = None
@@ -151,6 +155,7 @@ class _TickClock:
                 return step(nav, *a, **k)
             finally:
                 clock.ticks.append(1e3 * (time.thread_time() - t + clock._pending))
+                clock.times.append(a[0] if a else math.nan)
                 clock._pending = 0.0
                 clock._in_tick = False
 
@@ -210,6 +215,7 @@ def run_one(task: Task) -> Run:
         result,
         tuple(round(t, 4) for t in clock.ticks),
         clock.gc_ms,
+        clock.times[int(np.argmax(clock.ticks))] if clock.ticks else math.nan,
         verdict.sim_time_s / max(verdict.wall_time_s, 1e-9),
         verdict.nav_state == "reached" and not verdict.reached,
     )
@@ -330,6 +336,13 @@ def main() -> int:
             family, _, what = kind.partition(": ")
             seeds = [r.seed for r in failures if r.family == family and r.failure == what]
             print(f"  {kind}: {n}  seeds {seeds[:8]}")
+    slow = [(max(run.ticks_ms), run) for f in args.families for run in by_family[f] if run.ticks_ms]
+    if slow:
+        ms, run = max(slow, key=lambda pair: pair[0])
+        print(
+            f"slowest tick: {ms:.1f} ms ({run.result.family} seed {run.result.seed}, "
+            f"{run.result.expect}, at {run.slowest_at:.2f} s of sim time)"
+        )
     if all_results:
         worst = min(all_results, key=lambda r: r.min_clearance_m)
         print(
