@@ -9,7 +9,9 @@ Each :meth:`Navigation.step` (at the navigator's rate):
    twice as far: settling must not restart the approach); after giving up:
    ``unreachable`` (until a new goal);
 2. **global path** (:mod:`otonav.nav.global_path`) on the map's coarse grid, cells free
-   when their clearance is at least the centre clearance; replanned when there is none,
+   when their clearance is at least the centre clearance and, once the goal lies inside
+   what the robot has observed, within ``hull_margin`` of that
+   (:mod:`otonav.nav.observed_hull`); replanned when there is none,
    every ``replan_period`` s if the path ahead is blocked, and after each recovery.
    Before each replan, the cells the last scan saw through are cleared (ADR 0026).
    No path, proven (the search exhausted every cell reachable from the goal): first
@@ -109,6 +111,9 @@ class NavigationParams:
         clear_range: before a replan, occupied cells within this distance of the laser
             that the last observed scan saw through are cleared (ADR 0026), m; 0: the
             map never clears.
+        hull_margin: once the goal lies inside the convex hull of what the robot has
+            observed (returns, free beam ends, laser positions), A* routes only within
+            this distance of it, m (:mod:`otonav.nav.observed_hull`).
         progress_distance: progress that counts, m.
         progress_window: time to shrink the distance to go (along the path) by
             ``progress_distance``, s (:class:`~otonav.nav.recovery.ProgressChecker`).
@@ -239,7 +244,6 @@ class Navigation:
     def set_goal(self, goal: tuple[float, float]) -> None:
         if goal != self.goal:
             self.goal = goal
-            self.hull.add(np.array([goal[0]]), np.array([goal[1]]))
             self.path = None
             self._search = None
             self._replan_now = True
@@ -442,9 +446,14 @@ class Navigation:
         penalty = gap * np.float32(self.params.plan_penalty / room)
         return free, penalty
 
-    def _within_hull(self, n: int) -> NDArray[np.bool_]:
+    def _within_hull(self, n: int) -> NDArray[np.bool_] | bool:
         """The coarse cells within ``hull_margin`` of what the robot has observed
-        (:mod:`otonav.nav.observed_hull`), cached until the hull grows."""
+        (:mod:`otonav.nav.observed_hull`), cached until the hull grows; True (no
+        bound) while the goal lies outside it: the world evidently goes on beyond
+        what was seen."""
+        assert self.goal is not None
+        if not self.hull.contains(*self.goal):
+            return True
         cached = self._hull_mask
         if cached is not None and cached[0] == self.hull.version:
             return cached[1]

@@ -1,6 +1,6 @@
 """The bounds of what the robot has observed: the convex hull of every return, every
-beam's free end, every laser position and the goal, and the global planner's grid
-cells within a margin of it (issue 24, ADR 0059).
+beam's free end and every laser position, and the global planner's grid cells within a
+margin of it (issue 24, ADR 0059).
 
 Units: m; arrays are rows = y, columns = x, as in :mod:`otonav.nav.costmap`.
 
@@ -14,7 +14,10 @@ until its budget ran out). A planner working on a SLAM map has the same bound bu
 Nav2's global costmap takes the size of the map, which grows to the scans' extent.
 Here the bound is the convex hull (not the axis-aligned box: a building need not be
 square to odom) grown by ``margin``: space no beam has reached, beyond everything
-observed, is not routed through. Inside the hull, unknown stays free.
+observed, is not routed through. Inside the hull, unknown stays free. The navigator
+applies the bound only once the goal lies inside the hull: a goal beyond everything
+observed says the world goes on past it (from one room of a house, the goal two rooms
+away), and then the unknown stays unbounded as before.
 
 Cost: :meth:`ObservedHull.add` tests points against the hull's edges (a few dozen)
 and rebuilds it (Andrew's monotone chain) only from the points outside;
@@ -104,6 +107,13 @@ class ObservedHull:
         self._points = hull
         self.version += 1
         return True
+
+    def contains(self, x: float, y: float) -> bool:
+        """The point lies inside the hull (or on it); never while it has fewer than
+        three vertices."""
+        if self._points.shape[0] < 3:
+            return False
+        return not bool(self._outside(np.array([x]), np.array([y]))[0])
 
     def _outside(self, x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.bool_]:
         v = self._points

@@ -206,3 +206,27 @@ def test_a_way_round_a_wall_into_space_seen_empty_is_still_planned() -> None:
     assert _prove(nav, (0.0, 0.0, 0.0)) in ("driving", "avoiding")
     assert nav.path is not None
     assert np.abs(nav.path[:, 1]).max() > 2.3  # round an end of the wall
+
+
+def test_a_goal_beyond_everything_observed_is_not_bounded_by_it() -> None:
+    """Rooms (issue 24, seed 8 of the family): from the top room the robot sees, through
+    its door, only part of the wall below; the goal lies past that wall. The world
+    evidently goes on beyond what was observed, so there is no bound: the route round
+    the seen part of the wall is planned (with the bound, the hull spiked to the goal
+    had no room for it and "no path" was proven at 3 s: a false unreachable)."""
+    top_room = np.concatenate(
+        (
+            _segment(-5.0, 1.4, -2.0, 1.4),
+            _segment(-1.0, 1.4, 5.0, 1.4),  # the door: x in (-2, -1)
+            _segment(5.0, 1.4, 5.0, 5.0),
+            _segment(5.0, 5.0, -5.0, 5.0),
+            _segment(-5.0, 5.0, -5.0, 1.4),
+        )
+    )
+    seen_below = _segment(-3.4, -2.0, 0.0, -2.0)  # what the door lets it see
+    nav = Navigation(_params(), (-1.0, 3.3))
+    nav.set_goal((-2.0, -3.5))
+    nav.observe(np.concatenate((top_room, seen_below)))
+    assert _prove(nav, (-1.0, 3.3, 0.0)) in ("driving", "avoiding")
+    assert nav.path is not None
+    assert not nav.hull.contains(-2.0, -3.5)
