@@ -18,10 +18,19 @@ Prints a Markdown table, one row per family: success on the reachable worlds,
 walled-in worlds reported unreachable within the budget, clearance violations, false
 ``reached`` (the navigator said reached, the judge did not), the planner's tick time
 (the navigator's map update and decision per step, CPU time of the thread: p99 and
-max over every tick of the family) and the median real-time factor, next to the acceptance
-scenario's RTF measured in the same run. Then the failures by kind with a few seeds
-each; ``--failures DIR`` re-runs them with recordings into DIR next to their scenario
-YAML (repro: ``otonav run --scenario DIR/NAME.yaml``).
+max over every tick of the family), the longest garbage collection that fell inside a
+tick, and the median real-time factor, next to the acceptance scenario's RTF measured in
+the same run.
+
+Each process frees a run before the next (``gc.collect()`` outside the timed ticks) and
+keeps what it imported, and what its first run left alive, out of the collector's sight
+(``gc.freeze()``), as the sweep's warm workers do (ADR 0029): a run's objects are cyclic
+garbage that only a full collection frees, and without this about one navigator tick a
+family in ~250 runs absorbed a ~35 ms collection of the earlier runs' worlds (ADR 0059).
+
+Then the failures by kind with a few seeds each; ``--failures DIR`` re-runs them with
+recordings into DIR next to their scenario YAML (repro: ``otonav run --scenario
+DIR/NAME.yaml``).
 
 Targets (issue 24): >= 97 % success on reachable worlds, >= 98 % of unreachable worlds
 reported, 0 clearance violations, 0 false reached, planner tick p99 <= 5 ms and max
@@ -31,7 +40,9 @@ reported, 0 clearance violations, 0 false reached, planner tick p99 <= 5 ms and 
 from __future__ import annotations
 
 import argparse
+import gc
 import json
+import math
 import multiprocessing
 import statistics
 import sys
@@ -75,6 +86,10 @@ class Run:
     result: RunResult
     ticks_ms: tuple[float, ...]
     """The planner's work per navigator step (map update + decision), ms of CPU time."""
+    gc_ms: float
+    """The longest garbage collection inside one of those ticks, ms of CPU time (0: none)."""
+    slowest_at: float
+    """Sim time of the slowest tick, s."""
     rtf: float
     false_reached: bool
 
@@ -103,28 +118,46 @@ class _TickClock:
 
     def __init__(self) -> None:
         self.ticks: list[float] = []
+        self.times: list[float] = []
+        self.gc_ms = 0.0
         self._pending = 0.0
         self._saved: tuple[Callable[..., Any], Callable[..., Any]] | None = None
+        self._in_tick = False
+        self._gc_started = 0.0
+
+    def _on_gc(self, phase: str, info: dict[str, int]) -> None:
+        if not self._in_tick:
+            return
+        if phase == "start":
+            self._gc_started = time.thread_time()
+        else:
+            self.gc_ms = max(self.gc_ms, 1e3 * (time.thread_time() - self._gc_started))
 
     def __enter__(self) -> _TickClock:
         observe, step = Navigation.observe, Navigation.step
         self._saved = (observe, step)
         clock = self
+        gc.callbacks.append(self._on_gc)
 
         def timed_observe(nav: Navigation, *a: Any, **k: Any) -> int:
+            clock._in_tick = True
             t = time.thread_time()
             try:
                 return observe(nav, *a, **k)
             finally:
                 clock._pending += time.thread_time() - t
+                clock._in_tick = False
 
         def timed_step(nav: Navigation, *a: Any, **k: Any) -> Any:
+            clock._in_tick = True
             t = time.thread_time()
             try:
                 return step(nav, *a, **k)
             finally:
                 clock.ticks.append(1e3 * (time.thread_time() - t + clock._pending))
+                clock.times.append(a[0] if a else math.nan)
                 clock._pending = 0.0
+                clock._in_tick = False
 
         Navigation.observe = timed_observe  # type: ignore[method-assign,assignment]
         Navigation.step = timed_step  # type: ignore[method-assign,assignment]
@@ -133,6 +166,27 @@ class _TickClock:
     def __exit__(self, *exc: object) -> None:
         assert self._saved is not None
         Navigation.observe, Navigation.step = self._saved  # type: ignore[method-assign]
+        gc.callbacks.remove(self._on_gc)
+
+
+_runs_here = 0
+"""Runs this process has done (the first one's leftovers are frozen after it)."""
+
+
+def _start_process() -> None:
+    """What a fresh process has imported is out of the collector's sight from now on."""
+    gc.collect()
+    gc.freeze()
+
+
+def _free_run() -> None:
+    """Free the run that just ended (its objects are cyclic garbage), outside the
+    timed ticks; after the first run, freeze what it left alive (lazy imports, caches)."""
+    global _runs_here
+    gc.collect()
+    _runs_here += 1
+    if _runs_here == 1:
+        gc.freeze()
 
 
 def run_one(task: Task) -> Run:
@@ -143,6 +197,7 @@ def run_one(task: Task) -> Run:
         verdict = run_scenario(
             world.scenario, _stack(overrides), record=False, plot=False, wall_ceiling=900.0
         )
+    _free_run()
     result = RunResult.of(
         family,
         world,
@@ -159,6 +214,8 @@ def run_one(task: Task) -> Run:
     return Run(
         result,
         tuple(round(t, 4) for t in clock.ticks),
+        clock.gc_ms,
+        clock.times[int(np.argmax(clock.ticks))] if clock.ticks else math.nan,
         verdict.sim_time_s / max(verdict.wall_time_s, 1e-9),
         verdict.nav_state == "reached" and not verdict.reached,
     )
@@ -166,10 +223,13 @@ def run_one(task: Task) -> Run:
 
 def _results(tasks: list[Task], workers: int) -> Iterator[Run]:
     if workers <= 1:
+        _start_process()
         yield from map(run_one, tasks)
         return
     context = multiprocessing.get_context("forkserver")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+    with ProcessPoolExecutor(
+        max_workers=workers, mp_context=context, initializer=_start_process
+    ) as pool:
         yield from pool.map(run_one, tasks, chunksize=1)
 
 
@@ -182,7 +242,7 @@ def table(rows: list[tuple[FamilyRow, list[Run]]]) -> str:
         "| family | worlds | reachable | success (% of reachable) | BARN metric "
         "| time / optimal (median) | timeouts | false unreachable "
         "| unreachable reported | clearance violations | false reached "
-        "| tick p99 / max (ms) | RTF (median) |"
+        "| tick p99 / max (ms) | GC in a tick (max ms) | RTF (median) |"
     )
     lines = [head, "|" + "|".join("---" for _ in range(head.count("|") - 1)) + "|"]
     for r, runs in rows:
@@ -198,7 +258,9 @@ def table(rows: list[tuple[FamilyRow, list[Run]]]) -> str:
             f"| {r.walled_reported} of {r.walled} ({_fmt(r.walled_reported_pct, '.1f')} %) "
             f"| {r.clearance_violations} of {r.runs} "
             f"| {sum(run.false_reached for run in runs)} "
-            f"| {_fmt(p99, '.2f')} / {_fmt(worst, '.1f')} | {_fmt(rtf, '.1f')} |"
+            f"| {_fmt(p99, '.2f')} / {_fmt(worst, '.1f')} "
+            f"| {_fmt(max((run.gc_ms for run in runs), default=None), '.1f')} "
+            f"| {_fmt(rtf, '.1f')} |"
         )
     return "\n".join(lines)
 
@@ -274,6 +336,13 @@ def main() -> int:
             family, _, what = kind.partition(": ")
             seeds = [r.seed for r in failures if r.family == family and r.failure == what]
             print(f"  {kind}: {n}  seeds {seeds[:8]}")
+    slow = [(max(run.ticks_ms), run) for f in args.families for run in by_family[f] if run.ticks_ms]
+    if slow:
+        ms, run = max(slow, key=lambda pair: pair[0])
+        print(
+            f"slowest tick: {ms:.1f} ms ({run.result.family} seed {run.result.seed}, "
+            f"{run.result.expect}, at {run.slowest_at:.2f} s of sim time)"
+        )
     if all_results:
         worst = min(all_results, key=lambda r: r.min_clearance_m)
         print(

@@ -9,7 +9,9 @@ Each :meth:`Navigation.step` (at the navigator's rate):
    twice as far: settling must not restart the approach); after giving up:
    ``unreachable`` (until a new goal);
 2. **global path** (:mod:`otonav.nav.global_path`) on the map's coarse grid, cells free
-   when their clearance is at least the centre clearance; replanned when there is none,
+   when their clearance is at least the centre clearance and, once the goal lies inside
+   what the robot has observed, within ``hull_margin`` of that
+   (:mod:`otonav.nav.observed_hull`); replanned when there is none,
    every ``replan_period`` s if the path ahead is blocked, and after each recovery.
    Before each replan, the cells the last scan saw through are cleared (ADR 0026).
    No path, proven (the search exhausted every cell reachable from the goal): first
@@ -47,6 +49,7 @@ from otonav.nav.dwa import ClearanceFn, DwaParams, DwaResult, clear_arc, dwa_ste
 from otonav.nav.geometry import wrap_angle
 from otonav.nav.global_path import AstarSearch, GridPath
 from otonav.nav.local_clearance import local_clearance, nearby
+from otonav.nav.observed_hull import ObservedHull, free_ends
 from otonav.nav.plan_grid import best_points, free_threshold, pooled
 from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
 from otonav.nav.scan import ScanRays
@@ -108,6 +111,9 @@ class NavigationParams:
         clear_range: before a replan, occupied cells within this distance of the laser
             that the last observed scan saw through are cleared (ADR 0026), m; 0: the
             map never clears.
+        hull_margin: once the goal lies inside the convex hull of what the robot has
+            observed (returns, free beam ends, laser positions), A* routes only within
+            this distance of it, m (:mod:`otonav.nav.observed_hull`).
         progress_distance: progress that counts, m.
         progress_window: time to shrink the distance to go (along the path) by
             ``progress_distance``, s (:class:`~otonav.nav.recovery.ProgressChecker`).
@@ -138,6 +144,7 @@ class NavigationParams:
     max_expansions: int = 60_000
     expansions_per_tick: int = 600
     clear_range: float = 3.0
+    hull_margin: float = 0.25
     progress_distance: float = 0.3
     progress_window: float = 3.5
     goal_progress_window: float = 30.0
@@ -191,6 +198,8 @@ class Navigation:
     start: tuple[float, float]
     goal: tuple[float, float] | None = None
     map: ClearanceMap = field(init=False)
+    hull: ObservedHull = field(init=False)
+    """What the robot has observed: the global planner routes only within it."""
     path: NDArray[np.float64] | None = None
     path_length: float = math.nan
     replans: int = 0
@@ -213,6 +222,7 @@ class Navigation:
     """A* cells expanded so far, over all searches."""
     _replan_now: bool = True
     _reached: bool = False
+    _hull_mask: tuple[int, NDArray[np.bool_]] | None = None
 
     def __post_init__(self) -> None:
         p = self.params
@@ -224,6 +234,7 @@ class Navigation:
             max_distance=max(p.dwa.radius + p.dwa.clearance_cap, p.follow_distance) + 0.05,
         )
         self._stride = max(1, round(p.plan_resolution / p.map_resolution))
+        self.hull = ObservedHull(self.start[0], self.start[1])
         self._checker = ProgressChecker(
             p.progress_distance, p.progress_window, p.goal_progress_window
         )
@@ -255,12 +266,16 @@ class Navigation:
         them): kept, and used to clear what the scan saw through before the next
         replan."""
         if rays is not None:
-            self._rays = rays
+            seen = rays() if callable(rays) else rays
+            self._rays = seen
+            ex, ey = free_ends(seen)
+            self.hull.add(np.append(ex, seen.x), np.append(ey, seen.y))
         if isinstance(points_odom, tuple):
             self._returns = points_odom
-            return self.map.mark_xy(*points_odom)
-        self._returns = (points_odom[:, 0], points_odom[:, 1])
-        return self.map.mark(points_odom)
+        else:
+            self._returns = (points_odom[:, 0], points_odom[:, 1])
+        self.hull.add(*self._returns)
+        return self.map.mark_xy(*self._returns)
 
     @property
     def searching(self) -> bool:
@@ -425,10 +440,29 @@ class Navigation:
         coarse = pooled(self.map.interior(), self._stride)
         radius = self.params.dwa.radius
         free = coarse >= np.float32(free_threshold(radius, self.map.resolution))
+        free &= self._within_hull(free.shape[0])
         room = self.params.dwa.clearance_cap
         gap = np.minimum(np.maximum(np.float32(radius + room) - coarse, 0.0), room)
         penalty = gap * np.float32(self.params.plan_penalty / room)
         return free, penalty
+
+    def _within_hull(self, n: int) -> NDArray[np.bool_] | bool:
+        """The coarse cells within ``hull_margin`` of what the robot has observed
+        (:mod:`otonav.nav.observed_hull`), cached until the hull grows; True (no
+        bound) while the goal lies outside it: the world evidently goes on beyond
+        what was seen."""
+        assert self.goal is not None
+        if not self.hull.contains(*self.goal):
+            return True
+        cached = self._hull_mask
+        if cached is not None and cached[0] == self.hull.version:
+            return cached[1]
+        m = self.map
+        mask = self.hull.mask(
+            m.origin_x, m.origin_y, m.resolution * self._stride, n, n, self.params.hull_margin
+        )
+        self._hull_mask = (self.hull.version, mask)
+        return mask
 
     def _coarse_cell(self, x: float, y: float) -> tuple[int, int]:
         s, res = self._stride, self.map.resolution

@@ -112,8 +112,9 @@ def test_a_search_in_slices_is_the_search_in_one_go() -> None:
 
 
 def test_proving_no_path_is_spread_over_steps_each_within_its_budget() -> None:
-    """The robot boxed in, the goal outside: the proof floods the whole map. No step
-    expands more than ``expansions_per_tick`` cells; the proof still comes."""
+    """The robot boxed in, the goal outside in a room as large as the map: the proof
+    floods the whole room. No step expands more than ``expansions_per_tick`` cells;
+    the proof still comes."""
     params = _params(expansions_per_tick=500)
     nav = Navigation(params, (0.0, 0.0))
     nav.set_goal((5.0, 0.0))
@@ -125,7 +126,15 @@ def test_proving_no_path_is_spread_over_steps_each_within_its_budget() -> None:
             _segment(-0.8, 0.8, -0.8, -0.8),
         )
     )
-    nav.observe(box)
+    room = np.concatenate(
+        (
+            _segment(-9.5, -9.5, 9.5, -9.5, step=0.5),
+            _segment(9.5, -9.5, 9.5, 9.5, step=0.5),
+            _segment(9.5, 9.5, -9.5, 9.5, step=0.5),
+            _segment(-9.5, 9.5, -9.5, -9.5, step=0.5),
+        )
+    )
+    nav.observe(np.concatenate((box, room)))
     t, steps, out = 0.0, 0, None
     before = nav.expansions
     while steps < 400:

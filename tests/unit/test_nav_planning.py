@@ -175,6 +175,18 @@ def _rays(ranges: np.ndarray, x: float = 0.0, y: float = 0.0, yaw: float = 0.0) 
     return ScanRays(x, y, yaw, ranges.astype(np.float64), -math.pi, 2 * math.pi / n, 0.12, 8.0)
 
 
+def _seen(points: np.ndarray, beams: int = 360) -> ScanRays:
+    """The scan from the origin that returns ``points`` (odom = base_link): per beam,
+    the nearest point in its bearing bin, nothing within range elsewhere (so the
+    space past the points is observed empty: the planner routes only through what
+    was observed, ADR 0059)."""
+    inc = 2 * math.pi / beams
+    beam = np.rint((np.arctan2(points[:, 1], points[:, 0]) + math.pi) / inc).astype(int) % beams
+    ranges = np.full(beams, np.inf)
+    np.minimum.at(ranges, beam, np.hypot(points[:, 0], points[:, 1]))
+    return _rays(ranges)
+
+
 def test_cells_a_scan_sees_through_are_cleared_and_their_distances_recomputed() -> None:
     m = ClearanceMap(0.0, 0.0, half_size=5.0, resolution=0.05, max_distance=0.6)
     gone = _wall(1.0, -0.2, 0.2)  # a phantom 1 m ahead (a moved obstacle, a misread)
@@ -212,7 +224,8 @@ def test_a_return_or_an_unreadable_beam_keeps_its_cell() -> None:
 def test_navigation_replans_through_a_phantom_once_a_scan_sees_through_it() -> None:
     nav = Navigation(NavigationParams(), (0.0, 0.0))
     nav.set_goal((3.0, 0.0))
-    nav.observe(_wall(1.5, -3.0, 3.0))  # a wall across the way, long enough to detour
+    wall = _wall(1.5, -3.0, 3.0)  # a wall across the way, long enough to detour
+    nav.observe(wall, _seen(wall))
     t = 0.0
     nav.step(t, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
     while nav.searching:  # a search spans steps (expansions_per_tick)
@@ -314,7 +327,7 @@ def test_fast_path_gives_way_to_the_sampling_near_an_obstacle() -> None:
     assert clear_arc((0.0, 0.0, 0.0), 0.4, 0.0, (2.0, 0.0), 3.0, m.clearance_at, p) is None
     nav = Navigation(NavigationParams(), (0.0, 0.0))
     nav.set_goal((2.0, 0.0))
-    nav.observe(_wall(0.9, -0.3, 0.3))
+    nav.observe(_wall(0.9, -0.3, 0.3), _seen(_wall(0.9, -0.3, 0.3)))
     out = nav.step(0.0, (0.0, 0.0, 0.0), 0.4, 0.0, np.empty((0, 2)))
     assert out.dwa is not None
     assert out.dwa.samples > 1  # sampled, not the fast path
@@ -589,7 +602,8 @@ def test_navigation_gives_up_on_an_enclosed_goal_after_looking_around() -> None:
 def test_navigation_plans_around_a_box_and_reports_reached() -> None:
     nav = Navigation(NavigationParams(), (0.0, 0.0))
     nav.set_goal((3.0, 0.0))
-    nav.observe(_box_points(1.5, 0.0, 0.3, 0.4))
+    box = _box_points(1.5, 0.0, 0.3, 0.4)
+    nav.observe(box, _seen(box))
     out = nav.step(0.0, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
     assert out.state in ("driving", "avoiding")
     assert nav.path is not None
