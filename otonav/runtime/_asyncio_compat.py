@@ -288,7 +288,8 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
             return
         ready = this._ready
         inner = self._hooked.inner
-        self._drop_cancelled_timers()
+        if this._timer_cancelled_count:  # else there is nothing to drop (a call less)
+            self._drop_cancelled_timers()
         scheduled: list[Any] = this._scheduled
         if ready or this._stopping:
             if self._poll:
@@ -320,7 +321,8 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
             passes += 1
             if not passes & 255:
                 self.iteration_check()
-            self._drop_cancelled_timers()
-            scheduled = this._scheduled
+            if this._timer_cancelled_count:
+                self._drop_cancelled_timers()
+                scheduled = this._scheduled
             if self._poll:
                 this._process_events(inner.select(0))
