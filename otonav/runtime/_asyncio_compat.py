@@ -152,6 +152,12 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
     Debug mode runs asyncio's own iteration (the hook is then reached through the
     selector). ``beats`` counts passes (a watchdog's sign of progress); ``waiting`` is
     True while in the hook.
+
+    Timers wait in a heap of ``(when, seq, handle)`` tuples (``_timers``), compared in C,
+    instead of asyncio's heap of handles, compared by a Python ``__lt__`` (~8 calls a
+    timer: ADR 0058); (when, seq) is the order :class:`FifoTimerHandle` gives, so timers
+    fall due in the same order. In debug mode timers go to asyncio's own heap, which
+    asyncio's iteration reads; each iteration adopts what the other mode left.
     """
 
     def __init__(self) -> None:
@@ -160,6 +166,7 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
         selector.loop = self
         self._hooked = selector
         self._seq = 0
+        self._timers: list[tuple[float, int, FifoTimerHandle]] = []
         self._poll = False
         self.beats = 0
         self.waiting = False
@@ -196,17 +203,29 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
 
     def next_deadline(self) -> float | None:
         """The earliest scheduled timer's deadline (a cancelled one included), or None."""
-        scheduled: list[asyncio.TimerHandle] = self._scheduled  # type: ignore[attr-defined]
-        return scheduled[0].when() if scheduled else None
+        heads = self._earliest_timers()
+        return heads[0][0] if heads else None
 
     def deadline_after(self, timer: asyncio.TimerHandle | None) -> float:
         """The earliest deadline among the other timers when ``timer`` is the earliest
         (else, or with None, the earliest of all); ``inf`` if none."""
-        heap: list[asyncio.TimerHandle] = self._scheduled  # type: ignore[attr-defined]
-        # The root is ``timer`` or an earlier one; after it, the earliest timer is one
-        # of the root's children.
-        rest = heap[1:3] if heap and heap[0] is timer else heap[:1]
-        return min((t.when() for t in rest), default=math.inf)
+        heads = self._earliest_timers()
+        if not heads:
+            return math.inf
+        if heads[0][2] is timer:
+            return heads[1][0] if len(heads) > 1 else math.inf
+        return heads[0][0]
+
+    def _earliest_timers(self) -> list[tuple[float, int, FifoTimerHandle]]:
+        """The two earliest timers (and maybe more), earliest first, from both heaps
+        (ours, and asyncio's while debug mode runs): each heap's two earliest are among
+        its first three entries (the root and its children)."""
+        scheduled: list[FifoTimerHandle] = self._scheduled  # type: ignore[attr-defined]
+        heads = self._timers[:3]
+        if scheduled:
+            heads += [(h._when, h._seq, h) for h in scheduled[:3]]
+        heads.sort()
+        return heads
 
     def has_io(self) -> bool:
         """Whether anything besides the loop's self-pipe is registered for I/O."""
@@ -245,35 +264,57 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
     ) -> asyncio.TimerHandle:
         self._check_closed()  # type: ignore[attr-defined]
         self._seq += 1
-        timer = FifoTimerHandle(when, callback, args, self, context, self._seq)
-        heapq.heappush(self._scheduled, timer)  # type: ignore[attr-defined]
+        seq = self._seq
+        timer = FifoTimerHandle(when, callback, args, self, context, seq)
+        if self._debug:  # type: ignore[attr-defined]
+            heapq.heappush(self._scheduled, timer)  # type: ignore[attr-defined]
+        else:
+            heapq.heappush(self._timers, (when, seq, timer))
         timer._scheduled = True
         return timer
+
+    def _adopt_debug_timers(self) -> None:
+        """Move the timers debug mode put in asyncio's heap into ours."""
+        this: Any = self
+        for handle in this._scheduled:
+            heapq.heappush(self._timers, (handle._when, handle._seq, handle))
+        this._scheduled.clear()
+
+    def _hand_timers_to_asyncio(self) -> None:
+        """Move our timers into asyncio's heap (debug mode runs asyncio's iteration)."""
+        this: Any = self
+        for _when, _seq, handle in self._timers:
+            heapq.heappush(this._scheduled, handle)
+        self._timers.clear()
+
+    def close(self) -> None:
+        super().close()
+        self._timers.clear()  # as asyncio clears its own heap
 
     # -- one iteration ------------------------------------------------------------------
 
     def _drop_cancelled_timers(self) -> None:
         """asyncio's first step: drop cancelled timers (all, when they are many)."""
         this: Any = self  # asyncio's private attributes, untyped
-        scheduled: list[Any] = this._scheduled
-        count = len(scheduled)
+        timers = self._timers
+        count = len(timers)
         if (
             count > MIN_SCHEDULED_TIMER_HANDLES
             and this._timer_cancelled_count / count > MIN_CANCELLED_TIMER_HANDLES_FRACTION
         ):
             kept = []
-            for handle in scheduled:
-                if handle._cancelled:
-                    handle._scheduled = False
+            for entry in timers:
+                if entry[2]._cancelled:
+                    entry[2]._scheduled = False
                 else:
-                    kept.append(handle)
+                    kept.append(entry)
             heapq.heapify(kept)
-            this._scheduled = kept
+            self._timers = kept
             this._timer_cancelled_count = 0
         else:
-            while scheduled and scheduled[0]._cancelled:
+            while timers and timers[0][2]._cancelled:
                 this._timer_cancelled_count -= 1
-                heapq.heappop(scheduled)._scheduled = False
+                heapq.heappop(timers)[2]._scheduled = False
 
     def _run_once(self) -> None:
         """One asyncio iteration (class docstring): asyncio's steps in asyncio's order,
@@ -284,18 +325,22 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
         self.beats += 1
         if this._debug:
             self.waiting = True  # a debug loop: the watchdog only catches a held selector
+            if self._timers:
+                self._hand_timers_to_asyncio()
             super()._run_once()  # type: ignore[misc]
             return
+        if this._scheduled:  # left by debug mode
+            self._adopt_debug_timers()
         ready = this._ready
         inner = self._hooked.inner
         if this._timer_cancelled_count:  # else there is nothing to drop (a call less)
             self._drop_cancelled_timers()
-        scheduled: list[Any] = this._scheduled
+        timers = self._timers
         if ready or this._stopping:
             if self._poll:
                 this._process_events(inner.select(0))
         else:
-            timeout = max(0.0, scheduled[0]._when - self.time()) if scheduled else None
+            timeout = max(0.0, timers[0][0] - self.time()) if timers else None
             self.waiting = True
             events = self.select_idle(inner, timeout)
             self.waiting = False
@@ -306,8 +351,8 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
             # Due timers join the ready queue, then the callbacks ready now run (not the
             # ones they make ready: those are the next pass, as in asyncio).
             end_time = self.time() + this._clock_resolution
-            while scheduled and scheduled[0]._when < end_time:
-                handle = heapq.heappop(scheduled)
+            while timers and timers[0][0] < end_time:
+                handle = heapq.heappop(timers)[2]
                 handle._scheduled = False
                 ready.append(handle)
             for _ in range(len(ready)):
@@ -323,6 +368,6 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
                 self.iteration_check()
             if this._timer_cancelled_count:
                 self._drop_cancelled_timers()
-                scheduled = this._scheduled
+                timers = self._timers
             if self._poll:
                 this._process_events(inner.select(0))
