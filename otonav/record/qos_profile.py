@@ -73,4 +73,3 @@ def offered_qos_yaml(offered: Sequence[QoS]) -> str:
         for qos in (offered or (DEFAULT_QOS,))
     )
     return text.strip()
-

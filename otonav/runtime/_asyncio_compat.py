@@ -108,6 +108,31 @@ class FifoTimerHandle(asyncio.TimerHandle):
         return NotImplemented
 
 
+def _resolve(future: asyncio.Future[None]) -> None:
+    """A wake-up: ``future`` gets its result (None), unless it is done (cancelled)."""
+    if not future.done():
+        future.set_result(None)
+
+
+_NO_CONTEXT = contextvars.Context()
+"""The context of every :class:`WakeTimer` (its ``_run`` runs no code of its own in one)."""
+
+
+class WakeTimer(FifoTimerHandle):
+    """A timer whose callback is :func:`_resolve` of one future (a sleep's wake-up), run
+    without a context switch or a callback frame (~0.4 us a wake, ADR 0058): setting a
+    future's result runs nothing; it schedules the future's callbacks, each in the
+    context it was added with. A timer still, in every other respect (repr, cancel,
+    debug mode)."""
+
+    __slots__ = ()
+
+    def _run(self) -> None:
+        future = self._args[0]
+        if not future.done():
+            future.set_result(None)
+
+
 # -- asyncio: the loop --------------------------------------------------------------------
 
 
@@ -203,6 +228,8 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
 
     def next_deadline(self) -> float | None:
         """The earliest scheduled timer's deadline (a cancelled one included), or None."""
+        if not self._scheduled:  # type: ignore[attr-defined]  # (not in debug mode)
+            return self._timers[0][0] if self._timers else None
         heads = self._earliest_timers()
         return heads[0][0] if heads else None
 
@@ -266,6 +293,20 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
         self._seq += 1
         seq = self._seq
         timer = FifoTimerHandle(when, callback, args, self, context, seq)
+        if self._debug:  # type: ignore[attr-defined]
+            heapq.heappush(self._scheduled, timer)  # type: ignore[attr-defined]
+        else:
+            heapq.heappush(self._timers, (when, seq, timer))
+        timer._scheduled = True
+        return timer
+
+    def wake_at(self, when: float, future: asyncio.Future[None]) -> asyncio.TimerHandle:
+        """``call_at(when, ...)`` of a callback that gives ``future`` its result (None)
+        unless it is done: a sleep's wake-up, scheduled and ordered as any timer."""
+        self._check_closed()  # type: ignore[attr-defined]
+        self._seq += 1
+        seq = self._seq
+        timer = WakeTimer(when, _resolve, (future,), self, _NO_CONTEXT, seq)
         if self._debug:  # type: ignore[attr-defined]
             heapq.heappush(self._scheduled, timer)  # type: ignore[attr-defined]
         else:
@@ -352,9 +393,9 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
             # ones they make ready: those are the next pass, as in asyncio).
             end_time = self.time() + this._clock_resolution
             while timers and timers[0][0] < end_time:
-                handle = heapq.heappop(timers)[2]
-                handle._scheduled = False
-                ready.append(handle)
+                timer = heapq.heappop(timers)[2]
+                timer._scheduled = False
+                ready.append(timer)
             for _ in range(len(ready)):
                 handle = ready.popleft()
                 if not handle._cancelled:

@@ -117,18 +117,13 @@ class VirtualClock(Clock):
             await asyncio.sleep(0)
             return
         future: asyncio.Future[None] = loop.create_future()
-        handle = loop.call_at(sim_time, _wake, future)
+        handle = loop.wake_at(sim_time, future)  # a timer that sets its result
         try:
             await future
         except BaseException:
             handle.cancel()  # woken otherwise (cancelled): the timer must not fire
             raise
         # Woken by the timer: it has run, nothing to cancel (a cancel call per wake less).
-
-
-def _wake(future: asyncio.Future[None]) -> None:
-    if not future.done():
-        future.set_result(None)
 
 
 MAX_STEP_BATCH = 0.05

@@ -239,17 +239,20 @@ def test_timers_keep_their_order_across_debug_mode_and_a_purge() -> None:
     loop = VirtualTimeLoop()
     fired: list[tuple[float, int]] = []
 
+    def fire(i: int) -> None:
+        fired.append((loop.time(), i))
+
     async def main() -> None:
         handles = []
         for i in range(300):
             when = float(1 + i % 7)  # many equal deadlines
-            handles.append(loop.call_at(when, lambda i=i: fired.append((loop.time(), i))))
+            handles.append(loop.call_at(when, fire, i))
         for handle in handles[::3] + handles[1::3]:
             handle.cancel()  # two thirds: the purge path
         loop.set_debug(True)
         await asyncio.sleep(2.5)  # asyncio's iteration, our timers handed over
         assert loop.next_deadline() == 3.0
-        more = [loop.call_at(4.0, lambda i=i: fired.append((loop.time(), i))) for i in (1000, 1001)]
+        more = [loop.call_at(4.0, fire, i) for i in (1000, 1001)]
         loop.set_debug(False)
         more[0].cancel()
         await asyncio.sleep(10)
