@@ -128,6 +128,7 @@ def _instrument() -> None:
         id(f): f
         for f in (
             scan.scan_points,
+            scan.scan_in_frame,
             scan.to_frame,
             scan.nearest_return,
             safety.safe_command,

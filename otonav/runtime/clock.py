@@ -116,7 +116,7 @@ class VirtualClock(Clock):
         if sim_time <= loop.time():
             await asyncio.sleep(0)
             return
-        future: asyncio.Future[None] = loop.create_future()
+        future: asyncio.Future[None] = asyncio.Future(loop=loop)  # create_future's, inline
         handle = loop.wake_at(sim_time, future)  # a timer that sets its result
         try:
             await future
