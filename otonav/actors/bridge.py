@@ -282,26 +282,30 @@ class Bridge(Actor):
         self._odometry = self._odometry._replace(
             left=wheels.left_position, right=wheels.right_position, time=start
         )
-        clock = self.clock
+        clock, hal, pending = self.clock, self.hal, self._pending
+        streams = tuple(enumerate(publishers))
         while True:
             instant = min(due)
             await clock.sleep_until(instant)
             # A period that is not a whole number of ticks wakes at the next tick: stamp
             # (and integrate) with the instant the data is actually read at.
             now = clock.now()
-            if self.hal.health() is not self._health:
+            if hal.health() is not self._health:
                 await self._check_health(now)
             sec, nanosec = split_seconds(now)  # Time.from_seconds(now)'s, no Time object
-            for i, (period, publish, publish_waiting) in enumerate(publishers):
-                if due[i] <= instant + 1e-12:
+            last = instant + 1e-12
+            for i, (period, publish, publish_waiting) in streams:
+                if due[i] <= last:
                     counts[i] += 1
                     due[i] = start + counts[i] * period  # no drift: k periods from start
                     if publish is not None:
                         publish(sec, nanosec, now)
                     elif publish_waiting is not None:
-                        await self._publish_pending()  # in order
+                        if pending:
+                            await self._publish_pending()  # in order
                         await publish_waiting(sec, nanosec, now)
-            await self._publish_pending()
+            if pending:  # a coroutine only when a message waits (almost never)
+                await self._publish_pending()
 
     async def _publish_pending(self) -> None:
         """What found a full reliable mailbox (:meth:`_send`), in order, waiting."""

@@ -15,8 +15,6 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any, Final
 
-import yaml
-
 from otonav.runtime.qos import DEFAULT_QOS, QoS
 
 __all__ = ("INFINITE", "offered_qos_profiles", "offered_qos_yaml")
@@ -45,9 +43,33 @@ def offered_qos_profiles(offered: Sequence[QoS]) -> list[dict[str, Any]]:
     return [_profile(qos) for qos in (offered or (DEFAULT_QOS,))]
 
 
+def _infinite(key: str) -> str:
+    return f"  {key}:\n    sec: {INFINITE['sec']}\n    nsec: {INFINITE['nsec']}\n"
+
+
+_ENTRY = (
+    "- history: keep_last\n  depth: {depth}\n  reliability: {reliability}\n"
+    "  durability: {durability}\n"
+    + _infinite("deadline")
+    + _infinite("lifespan")
+    + "  liveliness: automatic\n"
+    + _infinite("liveliness_lease_duration")
+    + "  avoid_ros_namespace_conventions: false\n"
+)
+"""One profile as ``yaml.safe_dump`` writes :func:`offered_qos_profiles`' mapping (block
+style, keys in order); the depth is a decimal int, the enums plain lower-case words."""
+
+
 def offered_qos_yaml(offered: Sequence[QoS]) -> str:
-    """:func:`offered_qos_profiles` as the YAML string of an MCAP channel's metadata."""
-    text: str = yaml.safe_dump(
-        offered_qos_profiles(offered), default_flow_style=False, sort_keys=False
+    """:func:`offered_qos_profiles` as the YAML string of an MCAP channel's metadata:
+    the text ``yaml.safe_dump(..., default_flow_style=False, sort_keys=False)`` gives,
+    stripped (a test compares the two for every reliability, durability and a range of
+    depths), formatted directly: the dump cost ~0.4 ms a channel, ~6 ms of a recorded
+    run's 16 channels (ADR 0058)."""
+    text = "".join(
+        _ENTRY.format(
+            depth=qos.depth, reliability=qos.reliability.value, durability=qos.durability.value
+        )
+        for qos in (offered or (DEFAULT_QOS,))
     )
     return text.strip()

@@ -108,6 +108,31 @@ class FifoTimerHandle(asyncio.TimerHandle):
         return NotImplemented
 
 
+def _resolve(future: asyncio.Future[None]) -> None:
+    """A wake-up: ``future`` gets its result (None), unless it is done (cancelled)."""
+    if not future.done():
+        future.set_result(None)
+
+
+_NO_CONTEXT = contextvars.Context()
+"""The context of every :class:`WakeTimer` (its ``_run`` runs no code of its own in one)."""
+
+
+class WakeTimer(FifoTimerHandle):
+    """A timer whose callback is :func:`_resolve` of one future (a sleep's wake-up), run
+    without a context switch or a callback frame (~0.4 us a wake, ADR 0058): setting a
+    future's result runs nothing; it schedules the future's callbacks, each in the
+    context it was added with. A timer still, in every other respect (repr, cancel,
+    debug mode)."""
+
+    __slots__ = ()
+
+    def _run(self) -> None:
+        future = self._args[0]
+        if not future.done():
+            future.set_result(None)
+
+
 # -- asyncio: the loop --------------------------------------------------------------------
 
 
@@ -152,6 +177,12 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
     Debug mode runs asyncio's own iteration (the hook is then reached through the
     selector). ``beats`` counts passes (a watchdog's sign of progress); ``waiting`` is
     True while in the hook.
+
+    Timers wait in a heap of ``(when, seq, handle)`` tuples (``_timers``), compared in C,
+    instead of asyncio's heap of handles, compared by a Python ``__lt__`` (~8 calls a
+    timer: ADR 0058); (when, seq) is the order :class:`FifoTimerHandle` gives, so timers
+    fall due in the same order. In debug mode timers go to asyncio's own heap, which
+    asyncio's iteration reads; each iteration adopts what the other mode left.
     """
 
     def __init__(self) -> None:
@@ -160,6 +191,7 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
         selector.loop = self
         self._hooked = selector
         self._seq = 0
+        self._timers: list[tuple[float, int, FifoTimerHandle]] = []
         self._poll = False
         self.beats = 0
         self.waiting = False
@@ -196,17 +228,31 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
 
     def next_deadline(self) -> float | None:
         """The earliest scheduled timer's deadline (a cancelled one included), or None."""
-        scheduled: list[asyncio.TimerHandle] = self._scheduled  # type: ignore[attr-defined]
-        return scheduled[0].when() if scheduled else None
+        if not self._scheduled:  # type: ignore[attr-defined]  # (not in debug mode)
+            return self._timers[0][0] if self._timers else None
+        heads = self._earliest_timers()
+        return heads[0][0] if heads else None
 
     def deadline_after(self, timer: asyncio.TimerHandle | None) -> float:
         """The earliest deadline among the other timers when ``timer`` is the earliest
         (else, or with None, the earliest of all); ``inf`` if none."""
-        heap: list[asyncio.TimerHandle] = self._scheduled  # type: ignore[attr-defined]
-        # The root is ``timer`` or an earlier one; after it, the earliest timer is one
-        # of the root's children.
-        rest = heap[1:3] if heap and heap[0] is timer else heap[:1]
-        return min((t.when() for t in rest), default=math.inf)
+        heads = self._earliest_timers()
+        if not heads:
+            return math.inf
+        if heads[0][2] is timer:
+            return heads[1][0] if len(heads) > 1 else math.inf
+        return heads[0][0]
+
+    def _earliest_timers(self) -> list[tuple[float, int, FifoTimerHandle]]:
+        """The two earliest timers (and maybe more), earliest first, from both heaps
+        (ours, and asyncio's while debug mode runs): each heap's two earliest are among
+        its first three entries (the root and its children)."""
+        scheduled: list[FifoTimerHandle] = self._scheduled  # type: ignore[attr-defined]
+        heads = self._timers[:3]
+        if scheduled:
+            heads += [(h._when, h._seq, h) for h in scheduled[:3]]
+        heads.sort()
+        return heads
 
     def has_io(self) -> bool:
         """Whether anything besides the loop's self-pipe is registered for I/O."""
@@ -245,35 +291,71 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
     ) -> asyncio.TimerHandle:
         self._check_closed()  # type: ignore[attr-defined]
         self._seq += 1
-        timer = FifoTimerHandle(when, callback, args, self, context, self._seq)
-        heapq.heappush(self._scheduled, timer)  # type: ignore[attr-defined]
+        seq = self._seq
+        timer = FifoTimerHandle(when, callback, args, self, context, seq)
+        if self._debug:  # type: ignore[attr-defined]
+            heapq.heappush(self._scheduled, timer)  # type: ignore[attr-defined]
+        else:
+            heapq.heappush(self._timers, (when, seq, timer))
         timer._scheduled = True
         return timer
+
+    def wake_at(self, when: float, future: asyncio.Future[None]) -> asyncio.TimerHandle:
+        """``call_at(when, ...)`` of a callback that gives ``future`` its result (None)
+        unless it is done: a sleep's wake-up, scheduled and ordered as any timer."""
+        self._check_closed()  # type: ignore[attr-defined]
+        self._seq += 1
+        seq = self._seq
+        timer = WakeTimer(when, _resolve, (future,), self, _NO_CONTEXT, seq)
+        if self._debug:  # type: ignore[attr-defined]
+            heapq.heappush(self._scheduled, timer)  # type: ignore[attr-defined]
+        else:
+            heapq.heappush(self._timers, (when, seq, timer))
+        timer._scheduled = True
+        return timer
+
+    def _adopt_debug_timers(self) -> None:
+        """Move the timers debug mode put in asyncio's heap into ours."""
+        this: Any = self
+        for handle in this._scheduled:
+            heapq.heappush(self._timers, (handle._when, handle._seq, handle))
+        this._scheduled.clear()
+
+    def _hand_timers_to_asyncio(self) -> None:
+        """Move our timers into asyncio's heap (debug mode runs asyncio's iteration)."""
+        this: Any = self
+        for _when, _seq, handle in self._timers:
+            heapq.heappush(this._scheduled, handle)
+        self._timers.clear()
+
+    def close(self) -> None:
+        super().close()
+        self._timers.clear()  # as asyncio clears its own heap
 
     # -- one iteration ------------------------------------------------------------------
 
     def _drop_cancelled_timers(self) -> None:
         """asyncio's first step: drop cancelled timers (all, when they are many)."""
         this: Any = self  # asyncio's private attributes, untyped
-        scheduled: list[Any] = this._scheduled
-        count = len(scheduled)
+        timers = self._timers
+        count = len(timers)
         if (
             count > MIN_SCHEDULED_TIMER_HANDLES
             and this._timer_cancelled_count / count > MIN_CANCELLED_TIMER_HANDLES_FRACTION
         ):
             kept = []
-            for handle in scheduled:
-                if handle._cancelled:
-                    handle._scheduled = False
+            for entry in timers:
+                if entry[2]._cancelled:
+                    entry[2]._scheduled = False
                 else:
-                    kept.append(handle)
+                    kept.append(entry)
             heapq.heapify(kept)
-            this._scheduled = kept
+            self._timers = kept
             this._timer_cancelled_count = 0
         else:
-            while scheduled and scheduled[0]._cancelled:
+            while timers and timers[0][2]._cancelled:
                 this._timer_cancelled_count -= 1
-                heapq.heappop(scheduled)._scheduled = False
+                heapq.heappop(timers)[2]._scheduled = False
 
     def _run_once(self) -> None:
         """One asyncio iteration (class docstring): asyncio's steps in asyncio's order,
@@ -284,31 +366,37 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
         self.beats += 1
         if this._debug:
             self.waiting = True  # a debug loop: the watchdog only catches a held selector
+            if self._timers:
+                self._hand_timers_to_asyncio()
             super()._run_once()  # type: ignore[misc]
             return
+        if this._scheduled:  # left by debug mode
+            self._adopt_debug_timers()
         ready = this._ready
         inner = self._hooked.inner
-        self._drop_cancelled_timers()
-        scheduled: list[Any] = this._scheduled
+        if this._timer_cancelled_count:  # else there is nothing to drop (a call less)
+            self._drop_cancelled_timers()
+        timers = self._timers
         if ready or this._stopping:
             if self._poll:
                 this._process_events(inner.select(0))
         else:
-            timeout = max(0.0, scheduled[0]._when - self.time()) if scheduled else None
+            timeout = max(0.0, timers[0][0] - self.time()) if timers else None
             self.waiting = True
             events = self.select_idle(inner, timeout)
             self.waiting = False
-            this._process_events(events)
+            if events:  # (a time jump returns none: a call less per instant)
+                this._process_events(events)
         passes = 0
         while True:
             self.beats += 1
             # Due timers join the ready queue, then the callbacks ready now run (not the
             # ones they make ready: those are the next pass, as in asyncio).
             end_time = self.time() + this._clock_resolution
-            while scheduled and scheduled[0]._when < end_time:
-                handle = heapq.heappop(scheduled)
-                handle._scheduled = False
-                ready.append(handle)
+            while timers and timers[0][0] < end_time:
+                timer = heapq.heappop(timers)[2]
+                timer._scheduled = False
+                ready.append(timer)
             for _ in range(len(ready)):
                 handle = ready.popleft()
                 if not handle._cancelled:
@@ -320,7 +408,8 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
             passes += 1
             if not passes & 255:
                 self.iteration_check()
-            self._drop_cancelled_timers()
-            scheduled = this._scheduled
+            if this._timer_cancelled_count:
+                self._drop_cancelled_timers()
+                timers = self._timers
             if self._poll:
                 this._process_events(inner.select(0))

@@ -61,6 +61,7 @@ class VirtualTimeLoop(SteppedSelectorLoop):
         self._rate = tick_rate(self._source.tick)
         self._base = 0.0
         self._ticks = 0
+        self._now = 0.0  # time(), kept with _base and _ticks (read ~9 times an instant)
         # The loop advances to the first tick at or after a deadline; the resolution lets
         # a timer whose deadline is float noise above a tick fire at that tick. It must
         # stay well above the float spacing of large times (a year in: ~4e-9 s).
@@ -82,7 +83,8 @@ class VirtualTimeLoop(SteppedSelectorLoop):
     # -- time ---------------------------------------------------------------------------
 
     def time(self) -> float:
-        return self._base + self._ticks / self._rate
+        # _base + _ticks / _rate, computed when they change (the same float).
+        return self._now
 
     def _time_at(self, ticks: int) -> float:
         return self._base + ticks / self._rate
@@ -102,6 +104,7 @@ class VirtualTimeLoop(SteppedSelectorLoop):
         self._ticks = 0
         self._source = source
         self._rate = tick_rate(source.tick)
+        self._now = self._base + self._ticks / self._rate
         self.clock_resolution = 0.25 / self._rate
 
     # -- watchers: predicates evaluated whenever the system is idle at an instant -------
@@ -208,8 +211,9 @@ class VirtualTimeLoop(SteppedSelectorLoop):
         Always moving on matters: anyio re-arms a deadline timer that fired within the
         clock resolution but before its deadline; staying put would livelock.
         """
-        target = max(self._ticks + 1, math.ceil((when - self._base) * self._rate - 1.0))
-        while self._time_at(target) + self.clock_resolution <= when:
+        base, rate, resolution = self._base, self._rate, self.clock_resolution
+        target = max(self._ticks + 1, math.ceil((when - base) * rate - 1.0))
+        while base + target / rate + resolution <= when:  # _time_at(target), inline
             target += 1
         try:
             self._source.advance(target - self._ticks)
@@ -222,6 +226,7 @@ class VirtualTimeLoop(SteppedSelectorLoop):
             self._source.advance(target - self._ticks)
             self._fail(error)
         self._ticks = target
+        self._now = base + target / rate
         self.wakes += 1
 
     def iteration_check(self) -> None:

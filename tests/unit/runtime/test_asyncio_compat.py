@@ -152,3 +152,38 @@ def test_equal_deadlines_fire_in_scheduling_order_on_the_stepped_loop() -> None:
 
     with asyncio.Runner(loop_factory=compat.SteppedSelectorLoop) as runner:
         assert runner.run(main()) == list(range(40))
+
+
+@pytest.mark.parametrize("debug", [False, True], ids=["fast", "asyncio-debug"])
+def test_a_wake_timer_resolves_its_future_in_timer_order(debug: bool) -> None:
+    """wake_at (a sleep's wake-up, ADR 0058) is a timer like call_at's: ordered with the
+    others by deadline then scheduling order, its future resolved when due, a future
+    already done (cancelled) left alone, cancellable before it fires."""
+    from otonav.runtime import VirtualTimeLoop
+
+    loop = VirtualTimeLoop()
+    log: list[str] = []
+
+    async def main() -> None:
+        first: asyncio.Future[None] = loop.create_future()
+        first.add_done_callback(lambda f: log.append(f"first {f.cancelled()}"))
+        gone: asyncio.Future[None] = loop.create_future()
+        never: asyncio.Future[None] = loop.create_future()
+        loop.call_at(2.0, log.append, "call_at before")
+        loop.wake_at(2.0, first)
+        loop.call_at(2.0, log.append, "call_at after")
+        loop.wake_at(1.0, gone)
+        gone.cancel()
+        loop.wake_at(3.0, never).cancel()
+        assert "WakeTimer" in repr(loop.wake_at(5.0, loop.create_future()))
+        await first
+        log.append(f"woke at {loop.time():g}")
+        await asyncio.sleep(2)
+        assert not never.done()
+
+    loop.set_debug(debug)
+    try:
+        loop.run_until_complete(main())
+    finally:
+        loop.close()
+    assert log == ["call_at before", "call_at after", "first False", "woke at 2"]

@@ -228,3 +228,41 @@ def test_one_instant_runs_callbacks_in_stock_asyncio_order(debug: bool) -> None:
     virtual = trace(VirtualTimeLoop())
     assert "never" not in stock
     assert virtual == stock
+
+
+def test_timers_keep_their_order_across_debug_mode_and_a_purge() -> None:
+    """Timers wait in the loop's own heap of (when, seq) tuples, or in asyncio's while
+    debug mode runs asyncio's iteration (ADR 0058). Switching modes with timers pending,
+    cancelling most of them (asyncio's purge of cancelled timers: >100 timers, >50 %
+    cancelled) and equal deadlines must still fire every live timer once, by deadline
+    then in scheduling order, at its sim time."""
+    loop = VirtualTimeLoop()
+    fired: list[tuple[float, int]] = []
+
+    def fire(i: int) -> None:
+        fired.append((loop.time(), i))
+
+    async def main() -> None:
+        handles = []
+        for i in range(300):
+            when = float(1 + i % 7)  # many equal deadlines
+            handles.append(loop.call_at(when, fire, i))
+        for handle in handles[::3] + handles[1::3]:
+            handle.cancel()  # two thirds: the purge path
+        loop.set_debug(True)
+        await asyncio.sleep(2.5)  # asyncio's iteration, our timers handed over
+        assert loop.next_deadline() == 3.0
+        more = [loop.call_at(4.0, fire, i) for i in (1000, 1001)]
+        loop.set_debug(False)
+        more[0].cancel()
+        await asyncio.sleep(10)
+
+    try:
+        loop.run_until_complete(main())
+    finally:
+        loop.close()
+    live = sorted((float(1 + i % 7), i) for i in range(2, 300, 3))
+    expected = [*live[: live.index((4.0, min(i for w, i in live if w == 4.0)))]]
+    expected += [(w, i) for w, i in live if w == 4.0] + [(4.0, 1001)]
+    expected += [(w, i) for w, i in live if w > 4.0]
+    assert fired == expected
