@@ -294,7 +294,6 @@ class StaticRayCaster:
         self._sin = np.sin(angles)
         self._cutoff = cutoff
         self._reach = cutoff + geometry.box_rbound  # MuJoCo: dist > cutoff + rbound drops it
-        self._plane_reach = cutoff + geometry.plane_rbound
         self._last_boxes = np.zeros(0, dtype=np.int64)  # boxes hit by the last scan
         self._has_spheres = bool(np.isfinite(geometry.body_center[:, 0]).any())
         # row (n, i): box n's axis i in the world (column i of its row-major xmat)
@@ -367,9 +366,7 @@ class StaticRayCaster:
         g = self._g
         beams = np.arange(self._nb)
         for k in range(len(g.plane_ids)):
-            d = g.plane_pos[k] - pnt
-            if math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) > self._plane_reach[k]:
-                continue  # MuJoCo's cutoff
+            d = g.plane_pos[k] - pnt  # (MuJoCo 4.0 never drops a plane by the cutoff)
             mat = g.plane_mat[k]
             lvec2 = mat[2] * vec[:, 0] + mat[5] * vec[:, 1] + mat[8] * vec[:, 2]
             # ray_plane's first test, and: a beam too shallow to meet the (finite)
