@@ -117,7 +117,7 @@ def ray_box(pos: F64, mat: F64, size: F64, pnt: F64, vec: F64) -> F64:
     near = _sphere_hit(pos, ssz, pnt, vec)
     lpnt, lvec = _ray_map(pos, mat, pnt, vec)
     best = np.full(len(pos), np.inf)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         for i in range(3):
             j0, j1 = _FACE0[i], _FACE1[i]
             usable = np.abs(lvec[:, i]) > _MINVAL
@@ -146,7 +146,8 @@ def _entry_face(pos: F64, mat: F64, size: F64, pnt: F64, vec: F64, axis: I64, si
     m2 = mat[rows, axis + 6]
     lpnt = m0 * (pnt[0] - pos[:, 0]) + m1 * (pnt[1] - pos[:, 1]) + m2 * (pnt[2] - pos[:, 2])
     lvec = m0 * vec[:, 0] + m1 * vec[:, 1] + m2 * vec[:, 2]
-    result: F64 = (side * size[rows, axis] - lpnt) / lvec
+    with np.errstate(over="ignore"):
+        result: F64 = (side * size[rows, axis] - lpnt) / lvec
     return result
 
 
@@ -154,7 +155,7 @@ def ray_plane(pos: F64, mat: F64, size: F64, pnt: F64, vec: F64) -> F64:
     """MuJoCo 4.0's ``ray_plane`` for P (plane, ray) pairs (front face only, within the
     rendered rectangle when its size is positive); -1 for none."""
     lpnt, lvec = _ray_map(pos, mat, pnt, vec)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         x = -lpnt[:, 2] / lvec[:, 2]
         p0 = lpnt[:, 0] + x * lvec[:, 0]
         p1 = lpnt[:, 1] + x * lvec[:, 1]
