@@ -48,6 +48,7 @@ _CORNERS: Final = np.array(
 _SIGNS: Final = np.array([[1.0, 1.0, 1.0, 1.0], [1.0, 1.0, -1.0, -1.0], [1.0, -1.0, 1.0, -1.0]])
 _NEAR_FIRST: Final = 16  # boxes cast before the rest, nearest first
 _WIDE: Final = 24  # beams: a box wider than this is cast after the narrow ones
+_FACING: Final = 1e-3  # cosine: a face seen less squarely than this is checked
 _NO_ID: Final = np.iinfo(np.int64).max
 
 F64 = NDArray[np.float64]
@@ -227,7 +228,7 @@ class _Slabs:
 
     def pairs(
         self, boxes: I64, lo: I64, count: I64, nb: int, bound: F64, lower: F64 | None = None
-    ) -> tuple[I64, I64, F64, NDArray[np.bool_], NDArray[np.bool_], I64, F64]:
+    ) -> tuple[I64, I64, F64, NDArray[np.bool_], NDArray[np.bool_], I64, F64, NDArray[np.bool_]]:
         """Test every beam each of ``boxes`` may meet (``lower``: only where the beam's
         ``bound`` does not stop it first); the clear hits lower ``bound``."""
         c = count[boxes]
@@ -268,8 +269,16 @@ class _Slabs:
         excess[rows, axis] = -np.inf
         inner = np.maximum(np.maximum(excess[:, 0], excess[:, 1]), excess[:, 2]) < -_SLACK
         face = np.where(clear & (t_in > 0) & inner, axis, -1)
-        side = np.where(lv[rows, axis] > 0, -1.0, 1.0)
-        return box, beam, first_hit, clear, graze, face, side
+        facing = lv[rows, axis]
+        side = np.where(facing > 0, -1.0, 1.0)
+        # entering 1e-6 m inside its face, not edge-on: MuJoCo's bounding angles, which
+        # hold the box, hold this beam by far more than atan2's rounding (ADR 0057)
+        deep = (
+            (face >= 0)
+            & (np.abs(facing) >= _FACING)
+            & (np.maximum(np.maximum(excess[:, 0], excess[:, 1]), excess[:, 2]) < -_CLEAR)
+        )
+        return box, beam, first_hit, clear, graze, face, side, deep
 
 
 class StaticRayCaster:
@@ -317,7 +326,7 @@ class StaticRayCaster:
         result is not certain to be MuJoCo's: cast those with MuJoCo."""
         nb = self._nb
         body_ok = self._body_ok(pnt, vec)
-        found: list[tuple[I64, F64, I64]] = []
+        found: list[tuple[I64, F64, I64, NDArray[np.bool_]]] = []
         self._planes(pnt, vec, body_ok, found)
         bound = self._boxes(pnt, rot, vec, body_ok, found)
         best_t = np.full(nb, np.inf)
@@ -326,16 +335,23 @@ class StaticRayCaster:
             beam = np.concatenate([f[0] for f in found])
             t = np.concatenate([f[1] for f in found])
             ids = np.concatenate([f[2] for f in found])
+            deep = np.concatenate([f[3] for f in found])
             hit = t >= 0
-            beam, t, ids = beam[hit], t[hit], ids[hit]
+            beam, t, ids, deep = beam[hit], t[hit], ids[hit], deep[hit]
             np.minimum.at(best_t, beam, t)
             tie = t == best_t[beam]  # MuJoCo keeps the first of equal distances: lower id
             np.minimum.at(best_id, beam[tie], ids[tie])
+            winner = tie & (ids == best_id[beam])
+            sure = np.zeros(nb, dtype=np.bool_)
+            sure[beam[winner & deep]] = True
+        else:
+            sure = np.zeros(nb, dtype=np.bool_)
         # a pruning bound that no exact hit met: the pairs it dropped may matter
         unsure = np.isfinite(bound) & ~(best_t <= bound)
         won = np.isfinite(best_t)
-        if won.any():
-            unsure |= self._winners_unsure(pnt, vec, won, best_id)
+        check = won & ~sure
+        if check.any():
+            unsure |= self._winners_unsure(pnt, vec, check, best_id)
         geom.fill(-1)
         dist.fill(-1.0)
         geom[won] = best_id[won]
@@ -362,7 +378,7 @@ class StaticRayCaster:
         pnt: F64,
         vec: F64,
         body_ok: NDArray[np.bool_] | None,
-        found: list[tuple[I64, F64, I64]],
+        found: list[tuple[I64, F64, I64, NDArray[np.bool_]]],
     ) -> None:
         g = self._g
         beams = np.arange(self._nb)
@@ -393,7 +409,8 @@ class StaticRayCaster:
                 pnt,
                 vec[down],
             )
-            found.append((beams[down], t, np.full(m, g.plane_ids[k], dtype=np.int64)))
+            ids = np.full(m, g.plane_ids[k], dtype=np.int64)
+            found.append((beams[down], t, ids, np.zeros(m, dtype=np.bool_)))
 
     def _boxes(
         self,
@@ -401,7 +418,7 @@ class StaticRayCaster:
         rot: F64,
         vec: F64,
         body_ok: NDArray[np.bool_] | None,
-        found: list[tuple[I64, F64, I64]],
+        found: list[tuple[I64, F64, I64, NDArray[np.bool_]]],
     ) -> F64:
         """Cast the boxes; returns the per-beam bound used to drop pairs (inf: none)."""
         g = self._g
@@ -481,15 +498,15 @@ class StaticRayCaster:
             far = far[lower[far] <= reach]
             if len(far):
                 parts.append(slab.pairs(far, lo, count, nb, bound, lower))
-        box, beam, first_hit, clear, graze, face, side = (
-            np.concatenate([q[k] for q in parts]) for k in range(7)
+        box, beam, first_hit, clear, graze, face, side, deep = (
+            np.concatenate([q[k] for q in parts]) for k in range(8)
         )
         limit = bound[beam]
         go = (clear & (first_hit - _SLACK <= limit)) | (graze & (lower[box] <= limit))
-        box, beam, face, side = box[go], beam[go], face[go], side[go]
+        box, beam, face, side, deep = box[go], beam[go], face[go], side[go], deep[go]
         if body_ok is not None:
             ok = body_ok[g.box_body[sel[box]], beam]
-            box, beam, face, side = box[ok], beam[ok], face[ok], side[ok]
+            box, beam, face, side, deep = box[ok], beam[ok], face[ok], side[ok], deep[ok]
         if len(box) == 0:
             return bound
         gid = sel[box]
@@ -514,7 +531,7 @@ class StaticRayCaster:
                 pnt,
                 vec[beam[rest]],
             )
-        found.append((beam, t, g.box_ids[gid].astype(np.int64)))
+        found.append((beam, t, g.box_ids[gid].astype(np.int64), deep))
         self._last_boxes = np.unique(gid[t >= 0])
         return bound
 
