@@ -10,10 +10,11 @@ from numpy.typing import NDArray
 
 from otonav.hal.mujoco._lib import mujoco
 from otonav.hal.raycast import StaticGeometry, StaticRayCaster
+from otonav.limits import LIDAR_CASTER_MIN_BOXES
 
 __all__ = ["MIN_STATIC_BOXES", "castable", "ray_caster"]
 
-MIN_STATIC_BOXES: Final = 400
+MIN_STATIC_BOXES: Final = LIDAR_CASTER_MIN_BOXES
 """Below this many static boxes MuJoCo casts everything: its one call (~50 us for the
 empty arena's walls and floor, +1.8 us a box) is cheaper than the caster's numpy steps
 (~0.55 ms, +0.45 us a box; ADR 0057, benchmarks/ray_bench.py)."""
