@@ -9,21 +9,25 @@ returns **the same floats and geom ids as** ``mj_multiRay``:
    ``cutoff + rbound`` from the lidar, the same arithmetic); the box's extent across
    the scan plane (no beam can meet a box that does not cross it) and the disc that
    holds its outline projected on that plane, whose angular interval seen from the
-   lidar names the beams that can meet it, one beam of margin each side.
+   lidar (1e-9 rad of slack) names the beams that can meet it; the box's distance to
+   the lidar bounds every hit on it from below.
 2. *Per (beam, box) pair*: an ordinary slab test (any rounding) gives where the beam
-   enters each box; per beam, the nearest clear hit bounds the others, and only the
-   pairs that could come first (or graze) go on.
+   enters each box. The boxes the last scan hit and the nearest ones go first; their
+   clear hits bound each beam, so the boxes wholly behind them and the pairs past them
+   are dropped, and only the pairs that could come first (or graze) go on.
 3. *MuJoCo's arithmetic* (``ray_box``/``ray_plane`` of MuJoCo 4.0, every operation in
    the same order, no fused multiply-add) decides those pairs; per beam the smallest
    distance wins, ties to the lower geom id (MuJoCo's loop order). Planes are cast
-   against every beam the same way, and a static body's bounding sphere test too.
+   against every beam steep enough to meet them the same way (MuJoCo 4.0 does not drop
+   a plane by the cutoff), and a static body's bounding sphere test too.
 4. *What cannot be replicated bit for bit* is MuJoCo's per-geom angular bounds (its
-   ``atan2``); they only ever drop a pair whose hit grazes the box's outline. A beam
-   whose winner lies within 1e-9 rad of those bounds, or whose pruning bound in step 2
-   turns out wrong, is returned as *unsure*: the caller casts it with MuJoCo itself.
+   ``atan2``); they only ever drop a pair whose hit lies on the box's silhouette. A
+   winner that does not enter its face squarely and well inside is checked against
+   them; a beam within 1e-9 rad of them, or whose pruning bound in step 2 no exact hit
+   met, is returned as *unsure*: the caller casts it with MuJoCo itself.
 
 Everything here is numpy; the MuJoCo side (which geoms are static, the fallback cast)
-lives in :mod:`otonav.hal.mujoco.world`.
+lives in :mod:`otonav.hal.mujoco.static_geoms` and :mod:`otonav.hal.mujoco.world`.
 """
 
 from __future__ import annotations

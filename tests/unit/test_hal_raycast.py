@@ -265,3 +265,52 @@ def test_small_worlds_keep_one_mujoco_call() -> None:
     assert MujocoInterface("empty", extra_obstacles=few)._caster is None
     many = [b.to_obstacle() for b in clutter_scenario(static_geoms.MIN_STATIC_BOXES).obstacles]
     assert MujocoInterface("empty", extra_obstacles=many)._caster is not None
+
+
+def _with(path: Path, extra: str) -> Path:
+    """A scene of 12 static boxes around the start, the floor, and ``extra`` MJCF."""
+    ring = [
+        (2.0 * math.cos(k / 2), 2.0 * math.sin(k / 2), 0.25, 0.1, 0.2, 0.25, (1.0, 0.0, 0.0, 0.0))
+        for k in range(12)
+    ]
+    _scene(path, ring, 6.0)
+    path.write_text(path.read_text().replace("</worldbody>", extra + "</worldbody>"))
+    return path
+
+
+def test_moving_geoms_are_cast_by_mujoco_and_merged(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A box on a slide joint is not static: MuJoCo casts it (flg_static=0), the caster
+    the rest, and the nearer return wins, as in one mj_multiRay."""
+    scene = _with(
+        tmp_path / "w.xml",
+        '<body name="door" pos="1.0 0.3 0.25"><joint type="slide" axis="1 0 0"/>'
+        '<geom name="door" type="box" size="0.05 0.4 0.25" group="0"/></body>',
+    )
+    fast, ref = _pair(scene, monkeypatch)
+    assert fast._cast_moving
+    door = int(mujoco.mj_name2id(fast._model, mujoco.mjtObj.mjOBJ_GEOM, "door"))
+    for x in (0.0, 0.5, 1.5):
+        for world in (fast, ref):
+            _pose(world, x, 0.0, 0.05, 0.0, 0.0, 0.0)
+        _same_scan(fast, ref)
+        assert door in set(fast.scan_hit_geoms().tolist())
+
+
+@pytest.mark.parametrize(
+    "extra",
+    [
+        '<geom name="ball" type="sphere" size="0.2" pos="1 1 0.2" group="0"/>',
+        '<body name="target" mocap="true" pos="1 1 0.2">'
+        '<geom type="box" size="0.1 0.1 0.1" group="0"/></body>',
+    ],
+)
+def test_worlds_the_caster_does_not_model_stay_with_mujoco(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, extra: str
+) -> None:
+    """A static geom of another type, or a mocap body (its 'static' geoms move): MuJoCo
+    casts everything, as before."""
+    monkeypatch.setattr(static_geoms, "MIN_STATIC_BOXES", 0)
+    world = MujocoInterface(_with(tmp_path / "w.xml", extra))
+    assert world._caster is None
