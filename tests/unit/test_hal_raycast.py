@@ -269,8 +269,9 @@ def test_small_worlds_keep_one_mujoco_call() -> None:
 
 def _with(path: Path, extra: str) -> Path:
     """A scene of 12 static boxes around the start, the floor, and ``extra`` MJCF."""
-    ring = [
-        (2.0 * math.cos(k / 2), 2.0 * math.sin(k / 2), 0.25, 0.1, 0.2, 0.25, (1.0, 0.0, 0.0, 0.0))
+    upright: tuple[float, ...] = (1.0, 0.0, 0.0, 0.0)
+    ring: list[Box] = [
+        (2.0 * math.cos(k / 2), 2.0 * math.sin(k / 2), 0.25, 0.1, 0.2, 0.25, upright)
         for k in range(12)
     ]
     _scene(path, ring, 6.0)
