@@ -9,7 +9,9 @@ from 13 poses along the course, and what the options MuJoCo offers would change:
 - two passes: cutoff 2 m, then only the beams with no return within 2 m at the full range
   (exact: a return nearer than the first cutoff is one the full cast gives);
 - boxes in static bodies, one per 1 m cell (MuJoCo tests a body's bounding sphere before
-  its geoms): the scan, and what that layout does to a physics step.
+  its geoms): the scan, and what that layout does to a physics step;
+- otonav's numpy caster for static boxes and planes (ADR 0057, ``otonav.hal.raycast``,
+  what read_scan uses from 400 boxes), with MuJoCo for the beams it is not sure of.
 
 Each figure is a median of CPU time (this machine is shared), us per scan or per step; every
 variant's ranges and geom ids are compared with today's ("same" or "DIFFERENT").
@@ -32,7 +34,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from otonav.bench.clutter import clutter_scenario
-from otonav.hal.mujoco import scene_path
+from otonav.hal.mujoco import scene_path, static_geoms
+from otonav.hal.raycast import StaticRayCaster
 
 BEAMS = 360
 RANGE = 8.0
@@ -97,6 +100,42 @@ def two_passes(m: Any, d: Any, pnt: NDArray[np.float64], first: float = 2.0) -> 
     return geom, dist
 
 
+def numpy_caster(m: Any, d: Any) -> StaticRayCaster:
+    """The caster read_scan builds for this world (whatever its box count)."""
+    threshold = static_geoms.MIN_STATIC_BOXES
+    static_geoms.MIN_STATIC_BOXES = 0  # type: ignore[misc]
+    try:
+        caster, _moving = static_geoms.ray_caster(
+            m,
+            d,
+            groups=GROUPS,
+            exclude_body=-1,
+            angle_min=-math.pi,
+            increment=2 * math.pi / BEAMS,
+            beams=BEAMS,
+            cutoff=RANGE,
+        )
+    finally:
+        static_geoms.MIN_STATIC_BOXES = threshold  # type: ignore[misc]
+    assert caster is not None
+    return caster
+
+
+def with_caster(caster: StaticRayCaster) -> Callable[[Any, Any, NDArray[np.float64]], Scan]:
+    """A scan as read_scan makes it: the caster, then MuJoCo for the beams it is unsure of."""
+
+    def scan(m: Any, d: Any, pnt: NDArray[np.float64]) -> Scan:
+        geom = np.full(BEAMS, -1, np.int32)
+        dist = np.full(BEAMS, -1.0)
+        unsure = caster.cast(pnt, np.eye(3), VEC, geom, dist)
+        if unsure.any():
+            rows = np.flatnonzero(unsure)
+            geom[rows], dist[rows] = cast(m, d, pnt, rows, RANGE)
+        return geom, dist
+
+    return scan
+
+
 def cpu_us(f: Callable[[], object], inner: int) -> float:
     laps = []
     for _ in range(7):
@@ -134,7 +173,7 @@ def main() -> None:
     print(f"one {BEAMS}-beam scan, CPU us (median), {len(POSES)} poses along the clutter course")
     print(
         f"{'boxes':>6}{'today':>8}{'set-up':>8}{'/beam':>7}{'hidden':>8}{'2 pass':>8}"
-        f"{'cells':>8}   {'step':>6}{'step, cells':>12}"
+        f"{'cells':>8}{'numpy':>8}   {'step':>6}{'step, cells':>12}"
     )
     for n in args.counts:
         m, d = world(n, None)
@@ -160,14 +199,19 @@ def main() -> None:
         t_cells = per_scan(mc, dc, today)
         cells_same = same(ref, [today(mc, dc, p) for p in POSES], m, mc)
         t_step_cells = step_us(mc, dc)
+        numpy_scan = with_caster(numpy_caster(m, d))
+        numpy_scan(m, d, POSES[0])  # its first scan has no previous one to start from
+        t_numpy = per_scan(m, d, numpy_scan)
+        numpy_same = same(ref, [numpy_scan(m, d, p) for p in POSES], m, m)
         print(
             f"{n:>6}{t_today:>8.0f}{setup:>8.0f}{per_beam:>7.1f}{t_hidden:>8.0f}"
-            f"{t_two:>8.0f}{t_cells:>8.0f}   {t_step:>6.1f}{t_step_cells:>12.1f}"
-            f"   (2 pass {two_same}, cells {cells_same})"
+            f"{t_two:>8.0f}{t_cells:>8.0f}{t_numpy:>8.0f}   {t_step:>6.1f}{t_step_cells:>12.1f}"
+            f"   (2 pass {two_same}, cells {cells_same}, numpy {numpy_same})"
         )
     print(
         "hidden: boxes in a group no beam is cast against (what a box costs a beam that "
-        "cannot hit it); cells: the boxes in one static body per 1 m square"
+        "cannot hit it); cells: the boxes in one static body per 1 m square; numpy: "
+        "otonav's caster for static boxes and planes (ADR 0057)"
     )
 
 

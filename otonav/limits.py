@@ -171,9 +171,26 @@ _US_PER_BOX_STEP = 0.02
 sampled forward pass (measured 10-13 ns per box, issue 30). The judge's clearance no
 longer costs per box (otonav/scenario/clearance.py)."""
 _US_PER_BOX_BEAM = 0.01
-"""Wall µs per box per lidar beam cast: mj_multiRay tests every box's bounds for every
-beam, and sets every box's angular bounds up once per scan (measured 5.6 ns per box and
-beam plus 0.26 us per box and scan at 360 beams, issue 30)."""
+"""Wall µs per box per lidar beam cast by mj_multiRay (worlds with fewer than
+:data:`LIDAR_CASTER_MIN_BOXES` boxes): it tests every box's bounds for every beam, and
+sets every box's angular bounds up once per scan (measured 5.6 ns per box and beam plus
+0.26 us per box and scan at 360 beams, issue 30)."""
+LIDAR_CASTER_MIN_BOXES = 400
+"""From this many static boxes the lidar casts them with otonav's numpy caster
+(``otonav/hal/raycast.py``, ADR 0057: the same returns as mj_multiRay), whose cost per
+scan is mostly fixed; below it, one mj_multiRay call is cheaper."""
+_US_CASTER_PER_BEAM = 3.0
+"""Wall µs per beam of a scan by the numpy caster, whatever the box count (measured
+0.55-1.1 ms per 360-beam scan on the shared 2-core machine, ADR 0057)."""
+_US_CASTER_PER_BOX = 1.0
+"""Wall µs per box per scan by the numpy caster (measured 0.4-0.8 µs, ADR 0057)."""
+
+
+def _scan_us(lidar_beams: int, boxes: int) -> float:
+    """Wall µs of one scan of ``lidar_beams`` in a world of ``boxes``."""
+    if boxes < LIDAR_CASTER_MIN_BOXES:
+        return (_US_PER_BEAM + _US_PER_BOX_BEAM * boxes) * lidar_beams
+    return (_US_PER_BEAM + _US_CASTER_PER_BEAM) * lidar_beams + _US_CASTER_PER_BOX * boxes
 
 
 def estimated_wall_s(
@@ -193,7 +210,7 @@ def estimated_wall_s(
     per_sim_s_us = (
         (_US_PER_STEP + _US_PER_BOX_STEP * boxes) / timestep
         + _US_PER_WAKE * rates_hz
-        + (_US_PER_BEAM + _US_PER_BOX_BEAM * boxes) * scan_hz * lidar_beams
+        + _scan_us(lidar_beams, boxes) * scan_hz
     )
     return sim_budget * per_sim_s_us * 1e-6
 

@@ -127,6 +127,7 @@ CLUTTER_STAGES: tuple[tuple[str, str], ...] = (
     ("physics (mj_step, mj_forward)", "mj_step"),
     ("physics (mj_step, mj_forward)", "mj_forward"),
     ("lidar (mj_multiRay)", "mj_multiRay"),
+    ("lidar (numpy caster)", "otonav/hal/raycast"),
     ("world build (MjSpec, compile)", "compile"),
     ("world build (MjSpec, compile)", "add_geom"),
     ("world build (MjSpec, compile)", "pydantic"),

@@ -41,6 +41,7 @@ from otonav.hal.mujoco._lib import mujoco, viewer_module
 from otonav.hal.mujoco.derive import _actuator_of, _Derivation, _probe, _site_sensor
 from otonav.hal.mujoco.prepare import ROBOT_PREFIX, _load_robot, _merge_options, _RobotSpec
 from otonav.hal.mujoco.scene import SceneError, _add_box, _compile, _load_spec
+from otonav.hal.mujoco.static_geoms import ray_caster
 from otonav.hal.types import (
     BoxObstacle,
     GroundTruth,
@@ -202,6 +203,20 @@ class MujocoInterface(RobotHardwareInterface):
         self._stale = True
         self._closed = False
         self._sync()
+        # The static boxes and planes are cast in numpy (ADR 0057), MuJoCo casts the rest.
+        self._caster, self._cast_moving = ray_caster(
+            m,
+            self._data,
+            groups=_RAY_GROUPS,
+            exclude_body=self._chassis,
+            angle_min=self._angle_min,
+            increment=self._angle_increment,
+            beams=lidar_beams,
+            cutoff=self._range_max,
+        )
+        if self._caster is not None:
+            self._moving_geom = np.full(lidar_beams, -1, dtype=np.int32)
+            self._moving_dist = np.full(lidar_beams, -1.0)
 
     # -- model facts ----------------------------------------------------------------------
 
@@ -341,20 +356,10 @@ class MujocoInterface(RobotHardwareInterface):
         rot = d.site_xmat[self._lidar_site].reshape(3, 3)
         np.matmul(self._beams_local, rot.T, out=self._ray_vec)
         self._ray_origin[:] = d.site_xpos[self._lidar_site]
-        mujoco.mj_multiRay(
-            self._model,
-            d,
-            self._ray_origin,
-            self._ray_vec_flat,
-            _RAY_GROUPS,
-            1,
-            self._chassis,
-            self._ray_geom,
-            self._ray_dist,
-            None,
-            self._nbeams,
-            self._range_max,
-        )
+        if self._caster is None:
+            self._mujoco_cast(self._ray_vec_flat, self._ray_geom, self._ray_dist, static=True)
+        else:
+            self._cast_static_apart(rot)
         dist = self._ray_dist
         hit = self._ray_geom >= 0
         valid = hit & (dist >= self._range_min) & (dist <= self._range_max)
@@ -371,6 +376,52 @@ class MujocoInterface(RobotHardwareInterface):
             range_max=self._range_max,
             ranges=ranges,
         )
+
+    def _mujoco_cast(
+        self,
+        vec: NDArray[np.float64],
+        geom: NDArray[np.int32],
+        dist: NDArray[np.float64],
+        *,
+        static: bool,
+    ) -> None:
+        mujoco.mj_multiRay(
+            self._model,
+            self._data,
+            self._ray_origin,
+            vec,
+            _RAY_GROUPS,
+            1 if static else 0,
+            self._chassis,
+            geom,
+            dist,
+            None,
+            len(geom),
+            self._range_max,
+        )
+
+    def _cast_static_apart(self, rot: NDArray[np.float64]) -> None:
+        """The numpy caster for the static geoms, MuJoCo for the moving ones (none:
+        no call) and for any beam the caster is not sure of: the same returns as one
+        ``mj_multiRay`` over everything (ADR 0057)."""
+        assert self._caster is not None
+        geom, dist = self._ray_geom, self._ray_dist
+        unsure = self._caster.cast(self._ray_origin, rot, self._ray_vec, geom, dist)
+        if self._cast_moving:
+            mg, md = self._moving_geom, self._moving_dist
+            self._mujoco_cast(self._ray_vec_flat, mg, md, static=False)
+            # one cast keeps the nearest, the first (lower id) of equal distances
+            take = (md >= 0) & ((dist < 0) | (md < dist) | ((md == dist) & (mg < geom)))
+            geom[take] = mg[take]
+            dist[take] = md[take]
+        if unsure.any():
+            beams = np.flatnonzero(unsure)
+            sub_geom = np.full(len(beams), -1, dtype=np.int32)
+            sub_dist = np.full(len(beams), -1.0)
+            vec = np.ascontiguousarray(self._ray_vec[beams]).reshape(-1)
+            self._mujoco_cast(vec, sub_geom, sub_dist, static=True)
+            geom[beams] = sub_geom
+            dist[beams] = sub_dist
 
     def scan_hit_geoms(self) -> NDArray[np.int32]:
         """Geom id hit by each beam of the last :meth:`read_scan` (-1: miss). A copy."""
