@@ -293,12 +293,7 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
         self._seq += 1
         seq = self._seq
         timer = FifoTimerHandle(when, callback, args, self, context, seq)
-        if self._debug:  # type: ignore[attr-defined]
-            heapq.heappush(self._scheduled, timer)  # type: ignore[attr-defined]
-        else:
-            heapq.heappush(self._timers, (when, seq, timer))
-        timer._scheduled = True
-        return timer
+        return self._push_timer(when, seq, timer)
 
     def wake_at(self, when: float, future: asyncio.Future[None]) -> asyncio.TimerHandle:
         """``call_at(when, ...)`` of a callback that gives ``future`` its result (None)
@@ -307,6 +302,10 @@ class SteppedSelectorLoop(asyncio.SelectorEventLoop):
         self._seq += 1
         seq = self._seq
         timer = WakeTimer(when, _resolve, (future,), self, _NO_CONTEXT, seq)
+        return self._push_timer(when, seq, timer)
+
+    def _push_timer(self, when: float, seq: int, timer: FifoTimerHandle) -> asyncio.TimerHandle:
+        """Put ``timer`` in our heap (asyncio's in debug mode) and mark it scheduled."""
         if self._debug:  # type: ignore[attr-defined]
             heapq.heappush(self._scheduled, timer)  # type: ignore[attr-defined]
         else:
