@@ -22,6 +22,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from safety_model import stopping_path as _path
+from safety_model import worst_gap as _worst
 
 from otonav.nav.safety import SafetyParams, safe_command, stopping_reach
 
@@ -33,39 +35,6 @@ PARAMS = (
     # no latency: the horizon has no slack beyond the stop itself
     SafetyParams(radius=0.3, max_accel=2.0, max_alpha=4.0, latency=0.0, dt=0.05, scales=5),
 )
-
-
-def _speed(start: float, target: float, tm: float, latency: float, limit: float) -> float:
-    ramp = min(tm, latency)
-    before = start + min(max(target - start, -limit * ramp), limit * ramp)
-    if tm <= latency:
-        return before
-    return math.copysign(max(abs(before) - limit * (tm - latency), 0.0), before)
-
-
-def _path(v0: float, w0: float, v_t: float, w_t: float, p: SafetyParams) -> np.ndarray:
-    """(K, 2) centre positions along the stopping path, every dt until stopped."""
-    x = y = th = 0.0
-    out = []
-    k = 0
-    while True:
-        k += 1
-        tm = k * p.dt - 0.5 * p.dt
-        v = _speed(v0, v_t, tm, p.latency, p.max_accel)
-        w = _speed(w0, w_t, tm, p.latency, p.max_alpha)
-        th += w * p.dt
-        x += v * math.cos(th - 0.5 * w * p.dt) * p.dt
-        y += v * math.sin(th - 0.5 * w * p.dt) * p.dt
-        out.append((x, y))
-        if tm > p.latency and v == 0.0 and w == 0.0:
-            return np.array(out)
-
-
-def _worst(path: np.ndarray, pts: np.ndarray, p: SafetyParams) -> float:
-    d0 = np.hypot(pts[:, 0], pts[:, 1])
-    allowed = np.minimum(p.radius, d0 - 1e-4)
-    gap = np.hypot(pts[None, :, 0] - path[:, None, 0], pts[None, :, 1] - path[:, None, 1])
-    return float((gap - allowed[None, :]).min())
 
 
 _speeds = st.floats(-0.5, 0.5)

@@ -9,41 +9,17 @@ import math
 
 import numpy as np
 import pytest
+from safety_model import stopping_path, worst_gap
 
 from otonav.nav.safety import SafetyParams, safe_command
 
 pytestmark = pytest.mark.unit
 
 
-def _speed(start: float, target: float, tm: float, latency: float, limit: float) -> float:
-    """The documented profile at mid-step time ``tm``: toward the target at the limit
-    until the latency, then down to zero at the limit."""
-    ramp = min(tm, latency)
-    before = start + min(max(target - start, -limit * ramp), limit * ramp)
-    if tm <= latency:
-        return before
-    return math.copysign(max(abs(before) - limit * (tm - latency), 0.0), before)
-
-
 def _worst(v0: float, w0: float, v_t: float, w_t: float, pts: np.ndarray, p: SafetyParams) -> float:
     """Smallest (distance - allowed) along the stopping path, integrated every dt until
     the robot has stopped (the reference does not use the module's duration)."""
-    d0 = np.hypot(pts[:, 0], pts[:, 1])
-    allowed = np.minimum(p.radius, d0 - 1e-4)
-    x = y = th = 0.0
-    worst = math.inf
-    k = 0
-    while True:
-        k += 1
-        tm = k * p.dt - 0.5 * p.dt
-        v = _speed(v0, v_t, tm, p.latency, p.max_accel)
-        w = _speed(w0, w_t, tm, p.latency, p.max_alpha)
-        th += w * p.dt
-        x += v * math.cos(th - 0.5 * w * p.dt) * p.dt
-        y += v * math.sin(th - 0.5 * w * p.dt) * p.dt
-        worst = min(worst, float((np.hypot(pts[:, 0] - x, pts[:, 1] - y) - allowed).min()))
-        if tm > p.latency and v == 0.0 and w == 0.0:
-            return worst
+    return worst_gap(stopping_path(v0, w0, v_t, w_t, p), pts, p)
 
 
 def _reference(
