@@ -265,16 +265,18 @@ class Navigation:
         many map cells were new. ``rays`` (the same scan as rays, or a function making
         them): kept, and used to clear what the scan saw through before the next
         replan."""
-        if rays is not None:
-            seen = rays() if callable(rays) else rays
-            self._rays = seen
-            ex, ey = free_ends(seen)
-            self.hull.add(np.append(ex, seen.x), np.append(ey, seen.y))
         if isinstance(points_odom, tuple):
             self._returns = points_odom
         else:
             self._returns = (points_odom[:, 0], points_odom[:, 1])
-        self.hull.add(*self._returns)
+        seen_x, seen_y = self._returns
+        if rays is not None:
+            seen = rays() if callable(rays) else rays
+            self._rays = seen
+            ex, ey = free_ends(seen)  # with the laser's position: one hull update a scan
+            seen_x = np.concatenate((ex, (seen.x,), seen_x))
+            seen_y = np.concatenate((ey, (seen.y,), seen_y))
+        self.hull.add(seen_x, seen_y)
         return self.map.mark_xy(*self._returns)
 
     @property
