@@ -4,6 +4,7 @@ topics live, byte for byte what the recording holds."""
 
 from __future__ import annotations
 
+import subprocess
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -27,9 +28,12 @@ def cli_gui_child(tmp_path: Path) -> Iterator[Callable[..., _Child]]:
 def test_gui_and_foxglove_together(cli_gui_child: Callable[..., _Child], tmp_path: Path) -> None:
     port = _free_port()
     # empty scenario: ~9 s of sim time to the goal, ~2 s of wall time at scale 5. Sim time
-    # holds at the start until the client below has subscribed (--foxglove-wait).
+    # holds at the start until the client below has subscribed (--foxglove-wait). --hold
+    # keeps the window (and its X server) up after the run: on a loaded machine the viewer
+    # may first draw the robot after the last step, and a screenshot taken as the child
+    # exits loses its display (CI, stop 34: xwd exit 1).
     child = cli_gui_child(
-        "run", "--gui", "--scenario", "empty", "--scale", "5", "--out", tmp_path,
+        "run", "--gui", "--hold", "--scenario", "empty", "--scale", "5", "--out", tmp_path,
         "--foxglove", "--foxglove-port", port, "--foxglove-wait", "30",
     )  # fmt: skip
     display, xauthority = _screen_of(child)
@@ -39,12 +43,19 @@ def test_gui_and_foxglove_together(cli_gui_child: Callable[..., _Child], tmp_pat
     client = FoxgloveClient(f"ws://127.0.0.1:{port}", expect=expect, subscribe={"/odom", "/clock"})
     client.start()
     deadline = time.monotonic() + 30.0
-    # The window is up and draws the robot while the client is served.
+    # The window is up and draws the robot while the client is served (or, at the latest,
+    # once the run is held).
     seen = (0, 0.0, 0.0)
     while seen[0] < 30 and time.monotonic() < deadline and child.proc.poll() is None:
-        seen = _robot(_screenshot(display, xauthority))
+        try:
+            seen = _robot(_screenshot(display, xauthority))
+        except subprocess.CalledProcessError as exc:
+            child.proc.wait(timeout=10)  # the X server went: the child ended
+            raise AssertionError(f"no screenshot ({exc.stderr!r}){child}") from None
     assert seen[0] >= 30, f"no robot on screen: {seen}{child}"
-    assert child.expect("EXIT", timeout=60) == ["0"], str(child)
+    child.expect("the recording is finished;", timeout=60)  # the run ended, window held
+    child.send("close")
+    assert child.expect("EXIT", timeout=15) == ["0"], str(child)
     client.stop()
     assert child.proc.wait(timeout=10) == 0, str(child)
 

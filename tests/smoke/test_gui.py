@@ -51,7 +51,8 @@ sys.exit(4)
 
 # argv: mode ("run": to the goal; "close": the window is closed as a user would), scale.
 # Prints the display, waits for "go" on stdin, then RUNNING <viewer start s> once the
-# viewer is up and the clock starts, then VERDICT <json>.
+# viewer is up and the clock starts, then VERDICT <json>. In "run" the window is then
+# held open until "close" on stdin: a screenshot never races the X server's exit.
 GUI_CHILD = """
 import json, os, sys
 from otonav.hal.mujoco import MujocoInterface
@@ -76,10 +77,17 @@ def on_start(loop, task):
     if mode == "close":  # what the window's close button does: MuJoCo's own exit
         loop.call_later(0.3, handles[0]._handle.close)
 
+def held(verdict):  # "run": the window stays up (and Xvfb with it) until "close"
+    print("VERDICT", json.dumps(verdict.as_dict()), flush=True)
+    if sys.stdin.readline().strip() == "close":
+        handles[0]._handle.close()
+
 verdict = run_scenario_realtime(
-    BUILTIN["empty"], scale=scale, gui=True, record=False, plot=False, on_start=on_start
+    BUILTIN["empty"], scale=scale, gui=True, record=False, plot=False, on_start=on_start,
+    hold=held if mode == "run" else None,
 )
-print("VERDICT", json.dumps(verdict.as_dict()), flush=True)
+if mode != "run":
+    print("VERDICT", json.dumps(verdict.as_dict()), flush=True)
 """
 
 
@@ -315,8 +323,9 @@ def test_gui_run_draws_the_world_in_a_window_and_reaches_the_goal(
     (start_s,) = child.expect("RUNNING", timeout=10)
     print(f"viewer start {float(start_s):.3f} s")
 
-    # Poll the screen until the viewer has drawn (bounded by the run: ~1.7 s wall).
-    deadline = time.monotonic() + 5.0
+    # Poll the screen until the viewer has drawn (the run takes ~1.7 s wall; the window
+    # is held open after it).
+    deadline = time.monotonic() + 10.0
     colours = 1
     while colours <= 16 and time.monotonic() < deadline and child.proc.poll() is None:
         colours = _screenshot_colours(display, xauthority)
@@ -324,6 +333,7 @@ def test_gui_run_draws_the_world_in_a_window_and_reaches_the_goal(
 
     verdict = json.loads(" ".join(child.expect("VERDICT", timeout=10)))
     assert verdict["passed"], verdict["reason"]
+    child.send("close")
     assert child.proc.wait(timeout=10) == 0, str(child)
 
 
