@@ -18,6 +18,11 @@ counter (``data.time`` accumulates float error and is not used). Readings taken 
 Construction runs 0.25 s of physics with zero command so that at tick 0 the robot rests
 settled on its wheels and caster.
 
+A world with many static geoms (``limits.STATIC_SLEEP_MIN_GEOMS``, 100) has one more
+body, ``otonav_static_anchor``: jointed, without geoms, asleep, with sleeping enabled and
+every other tree set never to sleep, so that MuJoCo places the static geoms once instead
+of at every step; the physics is the same bit for bit (ADR 0062).
+
 Viewer: :meth:`MujocoInterface.open_viewer` opens MuJoCo's passive viewer on the live
 world (after :func:`otonav.hal.viewer.check_display`, so a missing display is a
 :class:`~otonav.hal.viewer.NoDisplayError`, not MuJoCo's hard exit). The viewer only
