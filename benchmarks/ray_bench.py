@@ -11,7 +11,10 @@ from 13 poses along the course, and what the options MuJoCo offers would change:
 - boxes in static bodies, one per 1 m cell (MuJoCo tests a body's bounding sphere before
   its geoms): the scan, and what that layout does to a physics step;
 - otonav's numpy caster for static boxes and planes (ADR 0057, ``otonav.hal.raycast``,
-  what read_scan uses from 400 boxes), with MuJoCo for the beams it is not sure of.
+  what read_scan uses from ``LIDAR_CASTER_MIN_BOXES`` boxes), with MuJoCo for the beams
+  it is not sure of;
+- a physics step as it was and with the static geoms anchored (ADR 0062,
+  ``otonav.hal.mujoco.static_sleep``: MuJoCo's sleeping skips them in mj_kinematics).
 
 Each figure is a median of CPU time (this machine is shared), us per scan or per step; every
 variant's ranges and geom ids are compared with today's ("same" or "DIFFERENT").
@@ -34,7 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from otonav.bench.clutter import clutter_scenario
-from otonav.hal.mujoco import scene_path, static_geoms
+from otonav.hal.mujoco import scene_path, static_geoms, static_sleep
 from otonav.hal.raycast import StaticRayCaster
 
 BEAMS = 360
@@ -46,9 +49,10 @@ VEC = np.stack((np.cos(_ANGLES), np.sin(_ANGLES), np.zeros(BEAMS)), axis=1)
 POSES = [np.array([x, 0.0, 0.15]) for x in np.linspace(-3.0, 3.0, 13)]
 
 
-def world(boxes: int, cell: float | None) -> tuple[Any, Any]:
+def world(boxes: int, cell: float | None, *, anchor: bool = False) -> tuple[Any, Any]:
     """The empty scene with the clutter course's boxes, in the world body (as the HAL
-    builds it) or in one static body per ``cell`` square."""
+    builds it) or in one static body per ``cell`` square; ``anchor``: with the sleeping
+    anchor the HAL adds from ``MIN_STATIC_GEOMS`` static geoms (ADR 0062)."""
     with scene_path("empty") as path:
         spec = mujoco.MjSpec.from_file(str(path))
     bodies: dict[tuple[int, int], Any] = {}
@@ -67,6 +71,8 @@ def world(boxes: int, cell: float | None) -> tuple[Any, Any]:
             pos=[box.x, box.y, 0.25],
             quat=[math.cos(box.yaw / 2), 0.0, 0.0, math.sin(box.yaw / 2)],
         )
+    if anchor:
+        static_sleep.anchor_static_geoms(spec)
     model = spec.compile()
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
@@ -173,7 +179,7 @@ def main() -> None:
     print(f"one {BEAMS}-beam scan, CPU us (median), {len(POSES)} poses along the clutter course")
     print(
         f"{'boxes':>6}{'today':>8}{'set-up':>8}{'/beam':>7}{'hidden':>8}{'2 pass':>8}"
-        f"{'cells':>8}{'numpy':>8}   {'step':>6}{'step, cells':>12}"
+        f"{'cells':>8}{'numpy':>8}   {'step':>6}{'step, cells':>12}{'anchored':>10}"
     )
     for n in args.counts:
         m, d = world(n, None)
@@ -199,6 +205,8 @@ def main() -> None:
         t_cells = per_scan(mc, dc, today)
         cells_same = same(ref, [today(mc, dc, p) for p in POSES], m, mc)
         t_step_cells = step_us(mc, dc)
+        ma, da = world(n, None, anchor=True)
+        t_step_anchored = step_us(ma, da)
         numpy_scan = with_caster(numpy_caster(m, d))
         numpy_scan(m, d, POSES[0])  # its first scan has no previous one to start from
         t_numpy = per_scan(m, d, numpy_scan)
@@ -206,12 +214,14 @@ def main() -> None:
         print(
             f"{n:>6}{t_today:>8.0f}{setup:>8.0f}{per_beam:>7.1f}{t_hidden:>8.0f}"
             f"{t_two:>8.0f}{t_cells:>8.0f}{t_numpy:>8.0f}   {t_step:>6.1f}{t_step_cells:>12.1f}"
+            f"{t_step_anchored:>10.1f}"
             f"   (2 pass {two_same}, cells {cells_same}, numpy {numpy_same})"
         )
     print(
         "hidden: boxes in a group no beam is cast against (what a box costs a beam that "
         "cannot hit it); cells: the boxes in one static body per 1 m square; numpy: "
-        "otonav's caster for static boxes and planes (ADR 0057)"
+        "otonav's caster for static boxes and planes (ADR 0057); anchored: a step with the "
+        "static geoms anchored (ADR 0062; from MIN_STATIC_GEOMS static geoms)"
     )
 
 

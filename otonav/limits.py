@@ -179,6 +179,11 @@ LIDAR_CASTER_MIN_BOXES = 400
 """From this many static boxes the lidar casts them with otonav's numpy caster
 (``otonav/hal/raycast.py``, ADR 0057: the same returns as mj_multiRay), whose cost per
 scan is mostly fixed; below it, one mj_multiRay call is cheaper."""
+STATIC_SLEEP_MIN_GEOMS = 100
+"""From this many static geoms (world body and bodies welded to it) the world anchors
+them with MuJoCo's sleeping so that ``mj_kinematics`` places them once, not at every step
+(``otonav/hal/mujoco/static_sleep.py``, ADR 0062: the same physics bit for bit). Below
+it the sleep bookkeeping (~0.6 us a step) costs more than it saves (~9 ns a geom)."""
 _US_CASTER_PER_BEAM = 3.0
 """Wall µs per beam of a scan by the numpy caster, whatever the box count (measured
 0.55-1.1 ms per 360-beam scan on the shared 2-core machine, ADR 0057)."""

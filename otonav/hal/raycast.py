@@ -228,13 +228,18 @@ class _Slabs:
     plane (``_CLEAR``) or grazes one (then only MuJoCo's arithmetic can say)."""
 
     def __init__(self, lp: F64, size: F64, ax: F64, ay: F64, cos: F64, sin: F64) -> None:
-        self.lp, self.size, self.ax, self.ay, self.cos, self.sin = lp, size, ax, ay, cos, sin
+        # one row per box (lidar, half sizes, the lidar's x and y axes, in the box's
+        # frame): one gather per batch of pairs instead of four
+        self.rows = np.concatenate([lp, size, ax, ay], axis=1)
+        self.cos, self.sin = cos[:, None], sin[:, None]
 
     def pairs(
         self, boxes: I64, lo: I64, count: I64, nb: int, bound: F64, lower: F64 | None = None
-    ) -> tuple[I64, I64, F64, NDArray[np.bool_], NDArray[np.bool_], I64, F64, NDArray[np.bool_]]:
+    ) -> tuple[I64, I64, F64, NDArray[np.bool_], NDArray[np.bool_]]:
         """Test every beam each of ``boxes`` may meet (``lower``: only where the beam's
-        ``bound`` does not stop it first); the clear hits lower ``bound``."""
+        ``bound`` does not stop it first); the clear hits lower ``bound``. Returns per
+        pair: box, beam, first hit, clear, grazing. Call under ``np.errstate`` ignoring
+        division, invalid and overflow (beams parallel to a face)."""
         c = count[boxes]
         total = int(c.sum())
         box = np.repeat(boxes, c)
@@ -243,19 +248,14 @@ class _Slabs:
         if lower is not None:
             ahead = lower[box] <= bound[beam]
             box, beam = box[ahead], beam[ahead]
-        p = self.lp[box]
-        s = self.size[box]
-        lv = self.cos[beam, None] * self.ax[box] + self.sin[beam, None] * self.ay[box]
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            inv = 1.0 / lv
-            t1 = (-s - p) * inv
-            t2 = (s - p) * inv
+        p, s, lv, t1, t2 = self._slabs(box, beam)
         lo_t = np.fmin(t1, t2)
         hi_t = np.fmax(t1, t2)
         t_in = np.maximum(np.maximum(lo_t[:, 0], lo_t[:, 1]), lo_t[:, 2])
         t_out = np.minimum(np.minimum(hi_t[:, 0], hi_t[:, 1]), hi_t[:, 2])
         # along a face's plane (or nearly): the slab test cannot say; MuJoCo's can
-        edge = ((np.abs(lv) <= _SLACK) & (np.abs(np.abs(p) - s) <= _CLEAR)).any(axis=1)
+        along = (np.abs(lv) <= _SLACK) & (np.abs(np.abs(p) - s) <= _CLEAR)
+        edge = along[:, 0] | along[:, 1] | along[:, 2]
         edge |= np.isnan(t_in) | np.isnan(t_out)
         chord = t_out - np.maximum(t_in, 0.0)
         clear = (chord > _CLEAR) & (np.abs(t_in) > _CLEAR) & ~edge
@@ -264,25 +264,38 @@ class _Slabs:
         if clear.any():
             reach = first_hit[clear]
             np.minimum.at(bound, beam[clear], reach + _SLACK * (1.0 + reach))
-        # a clear entry from outside, away from every edge of its face: MuJoCo's ray_box
-        # returns that face's distance (the only other face it meets is the exit)
+        return box, beam, first_hit, clear, graze
+
+    def _slabs(self, box: I64, beam: I64) -> tuple[F64, F64, F64, F64, F64]:
+        """Per pair: the lidar and the beam in the box's frame, and where the beam
+        crosses each face's plane (the same floats for a pair, whatever the batch)."""
+        rows = self.rows[box]
+        p, s = rows[:, 0:3], rows[:, 3:6]
+        lv = self.cos[beam] * rows[:, 6:9] + self.sin[beam] * rows[:, 9:12]
+        return p, s, lv, (-s - p) / lv, (s - p) / lv
+
+    def faces(
+        self, box: I64, beam: I64, clear: NDArray[np.bool_]
+    ) -> tuple[I64, F64, NDArray[np.bool_]]:
+        """For the pairs that go on to MuJoCo's arithmetic: the face a clear entry from
+        outside meets away from its edges (-1: none; then MuJoCo's ray_box returns that
+        face's distance, the only other face it meets being the exit), its side, and
+        whether the entry is deep inside the face (see ``pairs`` for ``np.errstate``)."""
+        p, s, lv, t1, t2 = self._slabs(box, beam)
+        lo_t = np.fmin(t1, t2)
+        t_in = np.maximum(np.maximum(lo_t[:, 0], lo_t[:, 1]), lo_t[:, 2])
         axis = np.argmax(np.where(np.isnan(lo_t), -np.inf, lo_t), axis=1)
         rows = np.arange(len(box))
-        with np.errstate(invalid="ignore"):
-            excess = np.abs(p + t_in[:, None] * lv) - s
+        excess = np.abs(p + t_in[:, None] * lv) - s
         excess[rows, axis] = -np.inf
-        inner = np.maximum(np.maximum(excess[:, 0], excess[:, 1]), excess[:, 2]) < -_SLACK
-        face = np.where(clear & (t_in > 0) & inner, axis, -1)
+        inner = np.maximum(np.maximum(excess[:, 0], excess[:, 1]), excess[:, 2])
+        face = np.where(clear & (t_in > 0) & (inner < -_SLACK), axis, -1)
         facing = lv[rows, axis]
         side = np.where(facing > 0, -1.0, 1.0)
         # entering 1e-6 m inside its face, not edge-on: MuJoCo's bounding angles, which
         # hold the box, hold this beam by far more than atan2's rounding (ADR 0057)
-        deep = (
-            (face >= 0)
-            & (np.abs(facing) >= _FACING)
-            & (np.maximum(np.maximum(excess[:, 0], excess[:, 1]), excess[:, 2]) < -_CLEAR)
-        )
-        return box, beam, first_hit, clear, graze, face, side, deep
+        deep = (face >= 0) & (np.abs(facing) >= _FACING) & (inner < -_CLEAR)
+        return face, side, deep
 
 
 class StaticRayCaster:
@@ -314,6 +327,7 @@ class StaticRayCaster:
         self._box_rows = np.ascontiguousarray(
             geometry.box_mat.reshape(-1, 3, 3).transpose(0, 2, 1).reshape(-1, 3)
         )
+        self._axes = self._box_rows.reshape(-1, 3, 3)  # [n, i, j]: box axis i, world j
         ids = np.concatenate([geometry.box_ids, geometry.plane_ids]).astype(np.int64)
         self._row_of = np.zeros(int(ids.max()) + 1 if len(ids) else 1, dtype=np.int64)
         self._row_of[ids] = np.arange(len(ids))
@@ -441,79 +455,77 @@ class StaticRayCaster:
         across = size[:, 0] * np.abs(az[:, 0]) + size[:, 1] * np.abs(az[:, 1])
         across += size[:, 2] * np.abs(az[:, 2])
         # MuJoCo's cutoff (the same floats) and the plane
-        sel = np.flatnonzero(~(d3 > self._reach) & (np.abs(local[:, 2]) <= across + _SLACK))
-        if len(sel) == 0:
-            return bound
-        local, size, frames, az = local[sel], size[sel], frames[sel], az[sel]
+        # (the boxes dropped go on with the others to the pairs, which leave them out:
+        # cheaper than copying the arrays of those kept)
+        keep = ~(d3 > self._reach) & (np.abs(local[:, 2]) <= across + _SLACK)
+        m = self._axes  # [n, i, j]: box axis i, world j
         # the disc holding the box's outline projected on the scan plane: the largest
-        # of |g0 +- g1 +- g2|, g_i = size_i * (box axis i in the lidar's x, y)
+        # of |g0 +- g1 +- g2|, g_i = size_i * (box axis i in the lidar's x, y); numpy's
+        # reductions over a short last axis cost ~10x its columns (so columns, below)
         gx = size * frames[:, :, 0]
         gy = size * frames[:, :, 1]
         cx = gx @ _SIGNS
         cy = gy @ _SIGNS
-        radius = np.sqrt((cx * cx + cy * cy).max(axis=1)) * (1.0 + _SLACK) + _SLACK
+        r2 = cx * cx + cy * cy
+        r2max = np.maximum(np.maximum(r2[:, 0], r2[:, 1]), np.maximum(r2[:, 2], r2[:, 3]))
+        radius = np.sqrt(r2max) * (1.0 + _SLACK) + _SLACK
         plane_d = np.sqrt(local[:, 0] * local[:, 0] + local[:, 1] * local[:, 1])
         full = plane_d <= radius
         half = np.arcsin(np.where(full, 1.0, radius / np.where(full, 1.0, plane_d)))
         centre = np.arctan2(local[:, 1], local[:, 0])
         lo = np.ceil((centre - half - _SLACK - self._angle_min) / self._inc).astype(np.int64)
         hi = np.floor((centre + half + _SLACK - self._angle_min) / self._inc).astype(np.int64)
-        count = np.where(full, nb, np.clip(hi - lo + 1, 0, nb))
+        count = np.where(full, nb, np.minimum(np.maximum(hi - lo + 1, 0), nb))
         lo = np.where(full, 0, lo % nb)
         # the lidar in each box's frame, and its distance to the box: no hit is nearer
-        m = self._box_rows.reshape(-1, 3, 3)[sel]  # [n, i, j]: box axis i, world j
-        lp = -(m * dif[sel][:, None, :]).sum(axis=2)
+        lp = np.empty_like(size)
+        for i in range(3):
+            lp[:, i] = -(m[:, i, 0] * dif[:, 0] + m[:, i, 1] * dif[:, 1] + m[:, i, 2] * dif[:, 2])
         out = np.maximum(np.abs(lp) - size, 0.0)
-        lower = np.sqrt((out * out).sum(axis=1)) - _SLACK
-        slab = _Slabs(
-            lp,
-            size,
-            np.ascontiguousarray(frames[:, :, 0]),
-            np.ascontiguousarray(frames[:, :, 1]),
-            self._cos,
-            self._sin,
-        )
-        # first the boxes that stopped a beam last scan and the nearest ones (an
-        # order only: whatever they hit now bounds the beams for all the others)
+        out *= out
+        lower = np.sqrt(out[:, 0] + out[:, 1] + out[:, 2]) - _SLACK
+        slab = _Slabs(lp, size, frames[:, :, 0], frames[:, :, 1], self._cos, self._sin)
         # first the boxes that stopped a beam last scan and the nearest ones, not the
         # wide ones (an order only: their clear hits bound the beams for the others)
-        n = len(sel)
+        n = len(g.box_ids)
         first = np.zeros(n, dtype=np.bool_)
         if n > _NEAR_FIRST:
             first[np.argpartition(lower, _NEAR_FIRST)[:_NEAR_FIRST]] = True
         else:
             first[:] = True
-        if len(self._last_boxes):
-            where = np.full(len(g.box_ids), -1, dtype=np.int64)
-            where[sel] = np.arange(n)
-            seen = where[self._last_boxes]
-            first[seen[seen >= 0]] = True
+        first[self._last_boxes] = True
         first &= count <= _WIDE
-        near = np.flatnonzero(first)
-        far = np.flatnonzero(~first)
-        parts = [slab.pairs(near, lo, count, nb, bound)]
-        if len(far):
-            # a box is skipped when every beam it could meet is stopped before it
-            doubled = np.concatenate([bound, bound, bound[:1]])
-            ends = np.empty(2 * len(far), dtype=np.int64)
-            ends[0::2] = lo[far]
-            ends[1::2] = lo[far] + count[far]
-            reach = np.maximum.reduceat(doubled, ends)[0::2]
-            far = far[lower[far] <= reach]
+        near = np.flatnonzero(first & keep)
+        far = np.flatnonzero(~first & keep)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            parts = [slab.pairs(near, lo, count, nb, bound)] if len(near) else []
             if len(far):
-                parts.append(slab.pairs(far, lo, count, nb, bound, lower))
-        box, beam, first_hit, clear, graze, face, side, deep = (
-            np.concatenate([q[k] for q in parts]) for k in range(8)
-        )
-        limit = bound[beam]
-        go = (clear & (first_hit - _SLACK <= limit)) | (graze & (lower[box] <= limit))
-        box, beam, face, side, deep = box[go], beam[go], face[go], side[go], deep[go]
-        if body_ok is not None:
-            ok = body_ok[g.box_body[sel[box]], beam]
-            box, beam, face, side, deep = box[ok], beam[ok], face[ok], side[ok], deep[ok]
-        if len(box) == 0:
-            return bound
-        gid = sel[box]
+                # a box is skipped when every beam it could meet is stopped before it
+                doubled = np.concatenate([bound, bound, bound[:1]])
+                ends = np.empty(2 * len(far), dtype=np.int64)
+                ends[0::2] = lo[far]
+                ends[1::2] = lo[far] + count[far]
+                reach = np.maximum.reduceat(doubled, ends)[0::2]
+                far = far[lower[far] <= reach]
+                if len(far):
+                    parts.append(slab.pairs(far, lo, count, nb, bound, lower))
+            if not parts:
+                return bound
+            if len(parts) == 1:
+                box, beam, first_hit, clear, graze = parts[0]
+            else:
+                box, beam, first_hit, clear, graze = (
+                    np.concatenate([q[k] for q in parts]) for k in range(5)
+                )
+            limit = bound[beam]
+            go = (clear & (first_hit - _SLACK <= limit)) | (graze & (lower[box] <= limit))
+            if body_ok is not None:
+                go &= body_ok[g.box_body[box], beam]
+            box, beam, clear = box[go], beam[go], clear[go]
+            if len(box) == 0:
+                return bound
+            face, side, deep = slab.faces(box, beam, clear)
+        gid = box
         t = np.empty(len(box))
         lite = face >= 0
         if lite.any():
@@ -536,7 +548,9 @@ class StaticRayCaster:
                 vec[beam[rest]],
             )
         found.append((beam, t, g.box_ids[gid].astype(np.int64), deep))
-        self._last_boxes = np.unique(gid[t >= 0])
+        hit = np.zeros(len(g.box_ids), dtype=np.bool_)
+        hit[gid[t >= 0]] = True
+        self._last_boxes = np.flatnonzero(hit)  # sorted, each once
         return bound
 
     def _winners_unsure(

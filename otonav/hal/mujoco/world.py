@@ -18,6 +18,11 @@ counter (``data.time`` accumulates float error and is not used). Readings taken 
 Construction runs 0.25 s of physics with zero command so that at tick 0 the robot rests
 settled on its wheels and caster.
 
+A world with many static geoms (``limits.STATIC_SLEEP_MIN_GEOMS``, 100) has one more
+body, ``otonav_static_anchor``: jointed, without geoms, asleep, with sleeping enabled and
+every other tree set never to sleep, so that MuJoCo places the static geoms once instead
+of at every step; the physics is the same bit for bit (ADR 0062).
+
 Viewer: :meth:`MujocoInterface.open_viewer` opens MuJoCo's passive viewer on the live
 world (after :func:`otonav.hal.viewer.check_display`, so a missing display is a
 :class:`~otonav.hal.viewer.NoDisplayError`, not MuJoCo's hard exit). The viewer only
@@ -42,6 +47,7 @@ from otonav.hal.mujoco.derive import _actuator_of, _Derivation, _probe, _site_se
 from otonav.hal.mujoco.prepare import ROBOT_PREFIX, _load_robot, _merge_options, _RobotSpec
 from otonav.hal.mujoco.scene import SceneError, _add_box, _compile, _load_spec
 from otonav.hal.mujoco.static_geoms import ray_caster
+from otonav.hal.mujoco.static_sleep import anchor_static_geoms, anchored
 from otonav.hal.types import (
     BoxObstacle,
     GroundTruth,
@@ -131,9 +137,13 @@ class MujocoInterface(RobotHardwareInterface):
                 parts.base.pos[2] -= probe.bottom  # rest on the floor, not in or above it
             _merge_options(spec, robot_spec)
             spec.worldbody.add_frame().attach_body(parts.base, prefix, "")
+        # Static geoms placed once, not at every step (ADR 0062): the same physics.
+        anchor = anchor_static_geoms(spec)
         self._model: Any = _compile(spec, label if not prefix else f"{label} with {robot_file}")
         self._data: Any = mujoco.MjData(self._model)
         m = self._model
+        if anchor and not anchored(m, self._data):
+            raise RuntimeError(f"{label}: the static-geom anchor did not fall asleep (ADR 0062)")
         obj = mujoco.mjtObj
 
         def ident(kind: Any, name: str) -> int:
