@@ -12,6 +12,8 @@ of ``--reps``. Inside each run, CPU time (``time.thread_time``) is charged to:
 - in (b) and (c), **each actor's own code**: every step of its task (its ``run``
   coroutine, and the bridge's command task) less the shared work inside it; what a
   publisher's delivery costs (mailboxes, the recorder's funnel) is its publisher's;
+- the recorder's **funnel offers** (in its publishers' steps) and its **chunk zstd** (in
+  its drains), each taken out of the step it runs in (ADR 0064);
 - **the loop**: the rest (the virtual-time loop's passes, timers and wake-ups, task
   switches, the bare loop's own glue in (a)).
 
@@ -155,6 +157,16 @@ def _instrument() -> None:
     _timed_method(SafetyLayer, "run", "actor: safety layer")
     _timed_method(BaseController, "run", "actor: base controller")
     _timed_method(Recorder, "run", "actor: recorder (drains)")
+    # The recorder's own work outside its drains' Python, charged apart (ADR 0064): the
+    # funnel's offers (inside the publishers' steps) and the chunks' zstd (inside the
+    # drains); each is taken out of the stage it runs in.
+    import zstandard
+
+    from otonav.runtime.funnel import _Tap
+
+    for method in ("_offer", "_offer_all"):
+        setattr(_Tap, method, _shared("recorder: funnel offers", getattr(_Tap, method)))
+    zstandard.compress = _shared("recorder: chunk zstd", zstandard.compress)
 
 
 def _one(kind: str, duration: float) -> dict[str, float]:
