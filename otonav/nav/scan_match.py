@@ -19,8 +19,10 @@ base_link. Two stages, both deterministic:
    ``yaw_scale`` m per rad). Points farther than ``max_distance`` from any stored
    return (new ground, outliers) are left out. The prior keeps a direction the scan
    does not constrain at the prediction instead of letting it wander (a corridor, a
-   single wall). Each step is accepted only if it lowers the cost
-   (Levenberg-Marquardt damping otherwise).
+   single wall). Each step is accepted if it does not raise the cost (an equal cost
+   counts: at the minimum the step is zero, it is taken, counted in
+   ``MatchResult.iterations``, and ends the refinement as converged); a step that
+   raises it is retried with Levenberg-Marquardt damping.
 
 A match is trusted (``ok``) when at least ``min_inliers`` of the points lie within
 ``max_distance`` of the map; otherwise the caller keeps its prediction.
