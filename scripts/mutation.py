@@ -67,6 +67,7 @@ TARGETS: dict[str, tuple[str, ...]] = {
     "otonav.nav.dwa": (
         "tests/unit/test_nav_planning.py",
         "tests/unit/test_dwa_reference.py",
+        "tests/unit/test_dwa_documented.py",
     ),
     "otonav.nav.global_path": (
         "tests/unit/test_nav_planning.py",
@@ -74,7 +75,11 @@ TARGETS: dict[str, tuple[str, ...]] = {
         "tests/unit/test_nav_search.py",
         "tests/unit/test_astar_contract.py",
     ),
-    "otonav.nav.plan_grid": ("tests/unit/test_nav_indoor.py", "tests/unit/test_nav_search.py"),
+    "otonav.nav.plan_grid": (
+        "tests/unit/test_nav_indoor.py",
+        "tests/unit/test_nav_search.py",
+        "tests/unit/test_plan_grid_contract.py",
+    ),
     "otonav.nav.recovery": (
         "tests/unit/test_nav_planning.py",
         "tests/unit/test_nav_indoor.py",
@@ -83,6 +88,7 @@ TARGETS: dict[str, tuple[str, ...]] = {
     "otonav.nav.scan_match": (
         "tests/unit/test_scan_match.py",
         "tests/unit/test_scan_match_reference.py",
+        "tests/unit/test_scan_match_documented.py",
         "tests/unit/test_localizer.py",
     ),
     "otonav.nav.scan_map": (

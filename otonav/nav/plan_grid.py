@@ -45,7 +45,9 @@ def free_threshold(radius: float, resolution: float) -> float:
 
 def pooled(fine: NDArray[np.float32], stride: int) -> NDArray[np.float32]:
     """The largest value in every ``stride`` x ``stride`` block of ``fine`` (a square
-    grid; a ragged edge is dropped)."""
+    grid; a ragged edge is dropped). At ``stride`` 1 that is ``fine`` itself, returned
+    as is, not copied (the replan's set-up at the map's own resolution): read it only,
+    a write would go into the map."""
     if stride == 1:
         return fine
     n = fine.shape[0] // stride
@@ -66,7 +68,8 @@ def best_points(
     cols: NDArray[np.intp],
 ) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """For coarse cells ``(rows, cols)``, the fine (row, col) of the largest value in
-    each block (the first one on ties, row-major)."""
+    each block (the first one on ties, row-major). At ``stride`` 1 every block is its
+    one cell: ``rows`` and ``cols`` themselves are returned, not copies."""
     if stride == 1:
         return rows, cols
     n = fine.shape[0] // stride

@@ -79,7 +79,9 @@ class ProgressChecker:
 def boundary_side(points: NDArray[np.float64], goal_bearing: float) -> int:
     """+1 to keep the obstacle on the left, -1 on the right: the side whose tangent at
     the nearest return (``points`` in base_link) points closer to ``goal_bearing``
-    (rad, base_link). With no returns: the side the goal is not on."""
+    (rad, base_link). When both tangents are equally good (the nearest return dead
+    ahead and the goal straight through it): +1, the obstacle on the left. With no
+    returns: the side the goal is not on."""
     if points.shape[0] == 0:
         return -1 if goal_bearing >= 0.0 else 1
     i = int(np.argmin(np.hypot(points[:, 0], points[:, 1])))

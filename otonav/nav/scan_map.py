@@ -212,8 +212,13 @@ class ScanMap:
     # -- reading -----------------------------------------------------------------------
 
     def nearest(self, x: Array, y: Array) -> Array:
-        """The distance field at the cell each point falls in (no interpolation), m;
-        ``max_distance`` outside the map. The correlative search's lookup."""
+        """The distance field at the cell each point falls in (no interpolation), m:
+        the distance from that cell's centre to the nearest stored return, capped at
+        ``max_distance``. Beyond the map's edge too: the field runs on for
+        ``ceil(max_distance / resolution)`` cells past it, so a return on the edge is
+        as near from a cell outside as from one inside; farther out every point
+        reads ``max_distance``, what the capped distance is there anyway (no return
+        is stored outside the map). The correlative search's lookup."""
         inv, pad, hi = 1.0 / self.resolution, self._pad, self._width - 1
         col = np.clip(np.floor((x - self.origin_x) * inv) + pad, 0, hi).astype(np.intp)
         row = np.clip(np.floor((y - self.origin_y) * inv) + pad, 0, hi).astype(np.intp)

@@ -5,22 +5,27 @@ base_link. Two stages, both deterministic:
 
 1. **Correlative search** (Olson 2009, "Real-time correlative scan matching"): every
    pose of a window around the prediction (``linear_window`` m in x and y at
-   ``linear_step``, ``angular_window`` rad at ``angular_step``) is scored by the mean
-   squared distance (:meth:`ScanMap.nearest`, capped) of the scan's points to the map,
-   plus a small pull toward the prediction (``prior``): where the map cannot tell
+   ``linear_step``, ``angular_window`` rad at ``angular_step``) is scored by the sum of
+   the squared distances (:meth:`ScanMap.nearest`, capped) of the scan's points to the
+   map, plus a small pull toward the prediction (``prior``): where the map cannot tell
    poses apart (a corridor's length) the prediction wins, and an exact tie goes to the
    candidate nearest it.
 2. **Gauss-Newton** (Hector SLAM's refinement, on point-to-line residuals as in
    point-to-plane ICP), from the prediction and, when the search found another best
-   candidate, from that one too; the lower final cost wins. Each scan point is paired
-   with the stored return nearest its cell (:meth:`ScanMap.correspond`, looked up again
-   at every step) and its residual is the distance along that return's normal;
-   minimise ``sum(r_i^2) + prior * |pose - prediction|^2`` (yaw weighted by
-   ``yaw_scale`` m per rad). Points farther than ``max_distance`` from any stored
-   return (new ground, outliers) are left out. The prior keeps a direction the scan
-   does not constrain at the prediction instead of letting it wander (a corridor, a
-   single wall). Each step is accepted only if it lowers the cost
-   (Levenberg-Marquardt damping otherwise).
+   candidate, from that one too; the lower final cost wins (the prediction's on an exact
+   tie, as in the search). Each scan point is paired with the stored return nearest its
+   cell (:meth:`ScanMap.correspond`, looked up again at every step) and its residual is
+   the distance along that return's normal; minimise
+   ``sum(r_i^2) + prior * |pose - prediction|^2`` (yaw weighted by ``yaw_scale`` m per
+   rad). Points farther than
+   ``max_distance`` from any stored return (new ground, outliers) are left out. The
+   prior keeps a direction the scan does not constrain at the prediction instead of
+   letting it wander (a corridor, a single wall). Each step is accepted if it does not
+   raise the cost (an equal cost counts: at the minimum the step is zero, it is taken,
+   counted in ``MatchResult.iterations``, and ends the refinement as converged); a step
+   that raises it is retried with Levenberg-Marquardt damping (1e-3, tenfold up to 1;
+   when none is accepted the refinement stops). It also stops after a step that moves x,
+   y and yaw each by less than 1e-4 (m, rad), and after ``iterations`` steps.
 
 A match is trusted (``ok``) when at least ``min_inliers`` of the points lie within
 ``max_distance`` of the map; otherwise the caller keeps its prediction.

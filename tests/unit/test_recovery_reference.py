@@ -168,3 +168,15 @@ def test_with_nothing_seen_the_side_is_the_one_the_goal_is_not_on() -> None:
     assert boundary_side(empty, 0.5) == -1
     assert boundary_side(empty, -0.5) == 1
     assert boundary_side(empty, 0.0) == -1
+
+
+@pytest.mark.parametrize("distance", [0.3, 1.0, 2.5])
+def test_on_an_exact_tie_the_side_is_the_obstacle_on_the_left(distance: float) -> None:
+    """boundary_side's docstring: both tangents equally good (the nearest return dead
+    ahead, the goal straight through it, each tangent a quarter turn off the goal)
+    gives +1, the obstacle on the left; a hair either way picks the nearer tangent
+    (the goal a little left: the tangent heading left, the obstacle on the right)."""
+    ahead = np.array([[distance, 0.0], [distance + 1.0, 0.5]])
+    assert boundary_side(ahead, 0.0) == 1
+    assert boundary_side(ahead, 1e-9) == -1
+    assert boundary_side(ahead, -1e-9) == 1

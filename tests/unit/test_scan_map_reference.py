@@ -265,3 +265,39 @@ def test_beams_mark_exactly_the_cells_their_samples_fall_in_up_to_the_map_edges(
     g = fresh()
     g.insert(0.1, 0.0625, np.array([0.175]), np.array([0.0625]))
     assert _known(g) == {(8, 9)}
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_beyond_the_edge_the_field_is_the_capped_distance_from_the_cell_centre(
+    seed: int,
+) -> None:
+    """``nearest``'s docstring: outside the map too, the distance from the centre of the
+    cell a point falls in to the nearest stored return, capped: a return on the edge is
+    as near from just outside (within ``max_distance``) as from inside; farther out, the
+    cap. Returns in the edge cells, points at cell centres up to 6 cells beyond."""
+    rng = np.random.default_rng(700 + seed)
+    res, cap = 0.1, float(rng.choice([0.25, 0.3]))
+    grid = ScanMap(0.0, 0.0, half_size=1.0, resolution=res, max_distance=cap)
+    n = grid.size
+    edge = [(i, j) for i in range(n) for j in range(n) if min(i, j, n - 1 - i, n - 1 - j) == 0]
+    picked = rng.choice(len(edge), 12, replace=False)
+    cells = [edge[k] for k in picked.tolist()]
+    off = rng.uniform(0.01, 0.99, (len(cells), 2))
+    rx = np.array(
+        [grid.origin_x + (c + u) * res for (_, c), (u, _) in zip(cells, off, strict=True)]
+    )
+    ry = np.array(
+        [grid.origin_y + (r + v) * res for (r, _), (_, v) in zip(cells, off, strict=True)]
+    )
+    assert grid.insert(0.0, 0.0, rx, ry) == len(cells)
+    k = np.arange(-6, n + 6)
+    cx = grid.origin_x + (k + 0.5) * res
+    qx, qy = (a.ravel() for a in np.meshgrid(cx, cx))
+    got = grid.nearest(qx, qy)
+    want = [
+        min(cap, min(math.hypot(x - px, y - py) for px, py in zip(rx, ry, strict=True)))
+        for x, y in zip(qx.tolist(), qy.tolist(), strict=True)
+    ]
+    assert got.tolist() == pytest.approx(want, abs=1e-12)
+    outside = (np.abs(qx) > 1.0) | (np.abs(qy) > 1.0)
+    assert (got[outside] < cap).sum() > 10  # the field does run on past the edge

@@ -4,9 +4,9 @@ loops (issue 24, test rigor), on random rooms, scans and predictions:
 * the correlative search is the brute-force minimum over its window (``0, +-step, ...``
   up to the window in x, y and yaw, the prediction's neighbours first on a tie) of the
   capped squared distances plus the prior;
-* refinement never ends at a higher cost than it starts (each step is accepted only if
-  it lowers the cost), the cost being the point-to-line residuals of the matched points,
-  ``max_distance^2`` per unmatched point, and the prior;
+* refinement never ends at a higher cost than it starts (a step is accepted only if it
+  does not raise the cost), the cost being the point-to-line residuals of the matched
+  points, ``max_distance^2`` per unmatched point, and the prior;
 * ``match_scan`` reports the inlier share and the rms of the pose it returns, trusts it
   exactly when the share reaches ``min_inliers``, and keeps the prediction otherwise."""
 
