@@ -15,7 +15,7 @@ def main() -> int:
         print("otonav: interrupted", file=sys.stderr)
         return INTERRUPTED
     try:
-        return cli_main()
+        return cli_main(owns_process=True)
     except KeyboardInterrupt:  # outside the CLI's own handling (argument parsing, ...)
         print("otonav: interrupted", file=sys.stderr)
         return INTERRUPTED

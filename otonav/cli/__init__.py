@@ -86,13 +86,20 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def main(argv: Sequence[str] | None = None) -> int:
+def main(argv: Sequence[str] | None = None, *, owns_process: bool = False) -> int:
+    """Run the command line ``argv`` (``sys.argv[1:]`` if None); the exit code.
+
+    ``owns_process``: the CLI is this process (the ``otonav`` script, ``python -m
+    otonav``), so ``otonav run`` may freeze what start-up made out of the cyclic
+    collector's sight (ADR 0063). A host calling ``main`` leaves it False: freezing is
+    the host's process-wide choice."""
     args_list = list(sys.argv[1:] if argv is None else argv)
     if not args_list or (
         args_list[0].startswith("-") and args_list[0] not in ("-h", "--help", "--version")
     ):
         args_list = ["run", *args_list]  # no command = run the default scenario
     args = build_parser().parse_args(args_list)
+    args.owns_process = owns_process
     from otonav.cli import logs
 
     logs.install()

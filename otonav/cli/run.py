@@ -266,12 +266,14 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
         console.print("the recording is finished; close the viewer window to exit")
         held.append(verdict)
 
-    # Start-up is done (modules imported, configs read, the live view bound): what exists
-    # now lives as long as the process. Out of the cyclic collector's sight it cannot
-    # cause a full collection inside the run: 40-80 ms at a process's first run, more
-    # than one navigation period of a real-time run (ADR 0063).
-    gc.collect()
-    gc.freeze()
+    if args.owns_process:
+        # Start-up is done (modules imported, configs read, the live view bound): what
+        # exists now lives as long as the process. Out of the cyclic collector's sight it
+        # cannot cause a full collection inside the run: 40-80 ms at a process's first
+        # run, more than one navigation period of a real-time run (ADR 0063). Not when a
+        # host calls main(): objects it holds now would never be collected later.
+        gc.collect()
+        gc.freeze()
     guard.arm()  # from here a signal stops the run and lets it finish its artifacts
     try:
         paced = args.gui or args.realtime or bridge is not None
