@@ -9,6 +9,7 @@ import sys
 
 import numpy as np
 import pytest
+from dwa_model import dwa_reference
 
 from otonav.hal import RobotGeometry
 from otonav.hal.mujoco import MujocoInterface
@@ -397,68 +398,6 @@ def test_fast_path_is_the_vectorised_rollout_it_replaced() -> None:
     assert refused > 30
 
 
-def _dwa_reference(
-    pose: tuple[float, float, float],
-    v0: float,
-    w0: float,
-    target: tuple[float, float],
-    distance: float,
-    m: ClearanceMap,
-    p: DwaParams,
-) -> tuple[float, float, int, float]:
-    """dwa_step as its docstring says it, one sample at a time: (v, omega, admissible
-    count, best score)."""
-    x0, y0, th0 = pose
-    cap = min(p.max_v, math.sqrt(p.max_accel * distance))
-    v_lo = min(max(v0 - p.max_accel * p.period, 0.0), cap)
-    v_hi = min(max(v0 + p.max_accel * p.period, 0.0), cap)
-    w_lo = max(w0 - p.max_alpha * p.period, -p.max_omega)
-    w_hi = min(w0 + p.max_alpha * p.period, p.max_omega)
-    off = abs(math.remainder(math.atan2(target[1] - y0, target[0] - x0) - th0, math.tau))
-    top = v_lo if off > p.rotate_threshold else v_hi
-    vs = np.linspace(v_lo, top, p.v_samples) if top > v_lo else [0.5 * (v_lo + top)]
-    ws = np.linspace(w_lo, w_hi, p.omega_samples)
-    samples = [(float(v), float(w)) for v in vs for w in ws]
-    samples.append((v_lo, min(max(0.0, w_lo), w_hi)))
-    steps = round(p.horizon / p.dt)
-    t = p.dt * np.arange(steps + 1)
-    here = float(m.clearance(np.array([x0]), np.array([y0]))[0])
-    best: tuple[float, float, float] | None = None
-    count = 0
-    for v, w in samples:
-        we = w if abs(w) >= 1e-6 else math.copysign(1e-6, w)
-        th = th0 + we * t
-        xs = x0 + v / we * (np.sin(th) - math.sin(th0))
-        ys = y0 - v / we * (np.cos(th) - math.cos(th0))
-        clear = m.clearance(xs, ys)
-        under = np.flatnonzero(clear[1:] < min(p.radius, here - 1e-3))
-        last = int(under[0]) if under.size else steps
-        free = v * t[last] if under.size else math.inf
-        if v * p.latency + v * v / (2.0 * p.max_accel) > free:
-            continue
-        count += 1
-        d = np.hypot(target[0] - xs[: last + 1], target[1] - ys[: last + 1])
-        i = int(np.argmin(d - 1e-9 * np.arange(last + 1)))
-        h = i if i > 0 else last  # never nearer: the heading where it gets to
-        bearing = abs(
-            math.remainder(math.atan2(target[1] - ys[h], target[0] - xs[h]) - th[h], math.tau)
-        )
-        bearing = 0.0 if d[i] < 0.05 else bearing
-        gain = (math.hypot(target[0] - x0, target[1] - y0) - d[i]) / (p.max_v * p.horizon)
-        room = min(max(float(clear.min()) - p.radius, 0.0), p.clearance_cap) / p.clearance_cap
-        score = (
-            p.w_heading * (1 - bearing / math.pi)
-            + p.w_progress * gain
-            + p.w_clearance * room
-            + p.w_speed * v / p.max_v
-        )
-        if best is None or score > best[2]:
-            best = (v, w, score)
-    if best is None:
-        return v_lo, min(max(0.0, w_lo), w_hi), 0, -math.inf
-    return best[0], best[1], count, best[2]
-
-
 def test_dwa_step_is_the_sampling_its_docstring_describes() -> None:
     """The vectorised step (sines per distinct yaw rate, sentinel cut, masks in place)
     against a plain per-sample loop, near random obstacles."""
@@ -476,12 +415,13 @@ def test_dwa_step_is_the_sampling_its_docstring_describes() -> None:
         target = (pose[0] + 2.0 * math.cos(b), pose[1] + 2.0 * math.sin(b))
         distance = float(rng.uniform(0.3, 3.0))
         r = dwa_step(pose, v0, w0, target, distance, m.clearance, p)
-        v, w, count, score = _dwa_reference(pose, v0, w0, target, distance, m, p)
+        want = dwa_reference(pose, v0, w0, target, distance, m.clearance, p)
+        count = want.admissible
         assert r.admissible == count
-        assert r.v == pytest.approx(v, abs=1e-12)
-        assert r.omega == pytest.approx(w, abs=1e-12)
+        assert r.v == pytest.approx(want.v, abs=1e-12)
+        assert r.omega == pytest.approx(want.omega, abs=1e-12)
         # (the step's clearance term stays in the map's float32: ~1e-8 apart)
-        assert r.best_score == pytest.approx(score, abs=1e-6)
+        assert r.best_score == pytest.approx(want.best_score, abs=1e-6)
         blocked += count == 0
         some += 0 < count < r.samples
     # (seeded: 7 cases with no admissible sample, 3 with some cut by the wall)
