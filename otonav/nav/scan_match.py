@@ -68,9 +68,10 @@ class MatchParams:
         linear_step: its spacing in x and y, m.
         angular_window: it spans +- this in yaw, rad.
         angular_step: its spacing in yaw, rad.
-        max_distance: a point farther than this from the map is not matched, m.
+        max_distance: a point this far or farther from the map is not matched, m.
         prior: weight of the pull toward the prediction, per m^2 (the scan's own
-            term is a sum of squared metres over its points).
+            term is a sum of squared metres over its points). With 0, a scan that
+            constrains nothing leaves the refinement where it started.
         yaw_scale: m of the prior per rad of yaw.
         iterations: Gauss-Newton steps at most.
         min_inliers: fraction of the points that must lie within ``max_distance``.
@@ -239,7 +240,10 @@ def refine(
         accepted = False
         while damping <= 1.0:
             A = H + damping * np.diag(np.diag(H))
-            delta = np.linalg.solve(A, -g)
+            try:
+                delta = np.linalg.solve(A, -g)
+            except np.linalg.LinAlgError:  # no prior and a scan that constrains nothing
+                break
             trial = (pose[0] + delta[0], pose[1] + delta[1], wrap_angle(pose[2] + delta[2]))
             t_lin = _linearize(grid, points, trial, prediction, params)
             if t_lin.cost <= lin.cost:

@@ -109,3 +109,18 @@ def test_on_an_exact_tie_between_the_two_candidates_the_prediction_wins() -> Non
     assert best == pytest.approx((0.05, 0.0, 0.0), abs=1e-12)
     result = match_scan(grid, pts, (0.0, 0.0, 0.0), params)
     assert (result.pose, result.ok, result.inliers) == ((0.0, 0.0, 0.0), True, 0.0)
+
+
+def test_with_no_prior_a_scan_that_constrains_nothing_leaves_the_refinement_in_place() -> None:
+    """The lone returns above (no normals: no inliers, a zero normal matrix) with no
+    prior and the default iterations: the step is undefined, so the refinement stays
+    where it started (it raised numpy's LinAlgError: Singular matrix)."""
+    grid = ScanMap(0.0, 0.0, half_size=2.0, resolution=0.05)
+    rx = np.array([1.025, 0.025, -0.975, 0.025])
+    ry = np.array([0.025, 1.025, 0.025, -0.975])
+    grid.insert(0.0, 0.0, rx, ry)
+    pts = np.stack((rx - 0.05, ry), axis=1)
+    params = MatchParams(prior=0.0, min_inliers=0.0)
+    assert refine(grid, pts, (0.05, 0.0, 0.0), (0.0, 0.0, 0.0), params) == ((0.05, 0.0, 0.0), 0)
+    result = match_scan(grid, pts, (0.0, 0.0, 0.0), params)
+    assert result.pose == (0.0, 0.0, 0.0)
