@@ -301,6 +301,10 @@ class LiveView(Actor):
         self._client_publishers: dict[str, Publisher[Any]] = {}
         self._loop: asyncio.AbstractEventLoop | None = None
         self._parameters: ActorParameters | None = None
+        # Changes asked before the loop runs (served while the stack starts), applied as
+        # the live view starts; the lock orders them against on_start taking the loop.
+        self._early_changes: list[tuple[list[tuple[str, Any]], Any]] = []
+        self._early_lock = threading.Lock()
         self.client_messages = 0
         """Messages clients published that were taken."""
 
@@ -365,9 +369,16 @@ class LiveView(Actor):
             self._log(Log.WARN, f"{publisher.topic}: a client's message dropped (full)")
 
     def serve_parameters(self, actors: Iterable[Actor]) -> None:
-        """Serve the parameters of ``actors`` (the system's) to clients."""
+        """Serve the parameters of ``actors`` (the system's) to clients. May be called
+        before the system runs: a change asked meanwhile is applied as the live view
+        starts, at the start's sim time."""
         self._parameters = ActorParameters(actors)
         self.server.parameter_sink = self
+
+    @property
+    def served_parameters(self) -> ActorParameters | None:
+        """The parameters served to clients (None until :meth:`serve_parameters`)."""
+        return self._parameters
 
     def get_parameters(self, names: list[str]) -> list[dict[str, Any]]:
         table = self._parameters
@@ -376,8 +387,12 @@ class LiveView(Actor):
         return [{"name": n, "value": values[n]} for n in wanted if n in values]
 
     def set_parameters(self, changes: list[tuple[str, Any]], reply: Any) -> None:
-        loop = self._loop
-        if loop is None or loop.is_closed():
+        with self._early_lock:
+            loop = self._loop
+            if loop is None:  # the stack is starting: applied by on_start
+                self._early_changes.append((changes, reply))
+                return
+        if loop.is_closed():
             reply([], "parameters: the stack is not running")
             return
         loop.call_soon_threadsafe(self._apply_parameters, changes, reply)
@@ -420,7 +435,11 @@ class LiveView(Actor):
                 tap._offer(message)
 
     async def on_start(self) -> None:
-        self._loop = asyncio.get_running_loop()
+        with self._early_lock:
+            self._loop = asyncio.get_running_loop()
+            early, self._early_changes = self._early_changes, []
+        for changes, reply in early:
+            self._apply_parameters(changes, reply)
         self.server.client_sink = self._take_client_message
         options = self.server.options
         if options.wait_for_subscriber is not None:

@@ -7,11 +7,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # the command's imports are in main(): --help stays fast
+    from collections.abc import Callable
     from contextlib import ExitStack
 
     from rich.console import Console
 
+    from otonav.actors.live_view import LiveView
     from otonav.cli.signals import StopOnSignals
+    from otonav.runtime import System
     from otonav.scenario import Verdict
 
 DEFAULT_OUT = Path("out")
@@ -254,7 +257,8 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
         shutil.rmtree(out / BAG_DIR, ignore_errors=True)
         guard.attach(loop, task)  # a signal now cancels the run, which then finishes
 
-    server, extra = _live_view(args)
+    server, view = _live_view(args)
+    extra: tuple[Any, ...] = () if view is None else (view,)
     bridge = _ros2_bridge(args, stack)
     if bridge is not None:
         extra = (*extra, bridge)
@@ -290,6 +294,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
             realtime=scale if paced else None,
             gui=args.gui,
             hold=hold if paced and args.hold else None,
+            on_system=None if view is None else _serve_parameters(view),
         )
     except RunCrashedError as crash:
         # An actor crashed (one line on stderr from the log; the traceback is on
@@ -346,15 +351,15 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
     return 0 if verdict.passed else 1
 
 
-def _live_view(args: argparse.Namespace) -> tuple[Any, tuple[Any, ...]]:
+def _live_view(args: argparse.Namespace) -> tuple[Any, LiveView | None]:
     """The Foxglove server and its actor when ``--foxglove`` (one line, exit 2, when it
-    cannot start); ``(None, ())`` otherwise."""
+    cannot start); ``(None, None)`` otherwise."""
     import sys
 
     from otonav.stack.files import ConfigFileError
 
     if not args.foxglove:
-        return None, ()
+        return None, None
     from otonav.actors.live_view import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
 
     try:
@@ -373,7 +378,30 @@ def _live_view(args: argparse.Namespace) -> tuple[Any, tuple[Any, ...]]:
         file=sys.stderr,
         flush=True,
     )
-    return server, (LiveView(server),)
+    return server, LiveView(server)
+
+
+def _serve_parameters(view: LiveView) -> Callable[[System], None]:
+    """What ``run_scenario`` calls with the run's system: ``view`` serves the parameters
+    of every actor of it (Foxglove's Parameters panel, as ros-foxglove-bridge serves a
+    robot's nodes'; docs/adr/0044), and the command says which ones can be set."""
+    import sys
+
+    def serve(system: System) -> None:
+        view.serve_parameters(system.actor(a.name) for a in system.graph().actors)
+        table = view.served_parameters
+        assert table is not None
+        names = list(table.values())
+        settable = sorted({n.split(".")[0] for n in names if table.settable(n)})
+        fields = ", ".join(f"{actor}.params.FIELD" for actor in settable) or "none"
+        print(
+            f"foxglove: serving the parameters of the run's actors ({len(names)}; "
+            f"Foxglove: Parameters panel); numbers settable while it runs: {fields}",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    return serve
 
 
 def _ros2_bridge(args: argparse.Namespace, stack: Any) -> Any:

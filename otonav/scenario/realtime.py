@@ -16,7 +16,7 @@ import anyio
 from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
 from otonav.limits import check_scale
-from otonav.runtime import Actor, RealTimeClock
+from otonav.runtime import Actor, RealTimeClock, System
 from otonav.runtime.timesource import tick_rate
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
@@ -95,6 +95,7 @@ def run_scenario_realtime(
     loop_factory: Callable[[], asyncio.AbstractEventLoop] | None = None,
     source: str = "scenario",
     progress: Callable[[Judge, float], None] | None = None,
+    on_system: Callable[[System], None] | None = None,
 ) -> Verdict:
     """:func:`~otonav.scenario.run.run_scenario` with ``realtime=scale`` (and ``gui``,
     ``hold``), which is how to ask for it: sim time follows the wall clock times
@@ -105,7 +106,8 @@ def run_scenario_realtime(
     is none), the window opens before the clock starts, is synced at ~60 Hz wall and
     closed at the end. Closing the window stops the run: the verdict fails and says so.
     ``on_start(loop, task)`` is called on the run's loop once the window (if any) is up.
-    ``extra_actors`` join the system (a live view, monitors).
+    ``extra_actors`` join the system (a live view, monitors); ``on_system(system)`` is
+    called with the wired system before it runs.
     ``hold`` (with ``gui``): once the run is over and its recording finished, call
     ``hold(verdict)`` (its artifact paths are not set yet) and keep the window open on
     the final state until the user closes it; Ctrl-C ends the hold too.
@@ -118,7 +120,15 @@ def run_scenario_realtime(
     if gui:
         check_display()
     with opened_scenario(
-        scenario, stack, out_dir, record, source, progress, extra_actors, realtime=scale
+        scenario,
+        stack,
+        out_dir,
+        record,
+        source,
+        progress,
+        extra_actors,
+        realtime=scale,
+        on_system=on_system,
     ) as (scenario, stack, hal, judge, session):
         viewer: ViewerHandle | None = None
         held: list[Verdict] = []

@@ -301,11 +301,13 @@ def opened_scenario(
     progress: Callable[[Judge, float], None] | None,
     extra_actors: tuple[Actor, ...],
     realtime: float | None = None,
+    on_system: Callable[[System], None] | None = None,
 ) -> Iterator[tuple[ScenarioConfig, StackConfig, RobotHardwareInterface, Judge, StackSession]]:
     """What a judged run opens, in the virtual and the real-time runner alike: the lock
     on ``out_dir`` (held until the block ends: one run per out_dir, issue 27, refused
     before it touches a file), the world, the judge and the session recording to
-    ``out_dir/recording.mcap`` (with ``record``)."""
+    ``out_dir/recording.mcap`` (with ``record``); ``on_system(system)`` is called with the
+    session's wired system before it runs (the session is closed if it raises)."""
     with lock_output(out_dir) if out_dir is not None else contextlib.nullcontext():
         scenario, stack, hal = scenario_world(scenario, stack, source=source)
         judge = Judge(
@@ -320,6 +322,12 @@ def opened_scenario(
             extra_actors=extra_actors,
             recording=out_dir / "recording.mcap" if out_dir and record else None,
         )
+        if on_system is not None:
+            try:
+                on_system(session.system)
+            except BaseException:
+                session.close()
+                raise
         yield scenario, stack, hal, judge, session
 
 
@@ -338,15 +346,19 @@ def run_scenario(
     realtime: float | None = None,
     gui: bool = False,
     hold: Callable[[Verdict], None] | None = None,
+    on_system: Callable[[System], None] | None = None,
 ) -> Verdict:
     """Run ``scenario`` headless in virtual time and judge it. With ``out_dir``, leave
     ``recording.mcap`` (unless ``record=False``) and ``trajectory.png`` there. The
     recording is finished on every exit path (an exception, Ctrl-C, SIGTERM).
-    ``extra_actors`` join the system (monitors, fault injectors). ``progress(judge,
-    sim_time)`` is called after every judge sample (the CLI's progress line). ``on_start(loop,
-    task)`` is called on the run's loop as it starts: a host running this in a worker
-    thread cancels the run with ``loop.call_soon_threadsafe(task.cancel)``. A goal
-    outside the arena or on an obstacle raises ``ConfigFileError`` naming ``source``.
+    ``extra_actors`` join the system (monitors, fault injectors). ``on_system(system)``
+    is called with the run's wired :class:`~otonav.runtime.System` before it starts: a
+    host reaching the actors (``otonav run --foxglove`` serves their parameters).
+    ``progress(judge, sim_time)`` is called after every judge sample (the CLI's progress
+    line). ``on_start(loop, task)`` is called on the run's loop as it starts: a host
+    running this in a worker thread cancels the run with
+    ``loop.call_soon_threadsafe(task.cancel)``. A goal outside the arena or on an
+    obstacle raises ``ConfigFileError`` naming ``source``.
     Another run writing to ``out_dir`` raises :class:`~otonav.record.outlock.OutputBusyError`
     before anything is touched. An actor's crash raises
     :class:`~otonav.scenario.crash.RunCrashedError` once the artifacts are written: an
@@ -375,11 +387,13 @@ def run_scenario(
             hold=hold,
             source=source,
             progress=progress,
+            on_system=on_system,
         )
     if hold is not None:
         raise ValueError("run_scenario: hold= needs gui=True (it keeps the viewer open)")
+    extra = tuple(extra_actors)
     with opened_scenario(
-        scenario, stack, out_dir, record, source, progress, tuple(extra_actors)
+        scenario, stack, out_dir, record, source, progress, extra, on_system=on_system
     ) as (scenario, stack, hal, judge, session):
         preload_lazy_imports()
         sim_time = [0.0]
