@@ -3,7 +3,8 @@ as ros-foxglove-bridge does on a robot: the real CLI in a subprocess, a real Web
 client over TCP. The client reads every actor's parameters while sim time is held at the
 start (``--foxglove-wait``), slows the navigator down, sees a refused value answered with
 an error, and the change is on /rosout (live and in the recording) at sim time 0; the
-recorded odometry never goes faster than the new limit."""
+recorded odometry never goes faster than the new limit. Both runners (virtual and real
+time) hand the wired system to ``on_system``, the hook the CLI uses."""
 
 from __future__ import annotations
 
@@ -21,6 +22,9 @@ from websockets.asyncio.client import ClientConnection, connect
 
 from otonav.actors import topics
 from otonav.record.reader import read_messages
+from otonav.runtime import ActorStatus, System
+from otonav.scenario import run_scenario
+from otonav.scenario.builtin import BUILTIN
 
 pytestmark = pytest.mark.smoke
 
@@ -161,3 +165,22 @@ async def test_otonav_run_foxglove_serves_and_sets_the_actors_parameters(
     speeds = [m.twist.twist.linear.x for _tp, _t, m in read_messages(recording, [topics.ODOM])]
     assert max(speeds) > 0.1  # it drove
     assert max(speeds) <= SLOW * 1.05  # never faster than the client's limit
+
+
+@pytest.mark.parametrize("realtime", [None, 20.0], ids=["virtual", "realtime"])
+def test_both_runners_hand_the_wired_system_to_on_system_before_it_runs(
+    realtime: float | None,
+) -> None:
+    seen: list[tuple[str, ActorStatus]] = []
+
+    def on_system(system: System) -> None:
+        seen.extend((a.name, a.status) for a in system.graph().actors)
+        assert system.actor("nav").name == "nav"  # the actors themselves, not only names
+
+    short = BUILTIN["empty"].model_copy(update={"sim_budget": 0.5})
+    verdict = run_scenario(short, record=False, plot=False, realtime=realtime, on_system=on_system)
+    assert verdict.sim_time_s > 0.4  # then the run went on as usual
+    names = [name for name, _ in seen]
+    assert {"nav", "safety", "judge"} <= set(names)
+    assert len(names) == len(set(names))  # called once
+    assert {status for _, status in seen} == {ActorStatus.CREATED}  # none started yet
