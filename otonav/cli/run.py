@@ -257,8 +257,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
         shutil.rmtree(out / BAG_DIR, ignore_errors=True)
         guard.attach(loop, task)  # a signal now cancels the run, which then finishes
 
-    server, view = _live_view(args)
-    extra: tuple[Any, ...] = () if view is None else (view,)
+    server, extra = _live_view(args)
     bridge = _ros2_bridge(args, stack)
     if bridge is not None:
         extra = (*extra, bridge)
@@ -294,7 +293,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
             realtime=scale if paced else None,
             gui=args.gui,
             hold=hold if paced and args.hold else None,
-            on_system=None if view is None else _serve_parameters(view),
+            on_system=None if server is None else _serve_parameters(extra[0]),
         )
     except RunCrashedError as crash:
         # An actor crashed (one line on stderr from the log; the traceback is on
@@ -351,15 +350,15 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
     return 0 if verdict.passed else 1
 
 
-def _live_view(args: argparse.Namespace) -> tuple[Any, LiveView | None]:
+def _live_view(args: argparse.Namespace) -> tuple[Any, tuple[Any, ...]]:
     """The Foxglove server and its actor when ``--foxglove`` (one line, exit 2, when it
-    cannot start); ``(None, None)`` otherwise."""
+    cannot start); ``(None, ())`` otherwise."""
     import sys
 
     from otonav.stack.files import ConfigFileError
 
     if not args.foxglove:
-        return None, None
+        return None, ()
     from otonav.actors.live_view import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
 
     try:
@@ -378,7 +377,7 @@ def _live_view(args: argparse.Namespace) -> tuple[Any, LiveView | None]:
         file=sys.stderr,
         flush=True,
     )
-    return server, LiveView(server)
+    return server, (LiveView(server),)
 
 
 def _serve_parameters(view: LiveView) -> Callable[[System], None]:
