@@ -368,17 +368,13 @@ class LiveView(Actor):
         except anyio.WouldBlock:
             self._log(Log.WARN, f"{publisher.topic}: a client's message dropped (full)")
 
-    def serve_parameters(self, actors: Iterable[Actor]) -> None:
-        """Serve the parameters of ``actors`` (the system's) to clients. May be called
-        before the system runs: a change asked meanwhile is applied as the live view
-        starts, at the start's sim time."""
-        self._parameters = ActorParameters(actors)
+    def serve_parameters(self, actors: Iterable[Actor]) -> ActorParameters:
+        """Serve the parameters of ``actors`` (the system's) to clients; the table served.
+        May be called before the system runs: a change asked meanwhile is applied as the
+        live view starts, at the start's sim time."""
+        self._parameters = table = ActorParameters(actors)
         self.server.parameter_sink = self
-
-    @property
-    def served_parameters(self) -> ActorParameters | None:
-        """The parameters served to clients (None until :meth:`serve_parameters`)."""
-        return self._parameters
+        return table
 
     def get_parameters(self, names: list[str]) -> list[dict[str, Any]]:
         table = self._parameters

@@ -387,9 +387,7 @@ def _serve_parameters(view: LiveView) -> Callable[[System], None]:
     import sys
 
     def serve(system: System) -> None:
-        view.serve_parameters(system.actor(a.name) for a in system.graph().actors)
-        table = view.served_parameters
-        assert table is not None
+        table = view.serve_parameters(system.actor(a.name) for a in system.graph().actors)
         names = list(table.values())
         settable = sorted({n.split(".")[0] for n in names if table.settable(n)})
         fields = ", ".join(f"{actor}.params.FIELD" for actor in settable) or "none"

@@ -391,9 +391,15 @@ def run_scenario(
         )
     if hold is not None:
         raise ValueError("run_scenario: hold= needs gui=True (it keeps the viewer open)")
-    extra = tuple(extra_actors)
     with opened_scenario(
-        scenario, stack, out_dir, record, source, progress, extra, on_system=on_system
+        scenario,
+        stack,
+        out_dir,
+        record,
+        source,
+        progress,
+        tuple(extra_actors),
+        on_system=on_system,
     ) as (scenario, stack, hal, judge, session):
         preload_lazy_imports()
         sim_time = [0.0]

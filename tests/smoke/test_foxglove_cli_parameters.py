@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import asyncio
 import json
-import socket
 import struct
 import sys
 from pathlib import Path
@@ -18,6 +17,7 @@ from typing import Any
 
 import pytest
 from foxglove_client import SUBPROTOCOLS, Channel
+from test_foxglove_live import _free_port
 from websockets.asyncio.client import ClientConnection, connect
 
 from otonav.actors import topics
@@ -33,13 +33,6 @@ CEILING = 90.0
 SLOW = 0.15
 """m/s: the navigator's new top speed (its default is 0.4)."""
 CHANGED = f"parameter nav.params.max_v: 0.4 -> {SLOW!r} (set by a client)"
-
-
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port: int = probe.getsockname()[1]
-    return port
 
 
 async def _line_with(stream: asyncio.StreamReader, text: str) -> str:
