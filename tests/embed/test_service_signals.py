@@ -15,6 +15,7 @@ from typing import Any
 
 import httpx
 import pytest
+from children import terminal_signals
 
 from otonav.record.reader import summarize
 
@@ -59,6 +60,7 @@ def test_ctrl_c_twice_during_heavy_runs_exits_cleanly_with_every_recording_index
         stderr=subprocess.PIPE,
         text=True,
         cwd=tmp_path,
+        preexec_fn=terminal_signals,
     )
     try:
         url = _address(process)

@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from children import terminal_signals
 
 from otonav.cli import main
 from otonav.record.reader import summarize
@@ -20,10 +21,6 @@ from otonav.record.reader import summarize
 pytestmark = pytest.mark.sil
 
 STALE = {"scenario": "acceptance", "passed": True, "reached": True}
-
-
-def _default_sigint() -> None:
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
 def _stale_out(out: Path) -> Path:
@@ -49,9 +46,7 @@ def test_an_interrupted_run_leaves_no_summary(
         stdin=subprocess.DEVNULL,
         stdout=subprocess.PIPE,
         stderr=child_side,
-        # A suite started in the background (`make test &`) ignores SIGINT, and a child
-        # that starts with it ignored never sees Ctrl-C: give it the default back.
-        preexec_fn=_default_sigint,
+        preexec_fn=terminal_signals,
     )
     os.close(child_side)
     try:

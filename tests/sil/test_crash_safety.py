@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from children import terminal_signals
 
 from otonav.record.reader import read_messages, summarize
 from otonav.record.salvage import salvage
@@ -27,6 +28,7 @@ def _start(out: Path, mode: str) -> subprocess.Popen[str]:
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=terminal_signals,
     )
     assert proc.stdout is not None
     line = proc.stdout.readline()  # blocks until the child reached 30 s of sim time

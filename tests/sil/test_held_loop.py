@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from children import terminal_signals
 
 from otonav.record.reader import summarize
 from otonav.runtime import Actor, WallClockCeilingError
@@ -51,6 +52,7 @@ def test_a_signal_stops_a_held_loop_and_names_the_actor(
         capture_output=True,
         text=True,
         timeout=50,
+        preexec_fn=terminal_signals,
     )
     assert done.returncode == code, done.stderr
     assert "Traceback" not in done.stderr

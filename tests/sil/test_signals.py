@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from children import terminal_signals
 
 from otonav.record.reader import read_messages, summarize
 
@@ -19,7 +20,11 @@ CHILD = Path(__file__).with_name("signal_child.py")
 
 def _run(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, str(CHILD), *args], capture_output=True, text=True, timeout=90
+        [sys.executable, str(CHILD), *args],
+        capture_output=True,
+        text=True,
+        timeout=90,
+        preexec_fn=terminal_signals,
     )
 
 
