@@ -5,10 +5,24 @@
 
 Each layer prints its wall time. The same script runs for people (`make test`) and CI
 (`.ci/run`).
+
+Two conditions a test must not depend on are fixed here, so that a test that does fails
+on every run instead of at random (issue 43):
+
+- the order: pytest-randomly shuffles each layer's tests with a seed the gate prints
+  (``GATE_SEED=N`` repeats a gate's orders; ``pytest tests/sil -p randomly
+  --randomly-seed=N`` one layer's, ``-p no:randomly`` runs the files' own order);
+- how the gate was started: each layer runs with SIGINT ignored, as a shell without job
+  control starts ``make test &`` or a CI step. A test whose child must see Ctrl-C starts
+  it with ``tests/children.py``'s ``terminal_signals``. Ctrl-C on the gate still stops
+  the layer: gate.py receives it and ends the layer's process.
 """
 
 from __future__ import annotations
 
+import os
+import random
+import signal
 import subprocess
 import sys
 import time
@@ -39,19 +53,31 @@ LAYERS: dict[str, list[list[str]]] = {
 }
 
 
+def _as_in_the_background() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
 def main(argv: list[str]) -> int:
     wanted = argv or list(LAYERS)
     unknown = [name for name in wanted if name not in LAYERS]
     if unknown:
         print(f"gate: unknown layer(s) {unknown}; valid: {list(LAYERS)}", file=sys.stderr)
         return 2
+    given = os.environ.get("GATE_SEED", "")
+    if given and not given.isdigit():
+        print(f"gate: GATE_SEED={given!r} is not a whole number", file=sys.stderr)
+        return 2
+    seed = int(given) if given else random.randrange(1, 2**31)
+    print(f"gate: tests in random order, GATE_SEED={seed} repeats it", flush=True)
     timings: list[tuple[str, float]] = []
     for name in (layer for layer in LAYERS if layer in wanted):
         print(f"\n=== layer {name} ===", flush=True)
         start = time.perf_counter()
         for cmd in LAYERS[name]:
+            if "pytest" in cmd:
+                cmd = [*cmd, f"--randomly-seed={seed}"]
             print("$ " + " ".join(Path(c).name if c == PY else c for c in cmd), flush=True)
-            code = subprocess.call(cmd, cwd=ROOT)
+            code = subprocess.call(cmd, cwd=ROOT, preexec_fn=_as_in_the_background)
             if code != 0:
                 elapsed = time.perf_counter() - start
                 print(f"\n=== layer {name} FAILED after {elapsed:.1f} s (exit {code}) ===")
