@@ -30,7 +30,9 @@ class Judge(Actor):
     first entry (``time_to_goal``) the judge checks, on ground truth, that the robot is
     still within the tolerance, its true speed is below ``max_speed``, and the navigator
     says ``reached``; ``reached`` is True only then. A robot that drives through the
-    goal fails, and ``arrival_problem`` says why.
+    goal fails, and ``arrival_problem`` says why. With ``nav_must_say_reached=False``
+    (``nav.planner: external``: a ROS 2 planner publishes no ``otonav_msgs/NavState``,
+    issue 37) arrival is judged on ground truth alone: within the tolerance and stopped.
     """
 
     # depth 16: /nav/state comes at 20 Hz and the judge drains it at rate_hz (100 Hz).
@@ -50,9 +52,11 @@ class Judge(Actor):
         progress: Callable[[Judge, float], None] | None = None,
         settle_s: float = ARRIVAL_SETTLE_S,
         max_speed: float = ARRIVAL_MAX_SPEED,
+        nav_must_say_reached: bool = True,
         name: str = "judge",
     ) -> None:
         super().__init__(name)
+        self.nav_must_say_reached = nav_must_say_reached
         self.settle_s = settle_s
         self.max_speed = max_speed
         self.arrival_checked_at: float | None = None
@@ -97,8 +101,8 @@ class Judge(Actor):
 
     @property
     def reached(self) -> bool:
-        """Arrived: within the tolerance, stopped, and the navigator said ``reached``,
-        ``settle_s`` after first entering the tolerance."""
+        """Arrived: within the tolerance, stopped, and (unless the planner is external)
+        the navigator said ``reached``, ``settle_s`` after first entering the tolerance."""
         return self.arrival_checked_at is not None and self.arrival_problem is None
 
     @property
@@ -120,14 +124,16 @@ class Judge(Actor):
             problems.append(f"{self.distance:.3f} m from the goal")
         if self.speed > self.max_speed:
             problems.append(f"moving at {self.speed:.2f} m/s")
-        if self.nav_state != "reached":
-            problems.append(f"/nav/state '{self.nav_state}'")
+        needs = f"<= {self.tolerance} m, < {self.max_speed} m/s"
+        if self.nav_must_say_reached:
+            needs += " and /nav/state 'reached'"
+            if self.nav_state != "reached":
+                problems.append(f"/nav/state '{self.nav_state}'")
         self.arrival_checked_at = now
         if problems:
             self.arrival_problem = (
                 f"entered the goal tolerance at {self.time_to_goal:.2f} s but had not "
-                f"arrived {self.settle_s:g} s later: {', '.join(problems)} (needs <= "
-                f"{self.tolerance} m, < {self.max_speed} m/s and /nav/state 'reached')"
+                f"arrived {self.settle_s:g} s later: {', '.join(problems)} (needs {needs})"
             )
 
     def _follow_nav_state(self, now: float) -> None:

@@ -311,7 +311,11 @@ def opened_scenario(
     with lock_output(out_dir) if out_dir is not None else contextlib.nullcontext():
         scenario, stack, hal = scenario_world(scenario, stack, source=source)
         judge = Judge(
-            hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance, progress=progress
+            hal,
+            (scenario.goal.x, scenario.goal.y),
+            scenario.goal_tolerance,
+            progress=progress,
+            nav_must_say_reached=stack.nav.planner != "external",
         )
         session = scenario_session(
             scenario,

@@ -186,3 +186,26 @@ def test_bad_robot_or_node_input_is_one_line_and_exit_2(
     assert err.startswith(f"otonav: error: {line}")
     assert "\n" not in err
     assert (tmp_path / "keep.txt").read_text() == "recorded before"
+
+
+def test_an_external_planner_that_publishes_no_nav_state_is_judged_on_ground_truth(
+    tmp_path: Path,
+) -> None:
+    """A ROS 2 planner cannot publish otonav_msgs/NavState (issue 37): with nav.planner
+    external, arriving (within the tolerance, stopped 2 s later) is the pass. The example
+    planner's /nav/state is remapped away, so nobody tells the judge 'reached'."""
+    config = tmp_path / "stack.yaml"
+    config.write_text(
+        "nav: {planner: external}\n"
+        "actors:\n"
+        f"  - name: planner\n    class: '{MY_NODES / 'simple_planner.py'}:StraightToGoal'\n"
+        "    remap: {/nav/state: /planner/state}\n"
+    )
+    out = tmp_path / "out"
+    args = ["run", "--scenario", "empty", "--config", str(config), "--out", str(out)]
+    assert main(args) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["passed"], summary
+    assert summary["time_to_goal_s"] is not None
+    assert not list(read_messages(out / "recording.mcap", ["/nav/state"]))
+    assert list(read_messages(out / "recording.mcap", ["/planner/state"]))
