@@ -174,7 +174,7 @@ class Bridge(Actor):
     """
 
     clock_out = Output(topics.CLOCK, Clock, topics.CLOCK_QOS)
-    odom = Output(topics.ODOM, Odometry, topics.SENSOR_QOS)
+    odom = Output(topics.ODOM, Odometry, topics.ODOM_QOS)
     imu = Output(topics.IMU, Imu, topics.SENSOR_QOS)
     scan = Output(topics.SCAN, LaserScan, topics.SENSOR_QOS)
     tf = Output(topics.TF, TFMessage, topics.TF_QOS)

@@ -26,6 +26,10 @@ DIAGNOSTICS = "/diagnostics"
 
 #: Sensor streams: best-effort, keep a few (a slow reader sees the newest, never stalls physics).
 SENSOR_QOS = SENSOR_DATA_QOS
+#: /odom: reliable, keep the last 10, as diff_drive_controller offers it: a node written
+#: ``create_subscription(Odometry, "/odom", cb, 10)`` asks reliable and matches only this
+#: (issue 37). The stack's own readers still subscribe best effort (SENSOR_QOS).
+ODOM_QOS = QoS(depth=10)
 #: /clock: best-effort, keep the last one.
 CLOCK_QOS = QoS(Reliability.BEST_EFFORT, depth=1)
 #: Commands and state: reliable.

@@ -20,5 +20,5 @@ def test_graph_rows_are_not_wrapped_in_a_pipe_and_name_ros_types(
     assert main(["graph"]) == 0
     out = capsys.readouterr().out
     row = next(line for line in out.splitlines() if "nav_msgs/msg/Odometry" in line)
-    assert "bridge (best_effort/depth=5/volatile)" in row
+    assert "bridge (reliable/depth=10/volatile)" in row  # as diff_drive_controller offers
     assert "nav (best_effort/depth=5/volatile)" in row  # the next column, on the same line
