@@ -18,6 +18,7 @@ agree: the gate checks that Cyclone's own deserializer reads our bytes.
 from __future__ import annotations
 
 import functools
+import math
 import threading
 from collections.abc import Callable
 from typing import Any, Final
@@ -106,25 +107,33 @@ def _qos(policy: DdsQos, *, reader: bool) -> Any:
     return Qos(*policies)
 
 
+class _Changes(threading.Condition):
+    """Notified whenever an endpoint gains or loses a remote match or data arrives;
+    ``matches`` counts the match changes (for :meth:`Participant.wait_quiet`)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.matches = 0
+
+
 class _Matched:
     """A count of matched remote endpoints, kept by Cyclone's listener thread."""
 
-    def __init__(self, changed: threading.Condition) -> None:
+    def __init__(self, changed: _Changes) -> None:
         self.count = 0
         self.changed = changed
 
     def update(self, count: int) -> None:
         with self.changed:
             self.count = count
+            self.changed.matches += 1
             self.changed.notify_all()
 
 
 class RawWriter:
     """Writes CDR bytes on one DDS topic."""
 
-    def __init__(
-        self, participant: Any, topic: Any, policy: DdsQos, changed: threading.Condition
-    ) -> None:
+    def __init__(self, participant: Any, topic: Any, policy: DdsQos, changed: _Changes) -> None:
         self.matched = _Matched(changed)
         listener = Listener(
             on_publication_matched=lambda _w, status: self.matched.update(status.current_count)
@@ -145,18 +154,25 @@ class RawWriter:
 class RawReader:
     """Takes the CDR bytes of each sample that arrives on one DDS topic."""
 
-    def __init__(
-        self, participant: Any, topic: Any, policy: DdsQos, changed: threading.Condition
-    ) -> None:
+    def __init__(self, participant: Any, topic: Any, policy: DdsQos, changed: _Changes) -> None:
         self.matched = _Matched(changed)
+        self.arrivals = 0
+        """Times data arrived (Cyclone's listener thread counts, under ``changed``)."""
+        self._changed = changed
         listener = Listener(
-            on_subscription_matched=lambda _r, status: self.matched.update(status.current_count)
+            on_subscription_matched=lambda _r, status: self.matched.update(status.current_count),
+            on_data_available=lambda _r: self._arrived(),
         )
         self._reader = DataReader(participant, topic, qos=_qos(policy, reader=True))
         self._reader.set_listener(listener)
         self._listener = listener
         self.matched.update(len(self._reader.get_matched_publications()))
         self._ref: int = self._reader._ref
+
+    def _arrived(self) -> None:
+        with self._changed:
+            self.arrivals += 1
+            self._changed.notify_all()
 
     def take(self, limit: int = 64) -> list[bytes]:
         """Every valid sample waiting (at most ``limit``), oldest first; never waits."""
@@ -170,12 +186,12 @@ class Participant:
     """One DDS domain participant: its topics, writers and readers."""
 
     def __init__(self, domain_id: int, config: str | None) -> None:
-        # A domain made with our configuration first; Cyclone adds CYCLONEDDS_URI's.
+        # A domain made with this configuration (ours, then CYCLONEDDS_URI's: naming.py).
         self._domain = Domain(domain_id, config) if config is not None else None
         self._participant = DomainParticipant(domain_id)
         self._topics: dict[str, Any] = {}
         self._made: list[Any] = [self._participant]
-        self.changed = threading.Condition()
+        self.changed = _Changes()
         """Notified whenever a writer or reader gains or loses a remote match."""
         self.closed = False
 
@@ -198,9 +214,27 @@ class Participant:
 
     def wait(self, ready: Callable[[], bool], timeout: float) -> bool:
         """Block (a worker thread, never the loop) until ``ready()`` after some match
-        changed, at most ``timeout`` wall seconds; whether it became ready."""
+        changed or some data arrived, at most ``timeout`` wall seconds; whether it became
+        ready."""
         with self.changed:
             return self.changed.wait_for(ready, timeout)
+
+    def wait_quiet(self, quiet: float, limit: float) -> bool:
+        """Block (a worker thread) until no endpoint gained or lost a match for ``quiet``
+        wall seconds, at most about ``limit``; whether it got quiet. Discovery announces a
+        peer's endpoints one by one: matching the first ones does not mean the rest."""
+        for _ in range(max(1, math.ceil(limit / quiet))):
+            with self.changed:
+                seen = self.changed.matches
+
+                def moved(seen: int = seen) -> bool:
+                    return self.changed.matches != seen or self.closed
+
+                if not self.changed.wait_for(moved, quiet):
+                    return True
+                if self.closed:
+                    return False
+        return False
 
     def close(self) -> None:
         """Delete every entity made here, then the participant and the domain: Cyclone's
@@ -208,7 +242,9 @@ class Participant:
         dropping references would leak them (idempotent)."""
         if self.closed:
             return
-        self.closed = True
+        with self.changed:  # a waiting worker thread sees it and returns
+            self.closed = True
+            self.changed.notify_all()
         for entity in reversed(self._made):
             entity.__del__()
         self._made.clear()

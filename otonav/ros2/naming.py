@@ -13,6 +13,18 @@ Each rule is rmw_cyclonedds_cpp's (``rmw_node.cpp``; docs/adr/0047 cites the lin
   data representation a Cyclone writer takes by default for a final type;
 - discovery (``check_create_domain``): ``LOCALHOST`` turns multicast off and lists
   ``localhost`` as a peer with participant indices ``auto`` (at most 32).
+
+Two settings rmw_cyclonedds does not need and otonav does, to talk to ROS 2's default
+rmw (Fast DDS; measured against Jazzy's and Kilted's rclpy, docs/adr/0065):
+
+- on LOCALHOST the interface is ``lo``: Cyclone 11 drops SPDP that arrives on an interface
+  it did not select, and it selects eth0, so a Fast DDS node that started after the
+  bridge was never discovered;
+- Fast DDS's XTypes type information is ignored (vendor 1.15) and types match by name,
+  as with Jazzy: Fast DDS 3 (Kilted) announces type objects for types with arrays or
+  sequences that Cyclone rejects as invalid ("ddsi_xt_type_add_typeobj with invalid
+  type object" on the terminal), and its readers of /odom, /scan and /imu then never
+  matched.
 """
 
 from __future__ import annotations
@@ -45,13 +57,22 @@ MAX_DOMAIN_ID: Final = 232
 TOPIC_PREFIX: Final = "rt"
 _ROS_NAME = re.compile(r"^(/[A-Za-z_][A-Za-z0-9_]*)+$")
 
+_FAST_DDS_TYPES: Final = (
+    "<Compatibility><IgnoreTypeInformation>1.15</IgnoreTypeInformation></Compatibility>"
+)
 LOCALHOST_CONFIG: Final = (
-    "<CycloneDDS><Domain><General><AllowMulticast>false</AllowMulticast></General>"
+    "<CycloneDDS><Domain><General><AllowMulticast>false</AllowMulticast>"
+    '<Interfaces><NetworkInterface name="lo"/></Interfaces></General>'
     "<Discovery><ParticipantIndex>auto</ParticipantIndex>"
     "<MaxAutoParticipantIndex>32</MaxAutoParticipantIndex>"
-    '<Peers><Peer address="localhost"/></Peers></Discovery></Domain></CycloneDDS>'
+    f'<Peers><Peer address="localhost"/></Peers></Discovery>{_FAST_DDS_TYPES}'
+    "</Domain></CycloneDDS>"
 )
-"""rmw_cyclonedds_cpp's configuration for ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``."""
+"""rmw_cyclonedds_cpp's configuration for ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``,
+on the loopback interface, with Fast DDS's type information ignored."""
+NETWORK_CONFIG: Final = f"<CycloneDDS><Domain>{_FAST_DDS_TYPES}</Domain></CycloneDDS>"
+"""Cyclone's defaults (multicast on its interfaces), with Fast DDS's type information
+ignored."""
 
 
 class Ros2Error(UsageError):
@@ -112,8 +133,8 @@ def domain_id(value: int | None, env: Mapping[str, str]) -> int:
 class Discovery:
     """How far the bridge is seen: a Cyclone configuration and the line that says it."""
 
-    config: str | None
-    """XML given to the domain before ``CYCLONEDDS_URI`` (None: Cyclone's defaults)."""
+    config: str
+    """XML given to the domain, then ``CYCLONEDDS_URI``'s (see :func:`discovery`)."""
     scope: str
     localhost: bool
 
@@ -125,14 +146,16 @@ def discovery(env: Mapping[str, str]) -> Discovery:
     set: otonav's default, unlike ROS 2 Jazzy's SUBNET) keep it on this host; ``SUBNET``
     and ``SYSTEM_DEFAULT`` use Cyclone's defaults (multicast on every interface). ``OFF``
     would make the bridge invisible and is refused. ``CYCLONEDDS_URI`` still applies
-    after ours, as in rmw_cyclonedds.
+    after ours, as in rmw_cyclonedds (Cyclone does not read it once a configuration is
+    given: it is appended here).
     """
     localhost_only = env.get("ROS_LOCALHOST_ONLY", "").strip() == "1"
     wanted = env.get("ROS_AUTOMATIC_DISCOVERY_RANGE", "").strip().upper()
     if localhost_only or wanted in ("", "LOCALHOST"):
-        return Discovery(LOCALHOST_CONFIG, "this host only (localhost)", True)
+        return Discovery(_with_uri(LOCALHOST_CONFIG, env), "this host only (localhost)", True)
     if wanted in ("SUBNET", "SYSTEM_DEFAULT"):
-        return Discovery(None, f"the network (ROS_AUTOMATIC_DISCOVERY_RANGE={wanted})", False)
+        scope = f"the network (ROS_AUTOMATIC_DISCOVERY_RANGE={wanted})"
+        return Discovery(_with_uri(NETWORK_CONFIG, env), scope, False)
     if wanted == "OFF":
         raise Ros2Error(
             "ROS_AUTOMATIC_DISCOVERY_RANGE=OFF: no ROS 2 node could see the bridge "
@@ -141,3 +164,10 @@ def discovery(env: Mapping[str, str]) -> Discovery:
     raise Ros2Error(
         f"ROS_AUTOMATIC_DISCOVERY_RANGE={wanted}: must be LOCALHOST, SUBNET, SYSTEM_DEFAULT or OFF"
     )
+
+
+def _with_uri(config: str, env: Mapping[str, str]) -> str:
+    """``config`` then the user's ``CYCLONEDDS_URI`` (a comma-separated list of files and
+    XML, which Cyclone reads in order, the later overriding)."""
+    user = env.get("CYCLONEDDS_URI", "").strip()
+    return f"{config},{user}" if user else config

@@ -13,6 +13,7 @@ from otonav.msgs import Clock, Odometry, PoseStamped
 from otonav.record.type_hash import rihs01
 from otonav.ros2.naming import (
     LOCALHOST_CONFIG,
+    NETWORK_CONFIG,
     Ros2Error,
     dds_qos,
     dds_topic,
@@ -56,12 +57,21 @@ def test_discovery_stays_on_this_host_unless_asked() -> None:
     assert discovery({"ROS_LOCALHOST_ONLY": "1"}).localhost
     assert discovery({"ROS_AUTOMATIC_DISCOVERY_RANGE": "localhost"}).localhost
     wide = discovery({"ROS_AUTOMATIC_DISCOVERY_RANGE": "SUBNET"})
-    assert (wide.config, wide.localhost) == (None, False)
+    assert (wide.config, wide.localhost) == (NETWORK_CONFIG, False)
     assert "network" in wide.scope
     with pytest.raises(Ros2Error, match="OFF"):
         discovery({"ROS_AUTOMATIC_DISCOVERY_RANGE": "OFF"})
     with pytest.raises(Ros2Error, match="must be LOCALHOST"):
         discovery({"ROS_AUTOMATIC_DISCOVERY_RANGE": "MARS"})
+
+
+def test_the_users_cyclonedds_uri_applies_after_ours() -> None:
+    """Cyclone reads no CYCLONEDDS_URI once given a configuration: it is appended, as
+    rmw_cyclonedds does, so the user's file still overrides."""
+    uri = "file:///etc/my-cyclone.xml"
+    assert discovery({"CYCLONEDDS_URI": uri}).config == f"{LOCALHOST_CONFIG},{uri}"
+    network = {"ROS_AUTOMATIC_DISCOVERY_RANGE": "SUBNET", "CYCLONEDDS_URI": uri}
+    assert discovery(network).config == f"{NETWORK_CONFIG},{uri}"
 
 
 def test_cyclonedds_is_imported_only_when_a_bridge_is_made() -> None:
@@ -77,7 +87,7 @@ def test_cyclonedds_is_imported_only_when_a_bridge_is_made() -> None:
     ("argv", "line"),
     [
         (["--ros2", "--ros2-domain", "300"], "--ros2-domain 300: must be 0..232"),
-        (["--ros2-domain", "3"], "--ros2-domain/--ros2-in: only with --ros2"),
+        (["--ros2-domain", "3"], "--ros2-domain: only with --ros2"),
         (["--ros2", "--ros2-in", "odom"], "--ros2-in 'odom': not a ROS 2 topic name"),
         (["--set", "ros2.domain_id=999"], "ros2.domain_id"),
     ],
