@@ -4,7 +4,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 
-.PHONY: run test lint bench docs test-docs clean image test-image test-versions mutation
+.PHONY: run test lint bench docs test-docs clean image test-image test-versions mutation ros2-peers
 
 $(STAMP): pyproject.toml constraints.txt
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -12,13 +12,27 @@ $(STAMP): pyproject.toml constraints.txt
 	$(PY) -m pip install --quiet -c constraints.txt -e '.[dev]'
 	@touch $(STAMP)
 
+## a real ROS 2 from PyPI as the gate's test peers (docs/adr/0065): Jazzy's and Kilted's
+## rclpy on Fast DDS, each in its own venv under .venvs/ (otonav's own .venv needs no
+## rclpy), pinned by tests/ros2/constraints-<distro>.txt
+ROS2_DISTROS := jazzy kilted
+ROS2_PACKAGES = rclpy rmw-fastrtps-cpp std-msgs geometry-msgs sensor-msgs nav-msgs rosgraph-msgs
+ROS2_STAMPS := $(foreach d,$(ROS2_DISTROS),.venvs/ros2-$(d)/.installed)
+.venvs/ros2-%/.installed: tests/ros2/constraints-%.txt
+	@test -x .venvs/ros2-$*/bin/python || $(PYTHON) -m venv .venvs/ros2-$*
+	.venvs/ros2-$*/bin/python -m pip install --quiet -c tests/ros2/constraints-$*.txt \
+		$(foreach p,$(ROS2_PACKAGES),ros-$*-$(p)) 2>&1 | grep -v "^WARNING: Location" || true
+	.venvs/ros2-$*/bin/python -c "import rclpy, nav_msgs.msg, sensor_msgs.msg, rosgraph_msgs.msg"
+	@touch $@
+ros2-peers: $(ROS2_STAMPS)
+
 ## set up and run the default scenario (headless)
 run: $(STAMP)
 	$(PY) -m otonav
 
 ## set up and run the whole gate: static, unit, smoke, SIL (stops at the first red layer)
 ## (the GUI smoke test needs Debian's xvfb and x11-apps: installed here when missing)
-test: $(STAMP)
+test: $(STAMP) ros2-peers
 	@sh scripts/ensure_xvfb.sh
 	$(PY) scripts/gate.py
 

@@ -146,6 +146,25 @@ def add_parser(commands: Any) -> None:
         help="a topic ROS 2 nodes may publish into the stack (repeatable; default /goal; "
         "e.g. /cmd_vel_nav to drive the robot from your own planner)",
     )
+    ros2.add_argument(
+        "--lockstep",
+        nargs="?",
+        action="append",
+        const="",
+        default=None,
+        metavar="TOPIC:PERIOD",
+        help="run the ROS 2 nodes in otonav's time, as fast as they follow: sim time holds at "
+        "each instant an answer is due (a message on TOPIC every PERIOD s of sim time, e.g. "
+        "/cmd_vel_nav:0.05; repeatable; default: the config's ros2.lockstep) until it came",
+    )
+    ros2.add_argument(
+        "--ros2-wait",
+        type=float,
+        default=None,
+        metavar="S",
+        help="hold sim time at 0 until the ROS 2 nodes matched, at most S wall seconds "
+        "(default: no wait; 30 with --lockstep)",
+    )
     p.set_defaults(handler=main)
 
 
@@ -259,6 +278,11 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
 
     server, extra = _live_view(args)
     bridge = _ros2_bridge(args, stack)
+    lockstep = bridge is not None and bool(bridge.options.lockstep)
+    if lockstep and (args.realtime or args.gui or args.scale is not None):
+        raise ConfigFileError(
+            "--lockstep: not with --realtime, --gui or --scale (sim time follows the nodes)"
+        )
     if bridge is not None:
         extra = (*extra, bridge)
     console = make_console()
@@ -279,7 +303,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
         gc.freeze()
     guard.arm()  # from here a signal stops the run and lets it finish its artifacts
     try:
-        paced = args.gui or args.realtime or bridge is not None
+        paced = args.gui or args.realtime or (bridge is not None and not lockstep)
         verdict = run_scenario(
             scenario,
             stack,
@@ -410,20 +434,73 @@ def _ros2_bridge(args: argparse.Namespace, stack: Any) -> Any:
 
     section = stack.ros2
     if not (args.ros2 or section.enabled):
-        if args.ros2_domain is not None or args.ros2_inputs:
-            raise ConfigFileError("--ros2-domain/--ros2-in: only with --ros2")
+        flags = {
+            "--ros2-domain": args.ros2_domain is not None,
+            "--ros2-in": bool(args.ros2_inputs),
+            "--lockstep": args.lockstep is not None,
+            "--ros2-wait": args.ros2_wait is not None,
+        }
+        given = [flag for flag, used in flags.items() if used]
+        if given:
+            raise ConfigFileError(f"{'/'.join(given)}: only with --ros2")
         return None
     from otonav.ros2 import Ros2Error, bridge_for
 
+    section = _ros2_section(args, section)
     try:
         bridge = bridge_for(section, domain_id=args.ros2_domain, inputs=args.ros2_inputs or ())
     except Ros2Error as exc:
         raise ConfigFileError(str(exc)) from None
+    options = bridge.options
+    if options.lockstep:
+        answers = ", ".join(f"{name} every {period:g} s" for name, period in options.lockstep)
+        timing = f"in lockstep: sim time waits for {answers}"
+    else:
+        timing = "paced to the wall clock"
     print(
         f"ros2: every topic on DDS domain {bridge.domain_id} (rt/odom ...), seen from "
-        f"{bridge.discovery.scope}; taking {', '.join(bridge.options.inputs)} in; paced to the "
-        "wall clock",
+        f"{bridge.discovery.scope}; taking {', '.join(options.inputs)} in; {timing}",
         file=sys.stderr,
         flush=True,
     )
     return bridge
+
+
+def _ros2_section(args: argparse.Namespace, section: Any) -> Any:
+    """The stack's ``ros2`` section with ``--lockstep`` and ``--ros2-wait`` applied, checked
+    as the config is (one line naming the flag and what is valid)."""
+    from pydantic import ValidationError
+
+    from otonav.stack.config import Ros2Config
+    from otonav.stack.files import ConfigFileError, describe_validation_error
+
+    update: dict[str, Any] = {}
+    given = [value for value in args.lockstep or () if value]
+    if given:
+        answers = []
+        for value in given:
+            topic, _, period = value.rpartition(":")
+            try:
+                answers.append({"topic": topic, "period": float(period)})
+            except ValueError:
+                raise ConfigFileError(
+                    f"--lockstep {value}: expected TOPIC:PERIOD, e.g. /cmd_vel_nav:0.05"
+                ) from None
+        update["lockstep"] = tuple(answers)
+    elif args.lockstep is not None and not section.lockstep:
+        raise ConfigFileError(
+            "--lockstep: say what your nodes answer with, e.g. --lockstep /cmd_vel_nav:0.05 "
+            "(or ros2.lockstep in the stack config)"
+        )
+    if args.ros2_wait is not None:
+        update["wait"] = args.ros2_wait
+    lockstep = update.get("lockstep", section.lockstep)
+    if lockstep and update.get("wait", section.wait) is None:
+        update["wait"] = 30.0  # a node started a moment later must not miss the start
+    if not update:
+        return section
+    flag = "--lockstep" if "lockstep" in update else "--ros2-wait"
+    try:
+        return Ros2Config.model_validate({**section.model_dump(), **update})
+    except ValidationError as exc:
+        raise ConfigFileError(describe_validation_error(flag, exc)) from None

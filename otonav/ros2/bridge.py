@@ -15,12 +15,21 @@ ROS 2 publisher offers by default (reliable, volatile), so ``ros2 topic pub`` an
 match it; a best-effort publisher does not (ROS 2's rule).
 
 Time: the bridge works on either loop; ``otonav run --ros2`` paces it to the wall clock
-(docs/adr/0047). With ``wait_for_peers`` the start holds sim time until DDS peers are
-matched, so a virtual-time run (a test) does not race past them.
+(docs/adr/0047). With ``wait_for_peers`` (``--ros2-wait``) the start holds sim time until
+DDS peers are matched, so neither a virtual-time run (a test) nor a node started a
+moment later races past them.
+
+Lockstep (``Ros2Options.lockstep``, virtual time only; docs/adr/0065): ROS 2 nodes run
+in otonav's time, as fast as they can follow. /clock is written to DDS last at each
+instant, once every other actor has published what it had for that instant (the loop's
+idle watcher); at each instant where a declared answer is due (``period`` multiples),
+sim time holds until a new sample arrived on each due topic, then takes it in, or the
+run fails after ``lockstep_timeout`` wall seconds naming the topic nobody answered.
 """
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import math
 import os
@@ -31,7 +40,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import anyio
 
 from otonav.actors import topics
-from otonav.msgs import Log, Message, Time
+from otonav.msgs import Clock, Log, Message, Time
 from otonav.record.cdr import encode
 from otonav.record.cdr_decode import decode
 from otonav.ros2.naming import (
@@ -50,7 +59,11 @@ if TYPE_CHECKING:
     from otonav.ros2.dds import Participant, RawReader, RawWriter
     from otonav.stack.config import Ros2Config
 
-__all__ = ("Ros2Bridge", "Ros2Options", "Ros2Statistics", "bridge_for")
+__all__ = ("LockstepTimeout", "Ros2Bridge", "Ros2Options", "Ros2Statistics", "bridge_for")
+
+
+class LockstepTimeout(RuntimeError):
+    """A ROS 2 node did not answer within ``lockstep_timeout``: the run fails with it."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -66,8 +79,14 @@ class Ros2Options:
     period: float = 0.01
     """s of sim time between two reads of the inputs."""
     wait_for_peers: float | None = None
-    """Hold sim time at the start until every input has a DDS publisher and some output
-    a DDS subscriber, for at most this many wall seconds (None: do not wait)."""
+    """Hold sim time at the start until a ROS 2 node subscribed to an output or publishes
+    an input (in lockstep: every answer has a publisher and /clock a subscriber), then
+    until no endpoint matched for 0.5 s (discovery settled), for at most this many wall
+    seconds each (None: do not wait)."""
+    lockstep: tuple[tuple[str, float], ...] = ()
+    """(topic, period): the answers of ROS 2 nodes in lockstep (empty: no lockstep)."""
+    lockstep_timeout: float = 5.0
+    """Wall seconds a node may take to answer in lockstep."""
 
     def __post_init__(self) -> None:
         if not (self.period > 0 and math.isfinite(self.period)):
@@ -81,6 +100,17 @@ class Ros2Options:
                     dds_topic(name)
                 except Ros2Error as exc:
                     raise Ros2Error(f"{key} {exc}") from None
+        for name, period in self.lockstep:
+            if name not in self.inputs:
+                raise Ros2Error(
+                    f"ros2.lockstep {name}: not an input of the bridge, so no node can answer "
+                    f"on it; add --ros2-in {name} (inputs: {', '.join(self.inputs)})"
+                )
+            if not (period > 0 and math.isfinite(period)):
+                raise Ros2Error(f"ros2.lockstep {name}: period {period}: must be > 0 s")
+        timeout = self.lockstep_timeout
+        if not (timeout > 0 and math.isfinite(timeout)):
+            raise Ros2Error(f"ros2.lockstep_timeout {timeout}: must be a number of seconds > 0")
 
 
 class Ros2Statistics(NamedTuple):
@@ -98,32 +128,45 @@ class Ros2Statistics(NamedTuple):
     """Messages from DDS that did not decode as the topic's type, or found it full."""
 
 
+_DISCOVERY_QUIET = 0.5
+"""Wall seconds without a new DDS match before a lockstep run starts."""
+
 _MIRROR_QOS = QoS(Reliability.BEST_EFFORT, depth=1)
 """Matches every publisher (ROS 2 rules): mirroring never makes wiring fail."""
 
 
 class _Mirror(Subscription[Any]):
-    """A mailbox that writes each message to its DDS topic as it is published."""
+    """A mailbox that writes each message to its DDS topic as it is published (or, when
+    ``deferred``, keeps the latest for the bridge to write once the instant settled)."""
 
-    __slots__ = ("latched", "refused", "sent", "unread", "writer")
+    __slots__ = ("deferred", "latched", "offered", "pending", "refused", "sent", "unread", "writer")
 
     def __init__(self, topic: Topic[Any], endpoint: Endpoint) -> None:
         super().__init__(topic.name, topic.msg_type, _MIRROR_QOS, endpoint)
         self.writer: RawWriter | None = None
+        self.offered: QoS | None = None
+        """The QoS the writer offers: the topic's publishers' when it was made."""
         self.latched = False
+        self.deferred = False
+        self.pending: Any = None
         self.sent = self.unread = self.refused = 0
 
     def _offer(self, message: Any) -> bool:
         self.received += 1
+        if self.deferred:
+            self.pending = message
+        else:
+            self.write(message)
+        return True
+
+    def write(self, message: Any) -> None:
         writer = self.writer
         if writer is None or not (writer.matched.count or self.latched):
             self.unread += 1
-            return True
-        if writer.write(encode(message)):
+        elif writer.write(encode(message)):
             self.sent += 1
         else:
             self.refused += 1
-        return True
 
     def _full(self) -> bool:
         return False
@@ -175,6 +218,14 @@ class Ros2Bridge(Actor):
         self._started = False
         self.received = 0
         self.rejected = 0
+        self._clock_mirror: _Mirror | None = None
+        self._armed: asyncio.Event | None = None
+        """Set by the idle watcher once a lockstep instant settled and /clock was written."""
+        self._baselines: list[int] = []
+        """Each input's DDS arrivals just before the armed instant's /clock was written."""
+        self._remove_watcher: Any = None
+        self._unmatched = ""
+        """The warning of a wait for peers that timed out, logged once the run starts."""
 
     # -- wiring -----------------------------------------------------------------------
 
@@ -194,6 +245,15 @@ class Ros2Bridge(Actor):
         for topic in list(bus.topics.values()):
             self._mirror(topic)
         bus.add_topic_listener(self._mirror)
+        if self.options.lockstep:
+            clock = self._mirrors.get(topics.CLOCK)
+            if clock is None:
+                raise Ros2Error("ros2.lockstep: the system publishes no /clock to step by")
+            clock.deferred = True  # written last at each instant: _settled
+            self._clock_mirror = clock
+        if self.options.wait_for_peers is not None:
+            self._open_endpoints()
+            self._wait_for_peers(self.options.wait_for_peers)
 
     def _mirror(self, topic: Topic[Any]) -> None:
         outputs = self.options.outputs
@@ -206,43 +266,155 @@ class Ros2Bridge(Actor):
             self._open_writer(topic, mirror)
 
     def _open_writer(self, topic: Topic[Any], mirror: _Mirror) -> None:
-        qos = _offered(topic)
+        qos = mirror.offered = _offered(topic)
         mirror.latched = qos.durability is Durability.TRANSIENT_LOCAL
-        mirror.writer = self.participant.writer(
-            dds_topic(topic.name), topic.msg_type, dds_qos(qos, topic.msg_type)
-        )
+        policy = dds_qos(qos, topic.msg_type)
+        mirror.writer = self.participant.writer(dds_topic(topic.name), topic.msg_type, policy)
         for publisher in topic.publishers:  # what a latched publisher already kept
             for message in publisher._history or ():
                 mirror._offer(message)
 
     # -- running ----------------------------------------------------------------------
 
-    async def on_start(self) -> None:
+    def _open_endpoints(self) -> None:
+        """Make the DDS writers and readers not made yet: from then on, discovery runs.
+        While wiring (``--ros2-wait``), a topic nobody publishes yet gets its writer only
+        when the run starts, once its publisher (the scenario's /goal) says what it offers."""
         bus = self._bus
         assert bus is not None, "on_wired comes first"
-        self._started = True
+        wiring = not self._started
         for name, mirror in self._mirrors.items():
-            self._open_writer(bus.topics[name], mirror)
+            topic = bus.topics[name]
+            if mirror.writer is None and (topic.publishers or not wiring):
+                self._open_writer(topic, mirror)
         for entry in self._inputs:
-            entry.reader = self.participant.reader(dds_topic(entry.name), entry.msg_type, entry.qos)
-        wait = self.options.wait_for_peers
-        # A worker thread waits; sim time holds still meanwhile (run_blocking).
-        if wait is not None and not await run_blocking(
-            self.participant.wait, self._peers_matched, wait
-        ):
-            self._log(Log.WARN, f"no ROS 2 peer matched within {wait:g} s; going on")
+            if entry.reader is None:
+                entry.reader = self.participant.reader(
+                    dds_topic(entry.name), entry.msg_type, entry.qos
+                )
+
+    def _wait_for_peers(self, wait: float) -> None:
+        """Block until the ROS 2 nodes matched (:meth:`_peers_matched`), then until no
+        other endpoint matched for a moment: a node's endpoints match one by one, and a
+        sample written before its reader matched is lost to it (in lockstep, its first
+        answers would differ from run to run). Called while wiring, before the system
+        runs, so sim time holds in every time mode (a real-time clock would run on)."""
+        if not self.participant.wait(self._peers_matched, wait):
+            self._unmatched = f"no ROS 2 peer matched within {wait:g} s; going on"
+        else:
+            self.participant.wait_quiet(_DISCOVERY_QUIET, wait)
+
+    def _reoffer(self) -> None:
+        """Writers made while wiring (``--ros2-wait``) offered what the topic's
+        publishers offered then; a publisher made since (the scenario's latched /goal)
+        may offer otherwise: such a writer is made again, with that QoS. The nodes'
+        readers are known by now, so it matches them at once."""
+        bus = self._bus
+        assert bus is not None
+        for name, mirror in self._mirrors.items():
+            topic = bus.topics[name]
+            if mirror.writer is not None and _offered(topic) != mirror.offered:
+                self.participant.drop(mirror.writer)
+                self._open_writer(topic, mirror)
+
+    async def on_start(self) -> None:
+        self._reoffer()
+        self._started = True
+        self._open_endpoints()
+        if self._unmatched:
+            self._log(Log.WARN, self._unmatched)
+        if self.options.lockstep:
+            add_watcher = getattr(asyncio.get_running_loop(), "add_idle_watcher", None)
+            if add_watcher is None:
+                raise Ros2Error(
+                    "ros2.lockstep: needs the virtual-time loop (not with --realtime or --gui)"
+                )
+            self._remove_watcher = add_watcher(self._settled)
 
     def _peers_matched(self) -> bool:
-        inputs = all(e.reader is not None and e.reader.matched.count for e in self._inputs)
+        if self.options.lockstep:
+            answers = {name for name, _period in self.options.lockstep}
+            clock = self._clock_mirror
+            writer = clock.writer if clock is not None else None
+            return all(
+                e.reader is not None and e.reader.matched.count
+                for e in self._inputs
+                if e.name in answers
+            ) and (writer is not None and writer.matched.count > 0)
+        inputs = any(e.reader is not None and e.reader.matched.count for e in self._inputs)
         outputs = any(
             m.writer is not None and m.writer.matched.count for m in self._mirrors.values()
         )
-        return inputs and (outputs or not self._mirrors)
+        return inputs or outputs
 
     async def run(self) -> None:
+        if self.options.lockstep:
+            await self._run_lockstep()
         rate = self.clock.rate(1.0 / self.options.period)
         while True:
             await rate.sleep()
+            self.take_inputs()
+
+    # -- lockstep -----------------------------------------------------------------------
+
+    def _settled(self) -> bool:
+        """The loop's idle watcher in lockstep: every actor has done what it had for this
+        instant. Write its /clock now, last, so a node's timer that this /clock fires sees
+        the instant's /odom and /scan first; on an armed instant, note each input's
+        arrivals first, then wake :meth:`_run_lockstep`. Never removed (returns False)."""
+        mirror = self._clock_mirror
+        if mirror is None:
+            return False
+        armed = self._armed
+        if armed is not None and not armed.is_set():
+            self._baselines = [e.reader.arrivals if e.reader else 0 for e in self._inputs]
+            if mirror.pending is None:  # an answer due between two /clock ticks
+                mirror.pending = Clock(clock=Time.from_seconds(self.clock.now()))
+            armed.set()
+        if mirror.pending is not None:
+            message, mirror.pending = mirror.pending, None
+            mirror.write(message)
+        return False
+
+    async def _run_lockstep(self) -> None:
+        clock = self.clock
+        entries = [
+            (next(e for e in self._inputs if e.name == name), period)
+            for name, period in self.options.lockstep
+        ]
+        counts = [0] * len(entries)
+        timeout = self.options.lockstep_timeout
+        while True:
+            dues = [(counts[i] + 1) * period for i, (_e, period) in enumerate(entries)]
+            at = min(dues)
+            await clock.sleep_until(at)
+            due = [i for i, when in enumerate(dues) if when <= at + 1e-9]
+            for i in due:
+                counts[i] += 1
+            armed = self._armed = asyncio.Event()
+            await armed.wait()  # set by _settled once this instant's /clock is out
+            waiting = [
+                (entries[i][0], self._baselines[self._inputs.index(entries[i][0])], entries[i][1])
+                for i in due
+            ]
+
+            def answered(waiting: list[tuple[_Input, int, float]] = waiting) -> bool:
+                return self.participant.closed or all(
+                    e.reader is not None and e.reader.arrivals > base for e, base, _p in waiting
+                )
+
+            if not await run_blocking(self.participant.wait, answered, timeout):
+                silent = [
+                    (e, p) for e, base, p in waiting if e.reader and e.reader.arrivals <= base
+                ]
+                entry, period = silent[0] if silent else (waiting[0][0], waiting[0][2])
+                publishers = entry.reader.matched.count if entry.reader else 0
+                raise LockstepTimeout(
+                    f"lockstep: no ROS 2 node answered on {entry.name} within {timeout:g} s "
+                    f"(wall) of /clock {clock.now():.3f} s ({publishers} DDS publisher(s) "
+                    f"matched; a node must publish it every {period:g} s of its use_sim_time "
+                    "clock)"
+                )
             self.take_inputs()
 
     def take_inputs(self) -> None:
@@ -267,6 +439,8 @@ class Ros2Bridge(Actor):
                     self._log(Log.WARN, f"{entry.name}: a ROS 2 message dropped (full)")
 
     async def on_stop(self) -> None:
+        if self._remove_watcher is not None:
+            self._remove_watcher()
         self.close()
 
     def close(self) -> None:
@@ -307,5 +481,8 @@ def bridge_for(
     options = Ros2Options(
         domain_id=domain_id if domain_id is not None else section.domain_id,
         inputs=tuple(inputs or section.inputs),
+        wait_for_peers=section.wait,
+        lockstep=tuple((answer.topic, answer.period) for answer in section.lockstep),
+        lockstep_timeout=section.lockstep_timeout,
     )
     return Ros2Bridge(options, env=env)

@@ -100,9 +100,11 @@ def _qos(policy: DdsQos, *, reader: bool) -> Any:
         ]
     else:
         policies.append(Policy.Durability.Volatile)
-    if reader:
-        policies.append(Policy.IgnoreLocal.Participant)  # never hear our own writers
-    else:
+    # Never match our own endpoints, on either side: a writer matched by the bridge's own
+    # reader of the same topic (/goal is both an input and mirrored) counted as a peer,
+    # and --ros2-wait let the run start before any node had matched.
+    policies.append(Policy.IgnoreLocal.Participant)
+    if not reader:
         policies.append(Policy.WriterDataLifecycle(autodispose=False))
     return Qos(*policies)
 
@@ -206,6 +208,12 @@ class Participant:
         writer = RawWriter(self._participant, self._topic(name, message), policy, self.changed)
         self._made.append(writer._writer)
         return writer
+
+    def drop(self, writer: RawWriter) -> None:
+        """Delete ``writer`` now (its readers see it go)."""
+        if writer._writer in self._made:
+            self._made.remove(writer._writer)
+            writer._writer.__del__()
 
     def reader(self, name: str, message: type[Message], policy: DdsQos) -> RawReader:
         reader = RawReader(self._participant, self._topic(name, message), policy, self.changed)

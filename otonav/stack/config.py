@@ -562,6 +562,19 @@ class ActorConfig(_Section):
     )
 
 
+_TOPIC_NAME = r"^(/[A-Za-z_][A-Za-z0-9_]*)+$"
+
+
+class LockstepAnswer(_Section):
+    """One thing your ROS 2 nodes answer with in lockstep (ADR 0065): ``topic`` is
+    published once every ``period`` s of sim time, after the node's /clock reaches it."""
+
+    topic: Annotated[str, Field(pattern=_TOPIC_NAME)]
+    """A topic a ROS 2 node publishes into the stack (one of ``inputs``)."""
+    period: float = Field(gt=0.0, le=60.0)
+    """s of sim time between two answers (the node's timer: 0.05 for 20 Hz), in (0, 60]."""
+
+
 class Ros2Config(_Section):
     """ROS 2 over DDS (``otonav run --ros2``, the extra ``otonav[ros2]``; ADR 0047)."""
 
@@ -569,8 +582,17 @@ class Ros2Config(_Section):
     """Mirror every topic on DDS as a ROS 2 node would, and take ``inputs`` in."""
     domain_id: int | None = Field(None, ge=0, le=232)
     """DDS domain (null: ``ROS_DOMAIN_ID``, else 0)."""
-    inputs: tuple[Annotated[str, Field(pattern=r"^(/[A-Za-z_][A-Za-z0-9_]*)+$")], ...] = ("/goal",)
+    inputs: tuple[Annotated[str, Field(pattern=_TOPIC_NAME)], ...] = ("/goal",)
     """Topics ROS 2 nodes may publish into the stack (e.g. add ``/cmd_vel_nav``)."""
+    lockstep: tuple[LockstepAnswer, ...] = ()
+    """What your nodes answer with, for ``--lockstep`` (e.g. ``[{topic: /cmd_vel_nav,
+    period: 0.05}]``): sim time holds at each due instant until the answer came."""
+    lockstep_timeout: float = Field(5.0, gt=0.0, le=3600.0)
+    """s of wall time a node may take to answer in lockstep before the run fails, in
+    (0, 3600]."""
+    wait: float | None = Field(None, gt=0.0, le=3600.0)
+    """s of wall time, at most, that sim time holds at 0 until the ROS 2 nodes matched
+    (``--ros2-wait``; null: do not wait, or 30 s in lockstep), in (0, 3600]."""
 
 
 class StackConfig(_Section):

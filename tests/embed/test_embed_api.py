@@ -19,7 +19,7 @@ from otonav.embed import (
     open_live_stack,
     run_scenario_async,
 )
-from otonav.msgs import Odometry, PoseStamped
+from otonav.msgs import LaserScan, Odometry, PoseStamped
 from otonav.record.reader import read_messages, summarize
 from otonav.runtime import (
     LATCHED_QOS,
@@ -61,9 +61,9 @@ async def test_live_stack_on_the_host_loop(tmp_path: Path) -> None:
             assert _host_subscribers(live, topics.ODOM) == 1
             # Wiring checks hold for the host too: QoS and type, at subscribe time.
             # The default is reliable, as System.subscribe's (ADR 0056): refused on
-            # best-effort /odom, naming the fix.
-            with pytest.raises(QoSIncompatibleError, match=r"/odom.*SENSOR_DATA_QOS"):
-                live.subscribe(topics.ODOM, Odometry)
+            # best-effort /scan, naming the fix. (/odom is reliable, as ROS 2 offers it.)
+            with pytest.raises(QoSIncompatibleError, match=r"/scan.*SENSOR_DATA_QOS"):
+                live.subscribe(topics.SCAN, LaserScan)
             with pytest.raises(TopicTypeError, match="/odom"):
                 live.subscribe(topics.ODOM, PoseStamped)
 

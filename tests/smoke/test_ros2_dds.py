@@ -15,6 +15,7 @@ from pathlib import Path
 
 import anyio
 import pytest
+from dds_domain import exclusive_domain
 
 from otonav.embed import open_live_stack
 from otonav.ros2 import Ros2Bridge, Ros2Options
@@ -29,15 +30,14 @@ CEILING = 60.0
 GOAL = (1.0, 0.3)
 
 
-def _domain() -> int:
-    """A domain of this test run's own: concurrent gates on this machine never meet."""
-    return 100 + os.getpid() % 100
-
-
 @pytest.mark.parametrize("way", ["extra_actor", "embedding_option"])
 @pytest.mark.asyncio
 async def test_a_ros2_node_reads_odom_and_sends_a_goal_that_is_reached(way: str) -> None:
-    domain = _domain()
+    with exclusive_domain() as domain:
+        await _reads_odom_and_sends_a_goal(way, domain)
+
+
+async def _reads_odom_and_sends_a_goal(way: str, domain: int) -> None:
     env = {k: v for k, v in os.environ.items() if not k.startswith(("ROS_", "CYCLONEDDS"))}
     peer = subprocess.Popen(  # noqa: ASYNC220 (started once, before the stack; not awaited)
         [sys.executable, str(PEER), str(domain), str(GOAL[0]), str(GOAL[1]), "40"],

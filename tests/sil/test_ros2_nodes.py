@@ -1,0 +1,136 @@
+"""Real ROS 2 nodes against ``otonav run --ros2`` (issue 37): Jazzy's and Kilted's rclpy
+on Fast DDS, from PyPI, each in its own venv (``make ros2-peers``), in processes of their
+own. Every test runs against both distros. The nodes import no otonav (tests/ros2/).
+
+Nothing here waits on a wall-clock duration: a peer says ``ready`` once it exists, the
+bridge holds sim time until it matched (``--ros2-wait``/lockstep), and each process ends
+on its own; the ``timeout`` of ``communicate`` only catches a hang.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import pytest
+from dds_domain import exclusive_domain
+
+from otonav.record.reader import read_messages, summarize
+
+pytestmark = pytest.mark.sil
+
+ROOT = Path(__file__).resolve().parents[2]
+NODES = ROOT / "tests" / "ros2"
+DISTROS = ["jazzy", "kilted"]
+HANG = 120.0
+"""Wall seconds: a hang, never a timing assertion."""
+
+
+def _python(distro: str) -> Path:
+    python = ROOT / ".venvs" / f"ros2-{distro}" / "bin" / "python"
+    assert python.exists(), f"{python} is missing: `make ros2-peers` installs it (make test does)"
+    return python
+
+
+def _env(domain: int) -> dict[str, str]:
+    """This environment without any DDS, ROS or library-path setting of its own (the ROS
+    wheels' bootstrap sets LD_LIBRARY_PATH for their own venv), on ``domain``, localhost."""
+    dropped = ("ROS_", "RMW_", "CYCLONEDDS", "_ROS_WHEELS", "AMENT_")
+    env = {
+        key: value
+        for key, value in os.environ.items()
+        if not key.startswith(dropped) and key not in ("LD_LIBRARY_PATH", "PYTHONPATH")
+    }
+    env |= {"ROS_DOMAIN_ID": str(domain), "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
+    return env
+
+
+@contextmanager
+def _process(argv: list[str], env: dict[str, str]) -> Iterator[subprocess.Popen[str]]:
+    proc = subprocess.Popen(
+        argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT
+    )
+    try:
+        yield proc
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        proc.communicate()
+
+
+def _otonav(*args: str) -> list[str]:
+    return [sys.executable, "-m", "otonav", "run", "--ros2", *args]
+
+
+@pytest.mark.timeout(180)
+@pytest.mark.parametrize("distro", DISTROS)
+def test_a_plain_rclpy_node_receives_odom_scan_imu_and_clock_with_the_qos_it_asks(
+    tmp_path: Path, distro: str
+) -> None:
+    """/odom subscribed ``(…, 10)`` (reliable, as diff_drive_controller offers it), /scan
+    and /imu with the sensor-data profile, /clock through use_sim_time: every one
+    arrives, and rclpy reports no incompatible QoS. The run is paced (plain --ros2)."""
+    scenario = tmp_path / "short.yaml"
+    scenario.write_text("name: short\nscene: empty\ngoal: {x: 3.0, y: 0.0}\nsim_budget: 3.0\n")
+    with exclusive_domain() as domain:
+        env = _env(domain)
+        peer_argv = [str(_python(distro)), str(NODES / "qos_peer.py"), "2.0"]
+        with _process(peer_argv, env) as peer:
+            assert peer.stdout is not None
+            assert peer.stdout.readline().strip() == "ready"
+            run = _otonav(
+                "--ros2-wait", "60", "--scale", "4", "--scenario", str(scenario),
+                "--no-record", "--out", str(tmp_path / "out"),
+            )  # fmt: skip
+            with _process(run, env) as otonav:
+                out, err = peer.communicate(timeout=HANG)
+                otonav.communicate(timeout=HANG)
+    assert peer.returncode == 0, err
+    report = json.loads(out.strip().splitlines()[-1])
+    assert report["problems"] == []
+    assert report["ros_time"] >= 2.0  # its clock followed /clock
+    counts = report["counts"]
+    # 2 s of sim time: /odom and /imu at 50 Hz, /scan at 10 Hz (best effort may lose a few)
+    assert counts["/odom"] >= 90, counts
+    assert counts["/imu"] >= 80, counts
+    assert counts["/scan"] >= 15, counts
+
+
+@pytest.mark.timeout(180)
+@pytest.mark.parametrize("distro", DISTROS)
+def test_an_unmodified_rclpy_go_to_goal_node_passes_the_acceptance_scenario_in_lockstep(
+    tmp_path: Path, distro: str
+) -> None:
+    """use_sim_time, a 20 Hz timer, /odom + /scan in, /cmd_vel_nav out: otonav holds sim
+    time at each 0.05 s until the node answered, and the run is judged on ground truth
+    (the node publishes no NavState). Started before the node, as a user would."""
+    out = tmp_path / "out"
+    with exclusive_domain() as domain:
+        env = _env(domain)
+        run = _otonav(
+            "--ros2-in", "/cmd_vel_nav", "--lockstep", "/cmd_vel_nav:0.05",
+            "--set", "nav.planner=external", "--out", str(out),
+        )  # fmt: skip
+        with _process(run, env) as otonav:
+            node_argv = [
+                str(_python(distro)), str(NODES / "go_to_goal.py"),
+                "--ros-args", "-p", "use_sim_time:=true",
+            ]  # fmt: skip
+            with _process(node_argv, env):
+                _stdout, err = otonav.communicate(timeout=HANG)
+    assert otonav.returncode == 0, err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["passed"], summary
+    assert summary["time_to_goal_s"] < 20.0
+    recording = out / "recording.mcap"
+    assert not summarize(recording).truncated
+    answers = [t for _topic, t, _m in read_messages(recording, ["/cmd_vel_nav"])]
+    # one answer per 0.05 s instant, each taken in at that instant of sim time
+    assert len(answers) >= summary["time_to_goal_s"] / 0.05
+    assert all(abs(t / 0.05 - round(t / 0.05)) < 1e-6 for t in answers), answers[:5]
+    assert answers[:3] == pytest.approx([0.05, 0.10, 0.15])
