@@ -279,10 +279,6 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
     server, extra = _live_view(args)
     bridge = _ros2_bridge(args, stack)
     lockstep = bridge is not None and bool(bridge.options.lockstep)
-    if lockstep and (args.realtime or args.gui or args.scale is not None):
-        raise ConfigFileError(
-            "--lockstep: not with --realtime, --gui or --scale (sim time follows the nodes)"
-        )
     if bridge is not None:
         extra = (*extra, bridge)
     console = make_console()
@@ -495,6 +491,10 @@ def _ros2_section(args: argparse.Namespace, section: Any) -> Any:
     if args.ros2_wait is not None:
         update["wait"] = args.ros2_wait
     lockstep = update.get("lockstep", section.lockstep)
+    if lockstep and (args.realtime or args.gui or args.scale is not None):
+        raise ConfigFileError(
+            "--lockstep: not with --realtime, --gui or --scale (sim time follows the nodes)"
+        )
     if lockstep and update.get("wait", section.wait) is None:
         update["wait"] = 30.0  # a node started a moment later must not miss the start
     if not update:
