@@ -33,6 +33,7 @@ import asyncio
 import contextlib
 import math
 import os
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, NamedTuple
@@ -56,7 +57,7 @@ from otonav.runtime import Actor, Bus, Durability, Output, QoS, Reliability, run
 from otonav.runtime.mailbox import Endpoint, Publisher, Subscription, Topic
 
 if TYPE_CHECKING:
-    from otonav.ros2.dds import Participant, RawReader, RawWriter
+    from otonav.ros2.dds import GraphWriter, Participant, RawReader, RawWriter
     from otonav.stack.config import Ros2Config
 
 __all__ = ("LockstepTimeout", "Ros2Bridge", "Ros2Options", "Ros2Statistics", "bridge_for")
@@ -225,6 +226,7 @@ class Ros2Bridge(Actor):
         """Each input's DDS arrivals just before the armed instant's /clock was written."""
         self._remove_watcher: Any = None
         self._unmatched = ""
+        self._graph: GraphWriter | None = None
         """The warning of a wait for peers that timed out, logged once the run starts."""
 
     # -- wiring -----------------------------------------------------------------------
@@ -264,6 +266,7 @@ class Ros2Bridge(Actor):
         self._mirrors[topic.name] = mirror
         if self._bus is not None and self._started:
             self._open_writer(topic, mirror)
+            self._announce()
 
     def _open_writer(self, topic: Topic[Any], mirror: _Mirror) -> None:
         qos = mirror.offered = _offered(topic)
@@ -317,10 +320,40 @@ class Ros2Bridge(Actor):
                 self.participant.drop(mirror.writer)
                 self._open_writer(topic, mirror)
 
+    def _announce(self) -> None:
+        """Every actor as a ROS 2 node on ``ros_discovery_info``, owning the DDS writer of
+        each topic it publishes and the DDS reader of each input it subscribes to (the
+        bridge: its inputs' readers), so ``ros2 node list`` and
+        ``get_publisher_names_and_types_by_node`` show the stack as nodes."""
+        bus = self._bus
+        if bus is None or self._graph is None:
+            return
+        readers: dict[str, list[RawReader]] = {self.name: []}
+        writers: dict[str, list[RawWriter]] = {self.name: []}
+        inputs = {e.name: e.reader for e in self._inputs if e.reader is not None}
+        for name, topic in bus.topics.items():
+            mirror = self._mirrors.get(name)
+            for publisher in topic.publishers:
+                owned = writers.setdefault(publisher.endpoint.actor, [])
+                if mirror is not None and mirror.writer is not None:
+                    owned.append(mirror.writer)
+                readers.setdefault(publisher.endpoint.actor, [])
+            for subscription in topic.subscriptions:
+                actor = subscription.endpoint.actor
+                writers.setdefault(actor, [])
+                owned_readers = readers.setdefault(actor, [])
+                if name in inputs and actor != self.name:
+                    owned_readers.append(inputs[name])
+        readers[self.name] += inputs.values()
+        nodes = [("/", _node_name(actor), readers[actor], writers[actor]) for actor in writers]
+        self._graph.publish(nodes)
+
     async def on_start(self) -> None:
         self._reoffer()
         self._started = True
         self._open_endpoints()
+        self._graph = self.participant.graph()
+        self._announce()
         if self._unmatched:
             self._log(Log.WARN, self._unmatched)
         if self.options.lockstep:
@@ -467,6 +500,12 @@ class Ros2Bridge(Actor):
             received=self.received,
             rejected=self.rejected,
         )
+
+
+def _node_name(actor: str) -> str:
+    """A ROS 2 node name for an actor (letters, digits and underscores, not a digit first)."""
+    name = re.sub(r"[^A-Za-z0-9_]", "_", actor)
+    return name if name and not name[0].isdigit() else f"_{name}"
 
 
 def bridge_for(

@@ -38,7 +38,7 @@ from otonav.msgs import Message
 from otonav.record.schemas import SEQUENCE, layout_for
 from otonav.ros2.naming import DdsQos, dds_type_name
 
-__all__ = ("Participant", "RawReader", "RawWriter", "idl_type")
+__all__ = ("GraphWriter", "Participant", "RawReader", "RawWriter", "idl_type")
 
 _PRIMITIVES: Final[dict[str, Any]] = {
     "bool": bool,
@@ -184,6 +184,76 @@ class RawReader:
         return [bytes(data) for data, info in taken if info.valid_data]
 
 
+_GID: Final = make_idl_struct(
+    "Gid", "rmw_dds_common::msg::dds_::Gid_", {"data": t.array[t.uint8, 16]}
+)
+_NODE: Final = make_idl_struct(
+    "NodeEntitiesInfo",
+    "rmw_dds_common::msg::dds_::NodeEntitiesInfo_",
+    {
+        "node_namespace": t.bounded_str[256],
+        "node_name": t.bounded_str[256],
+        "reader_gid_seq": t.sequence[_GID],
+        "writer_gid_seq": t.sequence[_GID],
+    },
+)
+_PARTICIPANT_INFO: Final = make_idl_struct(
+    "ParticipantEntitiesInfo",
+    "rmw_dds_common::msg::dds_::ParticipantEntitiesInfo_",
+    {"gid": _GID, "node_entities_info_seq": t.sequence[_NODE]},
+)
+_PARTICIPANT_INFO_HASH: Final = (
+    b"typehash=RIHS01_91a0593bacdcc50ea9bdcf849a938b128412cc1ea821245c663bcd26f83c295e;"
+)
+"""rmw_dds_common/msg/ParticipantEntitiesInfo's type hash (the same in Jazzy and Kilted)."""
+
+Node = tuple[str, str, list["RawReader"], list["RawWriter"]]
+"""(namespace, name, its readers, its writers)."""
+
+
+def _gid(entity: Any) -> Any:
+    return _GID(data=list(entity.guid.bytes))  # the 16-byte DDS GUID, as both rmws
+
+
+class GraphWriter:
+    """``ros_discovery_info``: which ROS 2 nodes this participant holds and which of its
+    endpoints belong to each (rmw_dds_common's ParticipantEntitiesInfo; reliable,
+    transient local, keep last 1, as rmw_fastrtps and rmw_cyclonedds write it). It is
+    how ``get_node_names_and_namespaces()`` and ``ros2 node list`` see nodes."""
+
+    def __init__(self, participant: Any, made: list[Any]) -> None:
+        self._participant = participant
+        topic = Topic(participant, "ros_discovery_info", _PARTICIPANT_INFO)
+        qos = Qos(
+            Policy.Reliability.Reliable(dds_infinity),
+            Policy.Durability.TransientLocal,
+            Policy.DurabilityService(0, Policy.History.KeepLast(1), -1, -1, -1),
+            Policy.History.KeepLast(1),
+            Policy.Userdata(_PARTICIPANT_INFO_HASH),
+            Policy.DataRepresentation(use_cdrv0_representation=True),
+            Policy.IgnoreLocal.Participant,
+        )
+        self._writer = DataWriter(participant, topic, qos=qos)
+        made += [topic, self._writer]
+
+    def publish(self, nodes: list[Node]) -> None:
+        """Announce ``nodes`` (replacing what was announced before)."""
+        self._writer.write(
+            _PARTICIPANT_INFO(
+                gid=_gid(self._participant),
+                node_entities_info_seq=[
+                    _NODE(
+                        node_namespace=namespace,
+                        node_name=name,
+                        reader_gid_seq=[_gid(reader._reader) for reader in readers],
+                        writer_gid_seq=[_gid(writer._writer) for writer in writers],
+                    )
+                    for namespace, name, readers, writers in nodes
+                ],
+            )
+        )
+
+
 class Participant:
     """One DDS domain participant: its topics, writers and readers."""
 
@@ -208,6 +278,10 @@ class Participant:
         writer = RawWriter(self._participant, self._topic(name, message), policy, self.changed)
         self._made.append(writer._writer)
         return writer
+
+    def graph(self) -> GraphWriter:
+        """The writer of ``ros_discovery_info`` (see :class:`GraphWriter`)."""
+        return GraphWriter(self._participant, self._made)
 
     def drop(self, writer: RawWriter) -> None:
         """Delete ``writer`` now (its readers see it go)."""

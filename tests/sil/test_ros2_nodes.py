@@ -69,12 +69,13 @@ def _otonav(*args: str) -> list[str]:
 
 @pytest.mark.timeout(180)
 @pytest.mark.parametrize("distro", DISTROS)
-def test_a_plain_rclpy_node_receives_odom_scan_imu_and_clock_with_the_qos_it_asks(
+def test_a_plain_rclpy_node_receives_odom_scan_imu_and_clock_and_sees_the_actors_as_nodes(
     tmp_path: Path, distro: str
 ) -> None:
     """/odom subscribed ``(…, 10)`` (reliable, as diff_drive_controller offers it), /scan
     and /imu with the sensor-data profile, /clock through use_sim_time: every one
-    arrives, and rclpy reports no incompatible QoS. The run is paced (plain --ros2)."""
+    arrives, and rclpy reports no incompatible QoS. The run is paced (plain --ros2).
+    ``get_node_names_and_namespaces()`` lists otonav's actors, with their topics."""
     scenario = tmp_path / "short.yaml"
     scenario.write_text("name: short\nscene: empty\ngoal: {x: 3.0, y: 0.0}\nsim_budget: 3.0\n")
     with exclusive_domain() as domain:
@@ -99,6 +100,13 @@ def test_a_plain_rclpy_node_receives_odom_scan_imu_and_clock_with_the_qos_it_ask
     assert counts["/odom"] >= 90, counts
     assert counts["/imu"] >= 80, counts
     assert counts["/scan"] >= 15, counts
+    # the node graph (ros_discovery_info): otonav's actors as nodes, each with what it
+    # publishes, as `ros2 node list` / `ros2 node info` show them
+    nodes = report["nodes"]
+    assert {"/bridge", "/nav", "/safety", "/base", "/ros2"} <= nodes.keys(), nodes
+    assert {"/odom", "/scan", "/imu", "/clock", "/tf"} <= set(nodes["/bridge"])
+    assert "/cmd_vel_nav" in nodes["/nav"]
+    assert "/cmd_vel" in nodes["/safety"]
 
 
 @pytest.mark.timeout(180)
