@@ -29,7 +29,7 @@ typed), :func:`build_parser` (the docs' CLI reference is generated from it), and
 loaders a host uses to take configs as ``otonav run`` does (imported on first use, like
 every command's dependencies)."""
 
-COMMANDS: tuple[str, ...] = ("run", "info", "inspect", "bench", "sweep", "replay")
+COMMANDS: tuple[str, ...] = ("run", "info", "inspect", "bench", "sweep", "replay", "play")
 """Modules under ``otonav.cli`` whose ``add_parser`` registers a command, in help order."""
 
 USAGE_ERROR = 2

@@ -142,3 +142,40 @@ def test_an_unmodified_rclpy_go_to_goal_node_passes_the_acceptance_scenario_in_l
     assert len(answers) >= summary["time_to_goal_s"] / 0.05
     assert all(abs(t / 0.05 - round(t / 0.05)) < 1e-6 for t in answers), answers[:5]
     assert answers[:3] == pytest.approx([0.05, 0.10, 0.15])
+
+
+@pytest.mark.timeout(180)
+@pytest.mark.parametrize("distro", DISTROS)
+def test_otonav_play_drives_a_use_sim_time_nodes_clock(tmp_path: Path, distro: str) -> None:
+    """``otonav play`` writes a recording onto DDS at its pace, /clock included (ros2 bag
+    play --clock): the node's ROS time follows the recording, and /odom arrives with
+    the QoS it was recorded with (reliable: the node's default subscription matches)."""
+    scenario = tmp_path / "short.yaml"
+    scenario.write_text("name: short\nscene: empty\ngoal: {x: 3.0, y: 0.0}\nsim_budget: 3.0\n")
+    out = tmp_path / "out"
+    recorded = subprocess.run(
+        [sys.executable, "-m", "otonav", "run", "--scenario", str(scenario), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=HANG,
+    )
+    assert (out / "recording.mcap").exists(), recorded.stderr
+    with exclusive_domain() as domain:
+        env = _env(domain)
+        peer_argv = [str(_python(distro)), str(NODES / "qos_peer.py"), "2.0"]
+        with _process(peer_argv, env) as peer:
+            assert peer.stdout is not None
+            assert peer.stdout.readline().strip() == "ready"
+            player = [
+                sys.executable, "-m", "otonav", "play", str(out / "recording.mcap"),
+                "--wait", "60", "--rate", "4",
+            ]  # fmt: skip
+            with _process(player, env) as playing:
+                report_line, err = peer.communicate(timeout=HANG)
+                _out, play_err = playing.communicate(timeout=HANG)
+    assert playing.returncode == 0, play_err
+    assert peer.returncode == 0, err
+    report = json.loads(report_line.strip().splitlines()[-1])
+    assert report["ros_time"] >= 2.0
+    assert report["problems"] == []
+    assert report["counts"]["/odom"] >= 90, report["counts"]
