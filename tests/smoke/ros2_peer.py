@@ -32,8 +32,12 @@ from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
+# On loopback, as the bridge: Cyclone 11 (this package; ROS 2's rmw_cyclonedds ships 0.10,
+# which has no such rule) drops discovery arriving on an interface it did not select, and
+# selects eth0, so whether the two met depended on which one heard the other first.
 LOCALHOST = (
-    "<CycloneDDS><Domain><General><AllowMulticast>false</AllowMulticast></General>"
+    "<CycloneDDS><Domain><General><AllowMulticast>false</AllowMulticast>"
+    '<Interfaces><NetworkInterface name="lo"/></Interfaces></General>'
     "<Discovery><ParticipantIndex>auto</ParticipantIndex>"
     "<MaxAutoParticipantIndex>32</MaxAutoParticipantIndex>"
     '<Peers><Peer address="localhost"/></Peers></Discovery></Domain></CycloneDDS>'
