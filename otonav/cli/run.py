@@ -313,7 +313,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
             realtime=scale if paced else None,
             gui=args.gui,
             hold=hold if paced and args.hold else None,
-            on_system=None if server is None else _serve_parameters(extra[0]),
+            on_system=_on_system(None if server is None else _serve_parameters(extra[0]), bridge),
         )
     except RunCrashedError as crash:
         # An actor crashed (one line on stderr from the log; the traceback is on
@@ -398,6 +398,23 @@ def _live_view(args: argparse.Namespace) -> tuple[Any, tuple[Any, ...]]:
         flush=True,
     )
     return server, (LiveView(server),)
+
+
+def _on_system(
+    foxglove: Callable[[System], None] | None, bridge: Any
+) -> Callable[[System], None] | None:
+    """The run's ``on_system``: the Foxglove view's parameters, and the ROS 2 bridge's
+    (served as ROS 2 parameter services when rclpy is importable: ADR 0065)."""
+    if foxglove is None and bridge is None:
+        return None
+
+    def on_system(system: System) -> None:
+        if foxglove is not None:
+            foxglove(system)
+        if bridge is not None:
+            bridge.serve_parameters(system.actor(a.name) for a in system.graph().actors)
+
+    return on_system
 
 
 def _serve_parameters(view: LiveView) -> Callable[[System], None]:

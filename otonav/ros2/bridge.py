@@ -34,7 +34,7 @@ import contextlib
 import math
 import os
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -53,11 +53,13 @@ from otonav.ros2.naming import (
     discovery,
     domain_id,
 )
+from otonav.ros2.parameters import rclpy_available
 from otonav.runtime import Actor, Bus, Durability, Output, QoS, Reliability, run_blocking
 from otonav.runtime.mailbox import Endpoint, Publisher, Subscription, Topic
 
 if TYPE_CHECKING:
     from otonav.ros2.dds import GraphWriter, Participant, RawReader, RawWriter
+    from otonav.ros2.parameters import ParameterNodes
     from otonav.stack.config import Ros2Config
 
 __all__ = ("LockstepTimeout", "Ros2Bridge", "Ros2Options", "Ros2Statistics", "bridge_for")
@@ -227,6 +229,10 @@ class Ros2Bridge(Actor):
         self._remove_watcher: Any = None
         self._unmatched = ""
         self._graph: GraphWriter | None = None
+        self._parameter_actors: tuple[Actor, ...] = ()
+        self.parameter_nodes: ParameterNodes | None = None
+        """The rclpy nodes serving the actors' parameters (None: rclpy not importable,
+        or :meth:`serve_parameters` not called)."""
         """The warning of a wait for peers that timed out, logged once the run starts."""
 
     # -- wiring -----------------------------------------------------------------------
@@ -320,6 +326,11 @@ class Ros2Bridge(Actor):
                 self.participant.drop(mirror.writer)
                 self._open_writer(topic, mirror)
 
+    def serve_parameters(self, actors: Iterable[Actor]) -> None:
+        """Serve the parameters of ``actors`` as ROS 2 parameter services once the run
+        starts, when rclpy is importable (:mod:`otonav.ros2.parameters`)."""
+        self._parameter_actors = tuple(actors)
+
     def _announce(self) -> None:
         """Every actor as a ROS 2 node on ``ros_discovery_info``, owning the DDS writer of
         each topic it publishes and the DDS reader of each input it subscribes to (the
@@ -345,13 +356,27 @@ class Ros2Bridge(Actor):
                 if name in inputs and actor != self.name:
                     owned_readers.append(inputs[name])
         readers[self.name] += inputs.values()
-        nodes = [("/", _node_name(actor), readers[actor], writers[actor]) for actor in writers]
+        served = self.parameter_nodes.nodes if self.parameter_nodes is not None else {}
+        nodes = [
+            ("/", _node_name(actor), readers[actor], writers[actor])
+            for actor in writers
+            if actor not in served  # rclpy's node of that name is in the graph already
+        ]
         self._graph.publish(nodes)
 
     async def on_start(self) -> None:
         self._reoffer()
         self._started = True
         self._open_endpoints()
+        if self._parameter_actors and rclpy_available():
+            from otonav.ros2.parameters import ParameterNodes
+
+            self.parameter_nodes = ParameterNodes(
+                self._parameter_actors,
+                domain_id=self.domain_id,
+                loop=asyncio.get_running_loop(),
+                node_name=_node_name,
+            )
         self._graph = self.participant.graph()
         self._announce()
         if self._unmatched:
@@ -482,6 +507,8 @@ class Ros2Bridge(Actor):
             mirror.writer = None
         for entry in self._inputs:
             entry.reader = None
+        if self.parameter_nodes is not None:
+            self.parameter_nodes.close()
         self.participant.close()
 
     def _log(self, level: int, text: str) -> None:

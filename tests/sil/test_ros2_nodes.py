@@ -179,3 +179,49 @@ def test_otonav_play_drives_a_use_sim_time_nodes_clock(tmp_path: Path, distro: s
     assert report["ros_time"] >= 2.0
     assert report["problems"] == []
     assert report["counts"]["/odom"] >= 90, report["counts"]
+
+
+@pytest.mark.timeout(180)
+@pytest.mark.parametrize("distro", DISTROS)
+def test_an_async_parameter_client_sets_the_navigators_top_speed_mid_run(
+    tmp_path: Path, distro: str
+) -> None:
+    """otonav run where rclpy is importable (the distro's venv) serves each actor's
+    parameters as ROS 2 parameter services: rclpy's AsyncParameterClient lists them, sets
+    /nav's ``params.dwa.max_v`` to 0.15 m/s at 3 s of sim time, and the recorded commands
+    and /odom obey it from then on; a refused value, a wrong type, a parameter that does
+    not exist and a read-only one are each an unsuccessful result with the reason."""
+    out = tmp_path / "out"
+    python = str(_python(distro))
+    with exclusive_domain() as domain:
+        env = _env(domain)
+        run = [python, "-m", "otonav", "run", "--ros2", "--ros2-wait", "60", "--scale", "2"]
+        with _process([*run, "--out", str(out)], env) as otonav:
+            peer_argv = [python, str(NODES / "param_peer.py"), "nav", "params.dwa.max_v"]
+            with _process([*peer_argv, "0.15", "3.0"], env) as peer:
+                report_line, peer_err = peer.communicate(timeout=HANG)
+            _stdout, run_err = otonav.communicate(timeout=HANG)
+    assert peer.returncode == 0, peer_err
+    assert otonav.returncode in (0, 1), run_err  # the slower robot may miss its budget
+    assert "Traceback" not in run_err
+    report = json.loads(report_line.strip().splitlines()[-1])
+    assert "params.dwa.max_v" in report["names"], report
+    assert report["set"] == {"successful": True, "reason": ""}
+    assert report["value"] == 0.15
+    assert not report["negative"]["successful"]
+    assert "max_v must be finite and > 0" in report["negative"]["reason"]
+    assert not report["string"]["successful"]
+    assert not report["missing"]["successful"]
+    assert not report["read_only"]["successful"]
+    assert "read-only" in report["read_only"]["reason"]
+    set_at = report["set_at"]
+    recording = out / "recording.mcap"
+    commands = [(t, m.linear.x) for _topic, t, m in read_messages(recording, ["/cmd_vel_nav"])]
+    assert max(v for t, v in commands if t < set_at - 0.5) > 0.3  # it was faster before
+    assert max(v for t, v in commands if t > set_at + 0.2) <= 0.15 + 1e-9
+    odom = sorted(
+        m.twist.twist.linear.x
+        for _topic, t, m in read_messages(recording, ["/odom"])
+        if t > set_at + 1.0
+    )
+    assert odom[int(0.95 * len(odom))] <= 0.16, odom[-10:]  # the odometry's own jitter aside
