@@ -10,6 +10,7 @@ from otonav.msgs.geometry import (
     Transform,
     TransformStamped,
     Twist,
+    TwistStamped,
     TwistWithCovariance,
     Vector3,
 )
@@ -66,6 +67,7 @@ __all__ = (
     "Transform",
     "TransformStamped",
     "Twist",
+    "TwistStamped",
     "TwistWithCovariance",
     "Vector3",
     "WheelCommand",

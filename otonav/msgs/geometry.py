@@ -81,6 +81,15 @@ class Twist(Message):
         return cls(linear=Vector3(x=v), angular=Vector3(z=omega))
 
 
+class TwistStamped(Message):
+    """geometry_msgs/msg/TwistStamped: a velocity command with its time and frame (what
+    Jazzy's diff_drive_controller takes on ``cmd_vel`` by default)."""
+
+    ros_type: ClassVar[str] = "geometry_msgs/msg/TwistStamped"
+    header: Header = Header()
+    twist: Twist = Twist()
+
+
 class TwistWithCovariance(Message):
     ros_type: ClassVar[str] = "geometry_msgs/msg/TwistWithCovariance"
     twist: Twist = Twist()

@@ -51,6 +51,7 @@ from otonav.msgs import (
     Transform,
     TransformStamped,
     Twist,
+    TwistStamped,
     TwistWithCovariance,
     Vector3,
     WheelCommand,
@@ -171,6 +172,7 @@ _KNOWN: Final[dict[type[Message], tuple[tuple[Field, ...], tuple[Constant, ...]]
     PoseStamped: ((_HEADER, _F("pose", Pose)), ()),
     PoseWithCovariance: ((_F("pose", Pose), _F("covariance", "float64", 36)), ()),
     Twist: ((_F("linear", Vector3), _F("angular", Vector3)), ()),
+    TwistStamped: ((_HEADER, _F("twist", Twist)), ()),
     TwistWithCovariance: ((_F("twist", Twist), _F("covariance", "float64", 36)), ()),
     Transform: ((_F("translation", Vector3), _F("rotation", Quaternion)), ()),
     TransformStamped: (

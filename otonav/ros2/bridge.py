@@ -34,14 +34,14 @@ import contextlib
 import math
 import os
 import re
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 import anyio
 
 from otonav.actors import topics
-from otonav.msgs import Clock, Log, Message, Time
+from otonav.msgs import Clock, Header, Log, Message, Time, Twist, TwistStamped
 from otonav.record.cdr import encode
 from otonav.record.cdr_decode import decode
 from otonav.ros2.naming import (
@@ -90,6 +90,9 @@ class Ros2Options:
     """(topic, period): the answers of ROS 2 nodes in lockstep (empty: no lockstep)."""
     lockstep_timeout: float = 5.0
     """Wall seconds a node may take to answer in lockstep."""
+    twist_stamped: bool = False
+    """Twist topics (/cmd_vel, /cmd_vel_nav) are geometry_msgs/TwistStamped on DDS, in
+    and out (Jazzy's diff_drive_controller's default); otonav's own stay Twist."""
 
     def __post_init__(self) -> None:
         if not (self.period > 0 and math.isfinite(self.period)):
@@ -142,7 +145,17 @@ class _Mirror(Subscription[Any]):
     """A mailbox that writes each message to its DDS topic as it is published (or, when
     ``deferred``, keeps the latest for the bridge to write once the instant settled)."""
 
-    __slots__ = ("deferred", "latched", "offered", "pending", "refused", "sent", "unread", "writer")
+    __slots__ = (
+        "convert",
+        "deferred",
+        "latched",
+        "offered",
+        "pending",
+        "refused",
+        "sent",
+        "unread",
+        "writer",
+    )
 
     def __init__(self, topic: Topic[Any], endpoint: Endpoint) -> None:
         super().__init__(topic.name, topic.msg_type, _MIRROR_QOS, endpoint)
@@ -152,6 +165,8 @@ class _Mirror(Subscription[Any]):
         self.latched = False
         self.deferred = False
         self.pending: Any = None
+        self.convert: Callable[[Any], Any] | None = None
+        """What the message becomes on DDS (a Twist stamped), or None: as it is."""
         self.sent = self.unread = self.refused = 0
 
     def _offer(self, message: Any) -> bool:
@@ -166,7 +181,7 @@ class _Mirror(Subscription[Any]):
         writer = self.writer
         if writer is None or not (writer.matched.count or self.latched):
             self.unread += 1
-        elif writer.write(encode(message)):
+        elif writer.write(encode(message if self.convert is None else self.convert(message))):
             self.sent += 1
         else:
             self.refused += 1
@@ -181,6 +196,8 @@ class _Input:
     msg_type: type[Message]
     publisher: Publisher[Any]
     qos: DdsQos
+    wire_type: type[Message]
+    """The type on DDS (TwistStamped for a Twist topic with ``twist_stamped``)."""
     reader: RawReader | None = None
 
 
@@ -248,8 +265,9 @@ class Ros2Bridge(Actor):
             endpoint = Endpoint(self.name, f"in{name}")
             publisher = bus.publisher(name, used.msg_type, qos, endpoint=endpoint)
             # A ROS 2 publisher's default offer: reliable, volatile.
-            wanted = dds_qos(QoS(depth=qos.depth), used.msg_type)
-            self._inputs.append(_Input(name, used.msg_type, publisher, wanted))
+            wire = self._wire_type(used.msg_type)
+            wanted = dds_qos(QoS(depth=qos.depth), wire)
+            self._inputs.append(_Input(name, used.msg_type, publisher, wanted, wire))
         for topic in list(bus.topics.values()):
             self._mirror(topic)
         bus.add_topic_listener(self._mirror)
@@ -274,11 +292,25 @@ class Ros2Bridge(Actor):
             self._open_writer(topic, mirror)
             self._announce()
 
+    def _wire_type(self, msg_type: type[Message]) -> type[Message]:
+        """The type a topic has on DDS: TwistStamped for a Twist with ``twist_stamped``."""
+        return TwistStamped if self.options.twist_stamped and msg_type is Twist else msg_type
+
+    def _stamped(self, twist: Twist) -> TwistStamped:
+        clock = self._otonav_clock
+        now = clock.now() if clock is not None else 0.0
+        return TwistStamped(
+            header=Header(stamp=Time.from_seconds(now), frame_id="base_link"), twist=twist
+        )
+
     def _open_writer(self, topic: Topic[Any], mirror: _Mirror) -> None:
         qos = mirror.offered = _offered(topic)
         mirror.latched = qos.durability is Durability.TRANSIENT_LOCAL
-        policy = dds_qos(qos, topic.msg_type)
-        mirror.writer = self.participant.writer(dds_topic(topic.name), topic.msg_type, policy)
+        wire = self._wire_type(topic.msg_type)
+        if wire is not topic.msg_type:
+            mirror.convert = self._stamped
+        policy = dds_qos(qos, wire)
+        mirror.writer = self.participant.writer(dds_topic(topic.name), wire, policy)
         for publisher in topic.publishers:  # what a latched publisher already kept
             for message in publisher._history or ():
                 mirror._offer(message)
@@ -299,7 +331,7 @@ class Ros2Bridge(Actor):
         for entry in self._inputs:
             if entry.reader is None:
                 entry.reader = self.participant.reader(
-                    dds_topic(entry.name), entry.msg_type, entry.qos
+                    dds_topic(entry.name), entry.wire_type, entry.qos
                 )
 
     def _wait_for_peers(self, wait: float) -> None:
@@ -483,11 +515,18 @@ class Ros2Bridge(Actor):
                 continue
             for data in reader.take():
                 try:
-                    message = decode(entry.msg_type, data)
+                    message = decode(entry.wire_type, data)
                 except (ValueError, IndexError, TypeError) as exc:
                     self.rejected += 1
                     first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-                    self._log(Log.WARN, f"{entry.name}: not a {entry.msg_type.ros_type} ({first})")
+                    self._log(Log.WARN, f"{entry.name}: not a {entry.wire_type.ros_type} ({first})")
+                    continue
+                if isinstance(message, TwistStamped):
+                    message = message.twist
+                problem = _not_finite(message)
+                if problem is not None:  # outside data, checked at the door (issue 41)
+                    self.rejected += 1
+                    self._log(Log.WARN, f"{entry.name}: refused from ROS 2: {problem}")
                     continue
                 try:
                     entry.publisher.publish_nowait(message)
@@ -529,6 +568,25 @@ class Ros2Bridge(Actor):
         )
 
 
+def _not_finite(message: Any, path: str = "") -> str | None:
+    """The first field of ``message`` that is a NaN or an infinity (a goal at x = NaN
+    crashed the navigator), or None."""
+    if isinstance(message, float):
+        return None if math.isfinite(message) else f"{path or 'value'} is {message}"
+    if isinstance(message, tuple | list):
+        for i, item in enumerate(message):
+            problem = _not_finite(item, f"{path}[{i}]")
+            if problem is not None:
+                return problem
+        return None
+    if isinstance(message, Message):
+        for name in type(message).model_fields:
+            problem = _not_finite(getattr(message, name), f"{path}.{name}" if path else name)
+            if problem is not None:
+                return problem
+    return None
+
+
 def _node_name(actor: str) -> str:
     """A ROS 2 node name for an actor (letters, digits and underscores, not a digit first)."""
     name = re.sub(r"[^A-Za-z0-9_]", "_", actor)
@@ -550,5 +608,6 @@ def bridge_for(
         wait_for_peers=section.wait,
         lockstep=tuple((answer.topic, answer.period) for answer in section.lockstep),
         lockstep_timeout=section.lockstep_timeout,
+        twist_stamped=section.twist_stamped,
     )
     return Ros2Bridge(options, env=env)

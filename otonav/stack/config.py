@@ -590,6 +590,10 @@ class Ros2Config(_Section):
     lockstep_timeout: float = Field(5.0, gt=0.0, le=3600.0)
     """s of wall time a node may take to answer in lockstep before the run fails, in
     (0, 3600]."""
+    twist_stamped: bool = False
+    """Velocity commands (/cmd_vel, /cmd_vel_nav) are ``geometry_msgs/TwistStamped`` on
+    DDS, in and out, as Jazzy's diff_drive_controller takes them by default; inside
+    otonav (and in the recording) they stay ``Twist``."""
     wait: float | None = Field(None, gt=0.0, le=3600.0)
     """s of wall time, at most, that sim time holds at 0 until the ROS 2 nodes matched
     (``--ros2-wait``; null: do not wait, or 30 s in lockstep), in (0, 3600]."""

@@ -9,7 +9,8 @@ A 20 Hz timer on the node's clock reads the latest /odom (subscribed with the de
 ``10``: reliable) and /scan (``qos_profile_sensor_data``), turns toward the latched /goal
 and drives at it, slowing when the scan sees something close ahead, and publishes
 /cmd_vel_nav (Twist) on every tick: zero until it has a goal, zero once it is within
-``tolerance`` of it. Parameters: ``max_v`` (m/s), ``kp_ang`` (1/s), ``tolerance`` (m).
+``tolerance`` of it. Parameters: ``max_v`` (m/s), ``kp_ang`` (1/s), ``tolerance`` (m),
+``stamped`` (publish TwistStamped, as for Jazzy's diff_drive_controller).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import math
 import sys
 
 import rclpy
-from geometry_msgs.msg import PoseStamped, Twist
+from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, qos_profile_sensor_data
@@ -33,6 +34,7 @@ class GoToGoal(Node):
         self.max_v = float(self.declare_parameter("max_v", 0.35).value)
         self.kp_ang = float(self.declare_parameter("kp_ang", 2.0).value)
         self.tolerance = float(self.declare_parameter("tolerance", 0.06).value)
+        self.stamped = bool(self.declare_parameter("stamped", False).value)
         self.pose: tuple[float, float, float] | None = None
         self.goal: tuple[float, float] | None = None
         self.ahead = math.inf
@@ -40,7 +42,8 @@ class GoToGoal(Node):
         self.create_subscription(LaserScan, "/scan", self.on_scan, qos_profile_sensor_data)
         latched = QoSProfile(depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self.create_subscription(PoseStamped, "/goal", self.on_goal, latched)
-        self.cmd = self.create_publisher(Twist, "/cmd_vel_nav", 10)
+        kind = TwistStamped if self.stamped else Twist
+        self.cmd = self.create_publisher(kind, "/cmd_vel_nav", 10)
         self.create_timer(PERIOD, self.tick)
 
     def on_odom(self, msg: Odometry) -> None:
@@ -73,7 +76,13 @@ class GoToGoal(Node):
                     self.max_v * max(0.0, math.cos(error)) * min(1.0, distance / 0.5) * slow
                 )
                 twist.angular.z = max(-1.5, min(1.5, self.kp_ang * error))
-        self.cmd.publish(twist)
+        if self.stamped:
+            stamped = TwistStamped(twist=twist)
+            stamped.header.stamp = self.get_clock().now().to_msg()
+            stamped.header.frame_id = "base_link"
+            self.cmd.publish(stamped)
+        else:
+            self.cmd.publish(twist)
 
 
 def main() -> None:

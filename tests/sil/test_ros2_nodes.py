@@ -110,24 +110,28 @@ def test_a_plain_rclpy_node_receives_odom_scan_imu_and_clock_and_sees_the_actors
 
 
 @pytest.mark.timeout(180)
+@pytest.mark.parametrize("stamped", [False, True], ids=["twist", "twist_stamped"])
 @pytest.mark.parametrize("distro", DISTROS)
 def test_an_unmodified_rclpy_go_to_goal_node_passes_the_acceptance_scenario_in_lockstep(
-    tmp_path: Path, distro: str
+    tmp_path: Path, distro: str, stamped: bool
 ) -> None:
     """use_sim_time, a 20 Hz timer, /odom + /scan in, /cmd_vel_nav out: otonav holds sim
     time at each 0.05 s until the node answered, and the run is judged on ground truth
-    (the node publishes no NavState). Started before the node, as a user would."""
+    (the node publishes no NavState). Started before the node, as a user would. With
+    ``ros2.twist_stamped`` the node publishes TwistStamped (Jazzy's diff_drive_controller
+    default), and otonav takes it in as the Twist its safety layer reads."""
     out = tmp_path / "out"
     with exclusive_domain() as domain:
         env = _env(domain)
         run = _otonav(
             "--ros2-in", "/cmd_vel_nav", "--lockstep", "/cmd_vel_nav:0.05",
-            "--set", "nav.planner=external", "--out", str(out),
+            "--set", "nav.planner=external", "--set", f"ros2.twist_stamped={str(stamped).lower()}",
+            "--out", str(out),
         )  # fmt: skip
         with _process(run, env) as otonav:
             node_argv = [
                 str(_python(distro)), str(NODES / "go_to_goal.py"),
-                "--ros-args", "-p", "use_sim_time:=true",
+                "--ros-args", "-p", "use_sim_time:=true", "-p", f"stamped:={str(stamped).lower()}",
             ]  # fmt: skip
             with _process(node_argv, env):
                 _stdout, err = otonav.communicate(timeout=HANG)

@@ -145,6 +145,7 @@ PINNED: dict[str, tuple[str, ...]] = {
         "Transform",
         "TransformStamped",
         "Twist",
+        "TwistStamped",
         "TwistWithCovariance",
         "Vector3",
         "WheelCommand",
