@@ -20,6 +20,8 @@ class RunningStack:
 
     system: System
     hal: RobotHardwareInterface
+    ros2: Actor | None = None
+    """The ROS 2 bridge, when the config's ``ros2.enabled`` (ADR 0047, 0065)."""
 
 
 @asynccontextmanager
@@ -49,12 +51,22 @@ async def running_stack(
     /cmd_vel_nav, behind the safety layer), plus ``safety.enabled: false`` to publish
     /cmd_vel straight to the base. ``navigator=False`` is the deprecated spelling of
     ``nav.planner: external`` (ADR 0055).
+
+    With ``ros2.enabled`` in the config, the ROS 2 bridge runs too (``stack.ros2``), as
+    ``otonav run --ros2`` has it; with ``ros2.lockstep`` your ROS 2 nodes run in the
+    test's sim time (ADR 0065).
     """
     if not isinstance(config, StackConfig):
         config = load_stack_file(config)
     hal = build_world(config, extra_obstacles=extra_obstacles)
     try:
         actors = [*build_actors(config, hal, navigator=navigator), *extra_actors]
+        bridge: Actor | None = None
+        if config.ros2.enabled:
+            from otonav.ros2 import bridge_for
+
+            bridge = bridge_for(config.ros2)
+            actors.append(bridge)
     except BaseException:
         hal.close()
         raise
@@ -65,4 +77,4 @@ async def running_stack(
         record_to=record_to,
     )
     async with session.running() as system:
-        yield RunningStack(system, hal)
+        yield RunningStack(system, hal, bridge)

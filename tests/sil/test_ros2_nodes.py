@@ -229,3 +229,50 @@ def test_an_async_parameter_client_sets_the_navigators_top_speed_mid_run(
         if t > set_at + 1.0
     )
     assert odom[int(0.95 * len(odom))] <= 0.16, odom[-10:]  # the odometry's own jitter aside
+
+
+@pytest.mark.sim(wall_ceiling=150)
+@pytest.mark.parametrize("distro", DISTROS)
+async def test_a_pytest_scenario_runs_a_ros2_node_in_its_sim_time(
+    tmp_path: Path, distro: str
+) -> None:
+    """The same through the pytest plugin: ``running_stack`` with a ``ros2`` section that
+    asks for lockstep; the test's ``until`` waits on sim time while the rclpy node
+    drives the robot to the goal."""
+    import math
+
+    from otonav.msgs import Point, Pose, PoseStamped
+    from otonav.runtime import LATCHED_QOS, until
+    from otonav.stack import StackConfig
+    from otonav.testing import running_stack
+
+    with exclusive_domain() as domain:
+        env = _env(domain)
+        config = StackConfig.model_validate(
+            {
+                "nav": {"planner": "external"},
+                "ros2": {
+                    "enabled": True,
+                    "domain_id": domain,
+                    "inputs": ("/cmd_vel_nav",),
+                    "lockstep": ({"topic": "/cmd_vel_nav", "period": 0.05},),
+                    "wait": 60.0,
+                },
+            }
+        )
+        node_argv = [
+            str(_python(distro)), str(NODES / "go_to_goal.py"),
+            "--ros-args", "-p", "use_sim_time:=true",
+        ]  # fmt: skip
+        with _process(node_argv, env):
+            async with running_stack(config) as stack:
+                goal = stack.system.publisher("/goal", PoseStamped, LATCHED_QOS, name="test")
+                await goal.publish(PoseStamped(pose=Pose(position=Point(x=1.2, y=0.6))))
+
+                def distance() -> float:
+                    truth = stack.hal.ground_truth()
+                    return math.hypot(1.2 - truth.x, 0.6 - truth.y)
+
+                # the node stops within 0.06 m by its odometry
+                await until(lambda: distance() < 0.12, within=15.0, observe=distance)
+                assert stack.ros2 is not None
