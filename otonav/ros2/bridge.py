@@ -153,6 +153,7 @@ class _Mirror(Subscription[Any]):
         "pending",
         "refused",
         "sent",
+        "unacked",
         "unread",
         "writer",
     )
@@ -167,6 +168,9 @@ class _Mirror(Subscription[Any]):
         self.pending: Any = None
         self.convert: Callable[[Any], Any] | None = None
         """What the message becomes on DDS (a Twist stamped), or None: as it is."""
+        self.unacked: set[_Mirror] | None = None
+        """In lockstep, for a reliable, volatile writer: where it notes itself once it
+        wrote, so the next answered /clock waits for the node's acknowledgement."""
         self.sent = self.unread = self.refused = 0
 
     def _offer(self, message: Any) -> bool:
@@ -183,6 +187,8 @@ class _Mirror(Subscription[Any]):
             self.unread += 1
         elif writer.write(encode(message if self.convert is None else self.convert(message))):
             self.sent += 1
+            if self.unacked is not None:
+                self.unacked.add(self)
         else:
             self.refused += 1
 
@@ -226,7 +232,7 @@ class Ros2Bridge(Actor):
         env = os.environ if env is None else env
         self.options = options
         self.domain_id = domain_id(options.domain_id, env)
-        self.discovery: Discovery = discovery(env)
+        self.discovery: Discovery = discovery(env, lockstep=bool(options.lockstep))
         try:
             from otonav.ros2.dds import Participant
         except ImportError:
@@ -244,6 +250,9 @@ class Ros2Bridge(Actor):
         self._baselines: list[int] = []
         """Each input's DDS arrivals just before the armed instant's /clock was written."""
         self._remove_watcher: Any = None
+        self._unacked: set[_Mirror] = set()
+        self.unacknowledged = 0
+        """Answered instants whose reliable samples a node did not acknowledge in time."""
         self._unmatched = ""
         self._graph: GraphWriter | None = None
         self._parameter_actors: tuple[Actor, ...] = ()
@@ -311,6 +320,8 @@ class Ros2Bridge(Actor):
             mirror.convert = self._stamped
         policy = dds_qos(qos, wire)
         mirror.writer = self.participant.writer(dds_topic(topic.name), wire, policy)
+        if self.options.lockstep and policy.reliable and not mirror.latched:
+            mirror.unacked = self._unacked
         for publisher in topic.publishers:  # what a latched publisher already kept
             for message in publisher._history or ():
                 mirror._offer(message)
@@ -460,6 +471,25 @@ class Ros2Bridge(Actor):
             self._baselines = [e.reader.arrivals if e.reader else 0 for e in self._inputs]
             if mirror.pending is None:  # an answer due between two /clock ticks
                 mirror.pending = Clock(clock=Time.from_seconds(self.clock.now()))
+            # The node's timer this /clock fires reads the latest /odom: it must be in
+            # the node's reader first. Reliable samples are acknowledged once they are
+            # (heartbeats every 1 ms in lockstep: naming.LOCKSTEP_CONFIG).
+            timeout = self.options.lockstep_timeout
+            for unacked in self._unacked:
+                writer = unacked.writer
+                if (
+                    writer is not None
+                    and writer.matched.count
+                    and not writer.wait_for_acks(timeout)
+                ):
+                    self.unacknowledged += 1
+                    self._log(
+                        Log.WARN,
+                        f"lockstep: {unacked.topic} not acknowledged within {timeout:g} s "
+                        f"(wall) of /clock {self.clock.now():.3f} s: the node may answer from "
+                        "older data",
+                    )
+            self._unacked.clear()
             armed.set()
         if mirror.pending is not None:
             message, mirror.pending = mirror.pending, None

@@ -152,6 +152,12 @@ class RawWriter:
             data = data + bytes(-len(data) & 3)
         return int(_clayer.ddspy_write(self._ref, data)) >= 0
 
+    def wait_for_acks(self, timeout: float) -> bool:
+        """Block until every matched reliable reader acknowledged what was written, at
+        most ``timeout`` wall seconds; whether they all did. (Through the C call:
+        cyclonedds' ``DataWriter.wait_for_acks`` raises AttributeError on a timeout.)"""
+        return int(self._writer._wait_for_acks(self._ref, int(timeout * 1e9))) == 0
+
 
 class RawReader:
     """Takes the CDR bytes of each sample that arrives on one DDS topic."""

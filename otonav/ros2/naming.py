@@ -71,6 +71,14 @@ LOCALHOST_CONFIG: Final = (
 """rmw_cyclonedds_cpp's configuration for ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``,
 on the loopback interface, with Fast DDS's type information ignored."""
 NETWORK_CONFIG: Final = f"<CycloneDDS><Domain>{_FAST_DDS_TYPES}</Domain></CycloneDDS>"
+LOCKSTEP_CONFIG: Final = (
+    "<CycloneDDS><Domain><Internal>"
+    '<HeartbeatInterval min="1ms" minsched="1ms">1ms</HeartbeatInterval>'
+    "</Internal></Domain></CycloneDDS>"
+)
+"""In lockstep, a writer's heartbeat every 1 ms instead of 100: the bridge waits for the
+node's acknowledgement of /odom before each /clock it answers (docs/adr/0065), and a
+reader acknowledges only when a heartbeat asks."""
 """Cyclone's defaults (multicast on its interfaces), with Fast DDS's type information
 ignored."""
 
@@ -139,7 +147,7 @@ class Discovery:
     localhost: bool
 
 
-def discovery(env: Mapping[str, str]) -> Discovery:
+def discovery(env: Mapping[str, str], *, lockstep: bool = False) -> Discovery:
     """ROS 2's discovery range from the environment; localhost unless asked otherwise.
 
     ``ROS_LOCALHOST_ONLY=1`` or ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` (or neither
@@ -147,15 +155,17 @@ def discovery(env: Mapping[str, str]) -> Discovery:
     and ``SYSTEM_DEFAULT`` use Cyclone's defaults (multicast on every interface). ``OFF``
     would make the bridge invisible and is refused. ``CYCLONEDDS_URI`` still applies
     after ours, as in rmw_cyclonedds (Cyclone does not read it once a configuration is
-    given: it is appended here).
+    given: it is appended here). ``lockstep`` adds :data:`LOCKSTEP_CONFIG`.
     """
+    extra = (LOCKSTEP_CONFIG,) if lockstep else ()
     localhost_only = env.get("ROS_LOCALHOST_ONLY", "").strip() == "1"
     wanted = env.get("ROS_AUTOMATIC_DISCOVERY_RANGE", "").strip().upper()
     if localhost_only or wanted in ("", "LOCALHOST"):
-        return Discovery(_with_uri(LOCALHOST_CONFIG, env), "this host only (localhost)", True)
+        config = _with_uri((LOCALHOST_CONFIG, *extra), env)
+        return Discovery(config, "this host only (localhost)", True)
     if wanted in ("SUBNET", "SYSTEM_DEFAULT"):
         scope = f"the network (ROS_AUTOMATIC_DISCOVERY_RANGE={wanted})"
-        return Discovery(_with_uri(NETWORK_CONFIG, env), scope, False)
+        return Discovery(_with_uri((NETWORK_CONFIG, *extra), env), scope, False)
     if wanted == "OFF":
         raise Ros2Error(
             "ROS_AUTOMATIC_DISCOVERY_RANGE=OFF: no ROS 2 node could see the bridge "
@@ -166,8 +176,8 @@ def discovery(env: Mapping[str, str]) -> Discovery:
     )
 
 
-def _with_uri(config: str, env: Mapping[str, str]) -> str:
-    """``config`` then the user's ``CYCLONEDDS_URI`` (a comma-separated list of files and
+def _with_uri(configs: tuple[str, ...], env: Mapping[str, str]) -> str:
+    """``configs`` then the user's ``CYCLONEDDS_URI`` (a comma-separated list of files and
     XML, which Cyclone reads in order, the later overriding)."""
     user = env.get("CYCLONEDDS_URI", "").strip()
-    return f"{config},{user}" if user else config
+    return ",".join((*configs, user) if user else configs)
