@@ -13,6 +13,7 @@ from otonav.msgs import Clock, Odometry, PoseStamped
 from otonav.record.type_hash import rihs01
 from otonav.ros2.naming import (
     LOCALHOST_CONFIG,
+    LOCKSTEP_CONFIG,
     NETWORK_CONFIG,
     Ros2Error,
     dds_qos,
@@ -72,6 +73,9 @@ def test_the_users_cyclonedds_uri_applies_after_ours() -> None:
     assert discovery({"CYCLONEDDS_URI": uri}).config == f"{LOCALHOST_CONFIG},{uri}"
     network = {"ROS_AUTOMATIC_DISCOVERY_RANGE": "SUBNET", "CYCLONEDDS_URI": uri}
     assert discovery(network).config == f"{NETWORK_CONFIG},{uri}"
+    # lockstep's faster heartbeat comes after ours and before the user's
+    lockstep = discovery({"CYCLONEDDS_URI": uri}, lockstep=True).config
+    assert lockstep == f"{LOCALHOST_CONFIG},{LOCKSTEP_CONFIG},{uri}"
 
 
 def test_cyclonedds_is_imported_only_when_a_bridge_is_made() -> None:
