@@ -21,6 +21,8 @@ NAV_STATE = "/nav/state"
 NAV_DIAGNOSTICS = "/nav/diagnostics"
 SAFETY_STATE = "/safety/state"
 ROSOUT = "/rosout"
+#: What a node's parameters became (rcl_interfaces/ParameterEvent).
+PARAMETER_EVENTS = "/parameter_events"
 HARDWARE_STATUS = "/hardware/status"
 DIAGNOSTICS = "/diagnostics"
 
@@ -44,3 +46,5 @@ HARDWARE_QOS = QoS(depth=10, durability=Durability.TRANSIENT_LOCAL)
 DIAGNOSTICS_QOS = QoS(Reliability.BEST_EFFORT, depth=10)
 #: /rosout: as in ROS 2, reliable, keep the last 1000.
 ROSOUT_QOS = QoS(depth=1000)
+#: /parameter_events: as rclcpp's qos_profile_parameter_events, reliable, the last 1000.
+PARAMETER_EVENTS_QOS = QoS(depth=1000)

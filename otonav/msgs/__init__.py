@@ -36,7 +36,15 @@ from otonav.msgs.sensors import (
     Odometry,
     TFMessage,
 )
-from otonav.msgs.std import Clock, Header, Log, Time
+from otonav.msgs.std import (
+    Clock,
+    Header,
+    Log,
+    Parameter,
+    ParameterEvent,
+    ParameterValue,
+    Time,
+)
 
 __all__ = (
     "Clock",
@@ -55,6 +63,9 @@ __all__ = (
     "NavState",
     "OccupancyGrid",
     "Odometry",
+    "Parameter",
+    "ParameterEvent",
+    "ParameterValue",
     "Point",
     "Pose",
     "PoseStamped",

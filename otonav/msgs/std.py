@@ -69,3 +69,45 @@ class Log(Message):
     file: str = ""
     function: str = ""
     line: int = 0
+
+
+class ParameterValue(Message):
+    """rcl_interfaces/msg/ParameterValue: one value, of the ``type`` it says."""
+
+    ros_type: ClassVar[str] = "rcl_interfaces/msg/ParameterValue"
+    NOT_SET: ClassVar[int] = 0
+    BOOL: ClassVar[int] = 1
+    INTEGER: ClassVar[int] = 2
+    DOUBLE: ClassVar[int] = 3
+    STRING: ClassVar[int] = 4
+    type: int = 0
+    bool_value: bool = False
+    integer_value: int = 0
+    double_value: float = 0.0
+    string_value: str = ""
+    byte_array_value: tuple[int, ...] = ()
+    bool_array_value: tuple[bool, ...] = ()
+    integer_array_value: tuple[int, ...] = ()
+    double_array_value: tuple[float, ...] = ()
+    string_array_value: tuple[str, ...] = ()
+
+
+class Parameter(Message):
+    """rcl_interfaces/msg/Parameter: a name and its value."""
+
+    ros_type: ClassVar[str] = "rcl_interfaces/msg/Parameter"
+    name: str = ""
+    value: ParameterValue = ParameterValue()
+
+
+class ParameterEvent(Message):
+    """rcl_interfaces/msg/ParameterEvent: what a node's parameters became, on
+    ``/parameter_events`` (a change made through ROS 2's parameter services)."""
+
+    ros_type: ClassVar[str] = "rcl_interfaces/msg/ParameterEvent"
+    stamp: Time = Time()
+    node: str = ""
+    """The node's fully qualified name, e.g. ``/nav``."""
+    new_parameters: tuple[Parameter, ...] = ()
+    changed_parameters: tuple[Parameter, ...] = ()
+    deleted_parameters: tuple[Parameter, ...] = ()

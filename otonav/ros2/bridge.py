@@ -41,7 +41,18 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import anyio
 
 from otonav.actors import topics
-from otonav.msgs import Clock, Header, Log, Message, Time, Twist, TwistStamped
+from otonav.msgs import (
+    Clock,
+    Header,
+    Log,
+    Message,
+    Parameter,
+    ParameterEvent,
+    ParameterValue,
+    Time,
+    Twist,
+    TwistStamped,
+)
 from otonav.record.cdr import encode
 from otonav.record.cdr_decode import decode
 from otonav.ros2.naming import (
@@ -220,6 +231,7 @@ class Ros2Bridge(Actor):
     """Mirrors topics out to DDS and takes inputs in (see the module docstring)."""
 
     rosout = Output(topics.ROSOUT, Log, topics.ROSOUT_QOS)
+    parameter_events = Output(topics.PARAMETER_EVENTS, ParameterEvent, topics.PARAMETER_EVENTS_QOS)
 
     def __init__(
         self,
@@ -369,6 +381,22 @@ class Ros2Bridge(Actor):
                 self.participant.drop(mirror.writer)
                 self._open_writer(topic, mirror)
 
+    def _parameter_changed(self, actor: str, key: str, value: Any) -> None:
+        """A set through ROS 2 took effect: say so on /parameter_events (recorded)."""
+        if isinstance(value, bool):
+            wire = ParameterValue(type=ParameterValue.BOOL, bool_value=value)
+        elif isinstance(value, int):
+            wire = ParameterValue(type=ParameterValue.INTEGER, integer_value=value)
+        else:
+            wire = ParameterValue(type=ParameterValue.DOUBLE, double_value=float(value))
+        event = ParameterEvent(
+            stamp=Time.from_seconds(self.clock.now()),
+            node=f"/{_node_name(actor)}",
+            changed_parameters=(Parameter(name=key, value=wire),),
+        )
+        with contextlib.suppress(anyio.WouldBlock):  # full: the event is not recorded
+            self.parameter_events.publish_nowait(event)
+
     def serve_parameters(self, actors: Iterable[Actor]) -> None:
         """Serve the parameters of ``actors`` as ROS 2 parameter services once the run
         starts, when rclpy is importable (:mod:`otonav.ros2.parameters`)."""
@@ -419,7 +447,13 @@ class Ros2Bridge(Actor):
                 domain_id=self.domain_id,
                 loop=asyncio.get_running_loop(),
                 node_name=_node_name,
+                on_change=self._parameter_changed,
             )
+            # rclpy's nodes put their own events on DDS: otonav's go to the recording only.
+            events = self._mirrors.get(topics.PARAMETER_EVENTS)
+            if events is not None and events.writer is not None:
+                self.participant.drop(events.writer)
+                events.writer = None
         self._graph = self.participant.graph()
         self._announce()
         if self._unmatched:

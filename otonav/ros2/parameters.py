@@ -21,7 +21,7 @@ import concurrent.futures
 import contextlib
 import importlib.util
 import threading
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 from otonav.actors.live_parameters import ActorParameters, ParameterError
@@ -49,6 +49,7 @@ class ParameterNodes:
         domain_id: int,
         loop: asyncio.AbstractEventLoop,
         node_name: Any,
+        on_change: Callable[[str, str, Any], None] | None = None,
     ) -> None:
         import rclpy
         from rcl_interfaces.msg import ParameterDescriptor
@@ -57,6 +58,8 @@ class ParameterNodes:
         from rclpy.node import Node
 
         self._loop = loop
+        self._on_change = on_change
+        """Called on the loop with (actor, key, new value) after each set it took."""
         self._table = ActorParameters(actors)
         self._context = Context()
         rclpy.init(context=self._context, domain_id=domain_id)
@@ -110,9 +113,12 @@ class ParameterNodes:
 
         async def apply() -> str | None:
             try:
-                self._table.set(name, value)
+                _old, new = self._table.set(name, value)
             except ParameterError as exc:
                 return str(exc)
+            if self._on_change is not None:
+                actor, _, key = name.partition(".")
+                self._on_change(actor, key, new)
             return None
 
         try:

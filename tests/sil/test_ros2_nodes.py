@@ -217,6 +217,12 @@ def test_an_async_parameter_client_sets_the_navigators_top_speed_mid_run(
     assert "read-only" in report["read_only"]["reason"]
     set_at = report["set_at"]
     recording = out / "recording.mcap"
+    # the change is recorded on /parameter_events, at the instant it took effect
+    ((stamp, event),) = [(t, m) for _topic, t, m in read_messages(recording, ["/parameter_events"])]
+    assert event.node == "/nav"
+    ((changed,),) = [event.changed_parameters]
+    assert (changed.name, changed.value.double_value) == ("params.dwa.max_v", 0.15)
+    assert 3.0 <= stamp <= set_at + 0.5  # the peer reads /clock, 100 Hz, a beat behind
     commands = [(t, m.linear.x) for _topic, t, m in read_messages(recording, ["/cmd_vel_nav"])]
     assert max(v for t, v in commands if t < set_at - 0.5) > 0.3  # it was faster before
     assert max(v for t, v in commands if t > set_at + 0.2) <= 0.15 + 1e-9

@@ -37,6 +37,9 @@ from otonav.msgs import (
     NavState,
     OccupancyGrid,
     Odometry,
+    Parameter,
+    ParameterEvent,
+    ParameterValue,
     Point,
     Pose,
     PoseStamped,
@@ -356,7 +359,37 @@ def samples() -> dict[type[Message], list[Message]]:
             ),
             Everything(label="abcde", values=(), after_values=1.0, labels=("xyz",), tail=2.0),
         ],
+        ParameterValue: PARAMETER_VALUES,
+        Parameter: [Parameter(), Parameter(name="params.dwa.max_v", value=PARAMETER_VALUES[1])],
+        ParameterEvent: [
+            ParameterEvent(),
+            ParameterEvent(
+                stamp=STAMPS[2],
+                node="/nav",
+                new_parameters=(Parameter(name="a", value=PARAMETER_VALUES[2]),),
+                changed_parameters=tuple(
+                    Parameter(name=f"p{i}", value=v) for i, v in enumerate(PARAMETER_VALUES)
+                ),
+            ),
+        ],
     }
+
+
+PARAMETER_VALUES = [
+    ParameterValue(),
+    ParameterValue(type=ParameterValue.DOUBLE, double_value=0.15),
+    ParameterValue(
+        type=9,
+        bool_value=True,
+        integer_value=-(2**62),
+        string_value="ŝkanilo",
+        byte_array_value=(0, 7, 255),
+        bool_array_value=(True, False),
+        integer_array_value=(-1, 2**63 - 1),
+        double_array_value=(0.5, -INF),
+        string_array_value=("", "abc"),
+    ),
+]
 
 
 SAMPLES = samples()
