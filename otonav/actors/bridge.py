@@ -15,6 +15,7 @@ import numpy as np
 
 from otonav.actors import topics
 from otonav.actors.odometry_error import OdometryError
+from otonav.actors.topics import FRAMES, Frames
 from otonav.control import OdometryEstimate, Pose2D, estimate_odometry
 from otonav.hal import HardwareHealth, HealthLevel, ImuSample, RobotHardwareInterface, WheelSetpoint
 from otonav.msgs import (
@@ -94,69 +95,83 @@ _STAMP = ("header.stamp.sec", "header.stamp.nanosec")
 # (0, 0, sin(yaw/2), cos(yaw/2)), as Quaternion.from_yaw builds it).
 CLOCK = FlatLayout(Clock.fast(clock=Time.fast(sec=0, nanosec=0)), ("clock.sec", "clock.nanosec"))
 """/clock: sec, nanosec."""
-ODOM = FlatLayout(
-    Odometry.fast(
-        header=_header("odom"),
-        child_frame_id="base_link",
-        pose=PoseWithCovariance.fast(
-            pose=Pose.fast(position=Point.fast(x=0.0, y=0.0, z=0.0), orientation=_IDENTITY),
-            covariance=_POSE_COV,
-        ),
-        twist=TwistWithCovariance.fast(
-            twist=Twist.fast(linear=_vector(), angular=_vector()), covariance=_TWIST_COV
-        ),
-    ),
-    (
-        *_STAMP,
-        "pose.pose.position.x",
-        "pose.pose.position.y",
-        "pose.pose.orientation.z",
-        "pose.pose.orientation.w",
-        "twist.twist.linear.x",
-        "twist.twist.angular.z",
-    ),
-)
-"""/odom: sec, nanosec, x, y, qz, qw, v, omega."""
-TF = FlatLayout(
-    TFMessage.fast(
-        transforms=(
-            TransformStamped.fast(
-                header=_header("odom"),
-                child_frame_id="base_link",
-                transform=Transform.fast(translation=_vector(), rotation=_IDENTITY),
+
+
+def sensor_layouts(
+    frames: Frames,
+) -> tuple[FlatLayout[Odometry], FlatLayout[TFMessage], FlatLayout[Imu]]:
+    """The fixed layouts of /odom, /tf and /imu with ``frames``' names (what varies per
+    message, in the order the bridge gives it; everything else is the template's)."""
+    odom = FlatLayout(
+        Odometry.fast(
+            header=_header("odom"),
+            child_frame_id=frames.base,
+            pose=PoseWithCovariance.fast(
+                pose=Pose.fast(position=Point.fast(x=0.0, y=0.0, z=0.0), orientation=_IDENTITY),
+                covariance=_POSE_COV,
             ),
-        )
-    ),
-    (
-        "transforms.0.header.stamp.sec",
-        "transforms.0.header.stamp.nanosec",
-        "transforms.0.transform.translation.x",
-        "transforms.0.transform.translation.y",
-        "transforms.0.transform.rotation.z",
-        "transforms.0.transform.rotation.w",
-    ),
-)
-"""/tf odom -> base_link: sec, nanosec, x, y, qz, qw."""
-IMU = FlatLayout(
-    Imu.fast(
-        header=_header("imu_link"),
-        orientation=_IDENTITY,
-        orientation_covariance=(0.0,) * 9,
-        angular_velocity=_vector(),
-        angular_velocity_covariance=(0.0,) * 9,
-        linear_acceleration=_vector(),
-        linear_acceleration_covariance=(0.0,) * 9,
-    ),
-    (
-        *_STAMP,
-        "orientation.x",
-        "orientation.y",
-        "orientation.z",
-        "orientation.w",
-        *(f"{v}.{a}" for v in ("angular_velocity", "linear_acceleration") for a in "xyz"),
-    ),
-)
-"""/imu: sec, nanosec, orientation x y z w, angular velocity x y z, acceleration x y z."""
+            twist=TwistWithCovariance.fast(
+                twist=Twist.fast(linear=_vector(), angular=_vector()), covariance=_TWIST_COV
+            ),
+        ),
+        (
+            *_STAMP,
+            "pose.pose.position.x",
+            "pose.pose.position.y",
+            "pose.pose.orientation.z",
+            "pose.pose.orientation.w",
+            "twist.twist.linear.x",
+            "twist.twist.angular.z",
+        ),
+    )
+    # /odom: sec, nanosec, x, y, qz, qw, v, omega.
+    tf = FlatLayout(
+        TFMessage.fast(
+            transforms=(
+                TransformStamped.fast(
+                    header=_header("odom"),
+                    child_frame_id=frames.base,
+                    transform=Transform.fast(translation=_vector(), rotation=_IDENTITY),
+                ),
+            )
+        ),
+        (
+            "transforms.0.header.stamp.sec",
+            "transforms.0.header.stamp.nanosec",
+            "transforms.0.transform.translation.x",
+            "transforms.0.transform.translation.y",
+            "transforms.0.transform.rotation.z",
+            "transforms.0.transform.rotation.w",
+        ),
+    )
+    # /tf odom -> base_link: sec, nanosec, x, y, qz, qw.
+    imu = FlatLayout(
+        Imu.fast(
+            header=_header(frames.imu),
+            orientation=_IDENTITY,
+            orientation_covariance=(0.0,) * 9,
+            angular_velocity=_vector(),
+            angular_velocity_covariance=(0.0,) * 9,
+            linear_acceleration=_vector(),
+            linear_acceleration_covariance=(0.0,) * 9,
+        ),
+        (
+            *_STAMP,
+            "orientation.x",
+            "orientation.y",
+            "orientation.z",
+            "orientation.w",
+            *(f"{v}.{a}" for v in ("angular_velocity", "linear_acceleration") for a in "xyz"),
+        ),
+    )
+    # /imu: sec, nanosec, orientation x y z w, angular velocity x y z, acceleration x y z.
+    return odom, tf, imu
+
+
+ODOM, TF, IMU = sensor_layouts(FRAMES)
+"""otonav's own robot's: /odom (sec, nanosec, x, y, qz, qw, v, omega), /tf odom ->
+base_link (sec, nanosec, x, y, qz, qw), /imu (sec, nanosec, orientation x y z w, angular
+velocity x y z, acceleration x y z)."""
 
 
 class Bridge(Actor):
@@ -195,9 +210,13 @@ class Bridge(Actor):
         diagnostics_hz: float = 1.0,
         initial_pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
         odometry_error: OdometryError | None = None,
+        frames: Frames = FRAMES,
         name: str = "bridge",
     ) -> None:
         super().__init__(name)
+        self.frames = frames
+        layouts = (ODOM, TF, IMU) if frames == FRAMES else sensor_layouts(frames)
+        self._odom_layout, self._tf_layout, self._imu_layout = layouts
         for field, hz in (
             ("clock_hz", clock_hz),
             ("odom_hz", odom_hz),
@@ -226,7 +245,8 @@ class Bridge(Actor):
         """/tf_static: base_link -> laser and base_link -> imu_link (latched), so a
         viewer can place the scan and the IMU."""
         geometry = self.hal.geometry
-        header = Header.fast(stamp=Time.from_seconds(self.clock.now()), frame_id="base_link")
+        frames = self.frames
+        header = Header.fast(stamp=Time.from_seconds(self.clock.now()), frame_id=frames.base)
 
         def fixed(child: str, x: float, y: float, z: float) -> TransformStamped:
             return TransformStamped.fast(
@@ -241,8 +261,8 @@ class Bridge(Actor):
         await self.tf_static.publish(
             TFMessage.fast(
                 transforms=(
-                    fixed("laser", geometry.laser_offset_x, 0.0, geometry.laser_offset_z),
-                    fixed("imu_link", *geometry.imu_offset),
+                    fixed(frames.laser, geometry.laser_offset_x, 0.0, geometry.laser_offset_z),
+                    fixed(frames.imu, *geometry.imu_offset),
                 )
             )
         )
@@ -347,8 +367,8 @@ class Bridge(Actor):
         if error is not None:  # /odom's twist is what the mis-calibrated odometry believes
             gyro_z = odometry.yaw_rate
         qz, qw = math.sin(pose.yaw / 2), math.cos(pose.yaw / 2)  # Quaternion.from_yaw's
-        self._send(self.odom, ODOM(sec, nanosec, pose.x, pose.y, qz, qw, v, gyro_z))
-        self._send(self.tf, TF(sec, nanosec, pose.x, pose.y, qz, qw))
+        self._send(self.odom, self._odom_layout(sec, nanosec, pose.x, pose.y, qz, qw, v, gyro_z))
+        self._send(self.tf, self._tf_layout(sec, nanosec, pose.x, pose.y, qz, qw))
 
     def _imu_at(self, now: float) -> ImuSample:
         """One IMU read per instant, shared by odometry and /imu (it was read twice)."""
@@ -362,7 +382,9 @@ class Bridge(Actor):
         w, x, y, z = sample.orientation
         self._send(
             self.imu,
-            IMU(sec, nanosec, x, y, z, w, *sample.angular_velocity, *sample.linear_acceleration),
+            self._imu_layout(
+                sec, nanosec, x, y, z, w, *sample.angular_velocity, *sample.linear_acceleration
+            ),
         )
 
     async def _publish_scan(self, sec: int, nanosec: int, _now: float) -> None:
@@ -381,7 +403,7 @@ class Bridge(Actor):
         )
         await self.scan.publish(
             LaserScan.fast(
-                header=Header.fast(stamp=stamp, frame_id="laser"),
+                header=Header.fast(stamp=stamp, frame_id=self.frames.laser),
                 angle_min=a_min,
                 angle_max=a_max,
                 angle_increment=a_inc,

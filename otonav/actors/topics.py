@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from otonav.runtime import LATCHED_QOS, SENSOR_DATA_QOS, Durability, QoS, Reliability
 
 CLOCK = "/clock"
@@ -25,6 +27,20 @@ ROSOUT = "/rosout"
 PARAMETER_EVENTS = "/parameter_events"
 HARDWARE_STATUS = "/hardware/status"
 DIAGNOSTICS = "/diagnostics"
+
+
+@dataclass(frozen=True, slots=True)
+class Frames:
+    """The frame ids the sensor bridge stamps (/odom's child, /tf, /tf_static, /scan,
+    /imu), as a ROS 2 robot's URDF names its links (REP 105). ``odom`` stays ``odom``."""
+
+    base: str = "base_link"
+    laser: str = "laser"
+    imu: str = "imu_link"
+
+
+#: The frame ids of otonav's own robot (a robot config's ``robot.frames`` renames them).
+FRAMES = Frames()
 
 #: Sensor streams: best-effort, keep a few (a slow reader sees the newest, never stalls physics).
 SENSOR_QOS = SENSOR_DATA_QOS

@@ -461,7 +461,12 @@ def _ros2_bridge(args: argparse.Namespace, stack: Any) -> Any:
 
     section = _ros2_section(args, section)
     try:
-        bridge = bridge_for(section, domain_id=args.ros2_domain, inputs=args.ros2_inputs or ())
+        bridge = bridge_for(
+            section,
+            domain_id=args.ros2_domain,
+            inputs=args.ros2_inputs or (),
+            base_frame=stack.robot.frames.base,
+        )
     except Ros2Error as exc:
         raise ConfigFileError(str(exc)) from None
     options = bridge.options

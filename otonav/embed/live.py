@@ -374,7 +374,7 @@ async def open_live_stack(
             if ros2 or stack.ros2.enabled:
                 from otonav.ros2 import bridge_for
 
-                bridge = bridge_for(stack.ros2)
+                bridge = bridge_for(stack.ros2, base_frame=stack.robot.frames.base)
                 actors.append(bridge)
         except BaseException:
             hal.close()

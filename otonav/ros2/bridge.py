@@ -104,6 +104,8 @@ class Ros2Options:
     twist_stamped: bool = False
     """Twist topics (/cmd_vel, /cmd_vel_nav) are geometry_msgs/TwistStamped on DDS, in
     and out (Jazzy's diff_drive_controller's default); otonav's own stay Twist."""
+    base_frame: str = "base_link"
+    """The frame a stamped Twist going out says (the robot's ``robot.frames.base``)."""
 
     def __post_init__(self) -> None:
         if not (self.period > 0 and math.isfinite(self.period)):
@@ -320,9 +322,8 @@ class Ros2Bridge(Actor):
     def _stamped(self, twist: Twist) -> TwistStamped:
         clock = self._otonav_clock
         now = clock.now() if clock is not None else 0.0
-        return TwistStamped(
-            header=Header(stamp=Time.from_seconds(now), frame_id="base_link"), twist=twist
-        )
+        header = Header(stamp=Time.from_seconds(now), frame_id=self.options.base_frame)
+        return TwistStamped(header=header, twist=twist)
 
     def _open_writer(self, topic: Topic[Any], mirror: _Mirror) -> None:
         qos = mirror.offered = _offered(topic)
@@ -663,6 +664,7 @@ def bridge_for(
     domain_id: int | None = None,
     inputs: Sequence[str] = (),
     env: Mapping[str, str] | None = None,
+    base_frame: str = "base_link",
 ) -> Ros2Bridge:
     """The bridge the stack config's ``ros2`` section asks for (``domain_id`` and
     ``inputs`` override it: the CLI's flags). The one way every surface makes it."""
@@ -673,5 +675,6 @@ def bridge_for(
         lockstep=tuple((answer.topic, answer.period) for answer in section.lockstep),
         lockstep_timeout=section.lockstep_timeout,
         twist_stamped=section.twist_stamped,
+        base_frame=base_frame,
     )
     return Ros2Bridge(options, env=env)

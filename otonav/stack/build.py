@@ -21,6 +21,7 @@ from otonav.actors import (
 from otonav.actors.localized_navigator import LocalizedNavigator
 from otonav.actors.localizer import Localizer, LocalizerParams
 from otonav.actors.odometry_error import OdometryError
+from otonav.actors.topics import Frames
 from otonav.control import DiffDriveGeometry
 from otonav.hal import BoxObstacle, RobotGeometry, RobotHardwareInterface
 from otonav.hal.mujoco import MujocoInterface
@@ -171,6 +172,7 @@ def build_actors(
             scan_hz=rates.scan_hz,
             initial_pose=initial_pose,
             odometry_error=odometry_error(config),
+            frames=Frames(**config.robot.frames.model_dump()),
         ),
         BaseController(
             DiffDriveGeometry(geometry.wheel_radius, geometry.wheel_separation),

@@ -510,6 +510,19 @@ class MountConfig(_Section):
         return self
 
 
+class FramesConfig(_Section):
+    """The frame ids of the robot's links in /odom, /tf, /tf_static, /scan and /imu, as
+    its URDF names them (REP 105); ``odom`` stays ``odom``."""
+
+    base: _Name = "base_link"
+    """The base frame: /odom's child frame and the parent of the sensors' (a Nav2 robot
+    often says ``base_footprint``)."""
+    laser: _Name = "laser"
+    """The lidar's frame (/scan's ``frame_id``)."""
+    imu: _Name = "imu_link"
+    """The IMU's frame (/imu's ``frame_id``)."""
+
+
 class RobotConfig(_Section):
     """The robot description (``otonav.hal.description``): a built-in robot or the
     user's MJCF/URDF, the names of its base and wheels, where its sensors sit. Wheel
@@ -537,6 +550,8 @@ class RobotConfig(_Section):
     """m/s, the robot's top speed: caps ``base.max_v`` and scales scenario budgets."""
     max_omega: float | None = Field(None, gt=0.0, le=limits.MAX_BASE_OMEGA)
     """rad/s, the robot's top yaw rate: caps ``base.max_omega``."""
+    frames: FramesConfig = FramesConfig()
+    """The frame ids otonav stamps its messages with (``--set robot.frames.base=...``)."""
 
 
 class ActorConfig(_Section):

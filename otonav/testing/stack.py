@@ -65,7 +65,7 @@ async def running_stack(
         if config.ros2.enabled:
             from otonav.ros2 import bridge_for
 
-            bridge = bridge_for(config.ros2)
+            bridge = bridge_for(config.ros2, base_frame=config.robot.frames.base)
             actors.append(bridge)
     except BaseException:
         hal.close()

@@ -209,3 +209,29 @@ def test_an_external_planner_that_publishes_no_nav_state_is_judged_on_ground_tru
     assert summary["time_to_goal_s"] is not None
     assert not list(read_messages(out / "recording.mcap", ["/nav/state"]))
     assert list(read_messages(out / "recording.mcap", ["/planner/state"]))
+
+
+def test_the_robots_frame_names_are_what_its_config_says(tmp_path: Path) -> None:
+    """robot.frames (issue 37 item 5): a Nav2-style robot's base_footprint and its
+    laser's link name stamp /odom, /tf, /tf_static, /scan and /imu; odom stays odom."""
+    out = tmp_path / "out"
+    args = [
+        "run", "--scenario", "empty", "--set", "robot.frames.base=base_footprint",
+        "--set", "robot.frames.laser=base_scan", "--set", "robot.frames.imu=imu",
+        "--out", str(out),
+    ]  # fmt: skip
+    assert main(args) == 0
+    recording = out / "recording.mcap"
+    ((_topic, _t, odom),) = read_messages(recording, ["/odom"], end=0.015)
+    assert (odom.header.frame_id, odom.child_frame_id) == ("odom", "base_footprint")
+    ((_topic, _t, tf),) = read_messages(recording, ["/tf"], end=0.015)
+    assert [(t.header.frame_id, t.child_frame_id) for t in tf.transforms] == [
+        ("odom", "base_footprint")
+    ]
+    ((_topic, _t, static),) = read_messages(recording, ["/tf_static"])
+    assert {(t.header.frame_id, t.child_frame_id) for t in static.transforms} == {
+        ("base_footprint", "base_scan"),
+        ("base_footprint", "imu"),
+    }
+    (scan, imu) = (next(read_messages(recording, [t]))[2] for t in ("/scan", "/imu"))
+    assert (scan.header.frame_id, imu.header.frame_id) == ("base_scan", "imu")

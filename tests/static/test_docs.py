@@ -57,9 +57,9 @@ def _leaf_keys(value: Any, prefix: str = "") -> set[str]:
 
 def test_the_config_reference_lists_every_key_with_its_default() -> None:
     rows = {row.key: row for row in docs_hooks.config_rows(StackConfig, StackConfig())}
-    every = _leaf_keys(StackConfig().model_dump(exclude={"robot"})) | {
-        f"robot.{key}" for key in StackConfig().robot.model_dump()
-    }
+    every = _leaf_keys(StackConfig().model_dump(exclude={"robot"})) | _leaf_keys(
+        StackConfig().robot.model_dump(), "robot."
+    )
     assert every <= rows.keys(), every - rows.keys()
     assert rows["hal.can.left.sign"].default == "`-1`"  # the section's default, not the class's
     assert rows["world.timestep"].bounds == "[0.0001, 0.01]"

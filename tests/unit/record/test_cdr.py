@@ -359,7 +359,7 @@ def samples() -> dict[type[Message], list[Message]]:
             ),
             Everything(label="abcde", values=(), after_values=1.0, labels=("xyz",), tail=2.0),
         ],
-        ParameterValue: PARAMETER_VALUES,
+        ParameterValue: [*PARAMETER_VALUES],
         Parameter: [Parameter(), Parameter(name="params.dwa.max_v", value=PARAMETER_VALUES[1])],
         ParameterEvent: [
             ParameterEvent(),
