@@ -182,8 +182,8 @@ class _Mirror(Subscription[Any]):
         self.convert: Callable[[Any], Any] | None = None
         """What the message becomes on DDS (a Twist stamped), or None: as it is."""
         self.unacked: set[_Mirror] | None = None
-        """In lockstep, for a reliable, volatile writer: where it notes itself once it
-        wrote, so the next answered /clock waits for the node's acknowledgement."""
+        """In lockstep, for a reliable writer: where it notes itself once it wrote, so the
+        next answered /clock waits for the node's acknowledgement."""
         self.sent = self.unread = self.refused = 0
 
     def _offer(self, message: Any) -> bool:
@@ -333,7 +333,7 @@ class Ros2Bridge(Actor):
             mirror.convert = self._stamped
         policy = dds_qos(qos, wire)
         mirror.writer = self.participant.writer(dds_topic(topic.name), wire, policy)
-        if self.options.lockstep and policy.reliable and not mirror.latched:
+        if self.options.lockstep and policy.reliable:
             mirror.unacked = self._unacked
         for publisher in topic.publishers:  # what a latched publisher already kept
             for message in publisher._history or ():
@@ -466,6 +466,13 @@ class Ros2Bridge(Actor):
                     "ros2.lockstep: needs the virtual-time loop (not with --realtime or --gui)"
                 )
             self._remove_watcher = add_watcher(self._settled)
+            wait = self.options.wait_for_peers
+            if wait is not None and not self._unmatched:
+                # Writers made just now (the scenario's latched /goal, whose publisher
+                # did not exist while wiring) match the node's readers a moment later:
+                # sim time holds until they did, or the node's first answers would
+                # depend on when its goal arrived.
+                await run_blocking(self.participant.wait_quiet, _DISCOVERY_QUIET, wait)
 
     def _peers_matched(self) -> bool:
         if self.options.lockstep:
