@@ -84,6 +84,14 @@ async def _reads_odom_and_sends_a_goal(way: str, domain: int) -> None:
                     what="the robot reached the ROS 2 node's goal",
                 )
                 trip = live.now() - taken
+                # The node says so from /odom, which may lag ground truth: keep the stack
+                # up until it has (it exits then), or it may never see the arrival.
+                await until(
+                    lambda: peer.poll() is not None,
+                    within=60.0,
+                    clock=live.clock,
+                    what="the ROS 2 node saw the robot arrive",
+                )
                 stats = bridge.statistics()
         out, err = await anyio.to_thread.run_sync(lambda: peer.communicate(timeout=30))
     finally:
