@@ -268,12 +268,12 @@ class Ros2Bridge(Actor):
         self.unacknowledged = 0
         """Answered instants whose reliable samples a node did not acknowledge in time."""
         self._unmatched = ""
+        """The warning of a wait for peers that timed out, logged once the run starts."""
         self._graph: GraphWriter | None = None
         self._parameter_actors: tuple[Actor, ...] = ()
         self.parameter_nodes: ParameterNodes | None = None
         """The rclpy nodes serving the actors' parameters (None: rclpy not importable,
         or :meth:`serve_parameters` not called)."""
-        """The warning of a wait for peers that timed out, logged once the run starts."""
 
     # -- wiring -----------------------------------------------------------------------
 
