@@ -230,16 +230,11 @@ class GraphWriter:
     def __init__(self, participant: Any, made: list[Any]) -> None:
         self._participant = participant
         topic = Topic(participant, "ros_discovery_info", _PARTICIPANT_INFO)
-        qos = Qos(
-            Policy.Reliability.Reliable(dds_infinity),
-            Policy.Durability.TransientLocal,
-            Policy.DurabilityService(0, Policy.History.KeepLast(1), -1, -1, -1),
-            Policy.History.KeepLast(1),
-            Policy.Userdata(_PARTICIPANT_INFO_HASH),
-            Policy.DataRepresentation(use_cdrv0_representation=True),
-            Policy.IgnoreLocal.Participant,
+        # A latched topic's writer, as every other writer here is made.
+        policy = DdsQos(
+            reliable=True, depth=1, transient_local=True, user_data=_PARTICIPANT_INFO_HASH
         )
-        self._writer = DataWriter(participant, topic, qos=qos)
+        self._writer = DataWriter(participant, topic, qos=_qos(policy, reader=False))
         made += [topic, self._writer]
 
     def publish(self, nodes: list[Node]) -> None:
