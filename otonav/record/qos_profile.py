@@ -15,9 +15,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Any, Final
 
-from otonav.runtime.qos import DEFAULT_QOS, QoS
+import yaml
 
-__all__ = ("INFINITE", "offered_qos_profiles", "offered_qos_yaml")
+from otonav.runtime.qos import DEFAULT_QOS, Durability, QoS, Reliability
+
+__all__ = ("INFINITE", "offered_qos_profiles", "offered_qos_yaml", "recorded_qos")
 
 INFINITE: Final = {"sec": 9223372036, "nsec": 854775807}
 """``RMW_DURATION_INFINITE`` as rosbag2 writes it."""
@@ -73,3 +75,29 @@ def offered_qos_yaml(offered: Sequence[QoS]) -> str:
         for qos in (offered or (DEFAULT_QOS,))
     )
     return text.strip()
+
+
+_RELIABILITY: Final = {1: Reliability.RELIABLE, 2: Reliability.BEST_EFFORT}
+_DURABILITY: Final = {1: Durability.TRANSIENT_LOCAL, 2: Durability.VOLATILE}
+"""rosbag2's older integer enums (rmw's), beside the names :func:`offered_qos_yaml` writes."""
+
+
+def recorded_qos(text: str) -> QoS:
+    """The inverse of :func:`offered_qos_yaml`: the first profile of a channel's
+    ``offered_qos_profiles`` (otonav's names or rosbag2's integers); ROS 2's default
+    profile (reliable, volatile, 10) for an empty, unreadable or unknown one."""
+    try:
+        profiles = yaml.safe_load(text or "[]")
+        first = profiles[0] if isinstance(profiles, list) and profiles else None
+        if not isinstance(first, dict):
+            return DEFAULT_QOS
+        reliability = first.get("reliability", Reliability.RELIABLE.value)
+        durability = first.get("durability", Durability.VOLATILE.value)
+        depth = first.get("depth", DEFAULT_QOS.depth)
+        return QoS(
+            _RELIABILITY.get(reliability) or Reliability(reliability),
+            depth=depth if isinstance(depth, int) and 0 < depth <= 10_000 else DEFAULT_QOS.depth,
+            durability=_DURABILITY.get(durability) or Durability(durability),
+        )
+    except (yaml.YAMLError, ValueError, TypeError):
+        return DEFAULT_QOS

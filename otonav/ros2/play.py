@@ -17,19 +17,18 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import yaml
 from mcap.reader import make_reader
 
 import otonav.msgs
 from otonav.msgs import Message
+from otonav.record.qos_profile import recorded_qos
 from otonav.record.reader import RecordingError, summarize
 from otonav.ros2.naming import Ros2Error, dds_qos, dds_topic, discovery, domain_id
-from otonav.runtime import Durability, QoS, Reliability
 
 if TYPE_CHECKING:
     from otonav.ros2.dds import Participant, RawWriter
 
-__all__ = ("PlayResult", "play", "recorded_qos")
+__all__ = ("PlayResult", "play")
 
 _MESSAGES: dict[str, type[Message]] = {
     cls.ros_type: cls
@@ -37,9 +36,6 @@ _MESSAGES: dict[str, type[Message]] = {
     if isinstance(cls, type) and issubclass(cls, Message) and cls is not Message
 }
 """ROS type name -> otonav's message class, for every message otonav defines."""
-
-_RELIABILITY = {"reliable": Reliability.RELIABLE, 1: Reliability.RELIABLE}
-_TRANSIENT = {"transient_local": Durability.TRANSIENT_LOCAL, 1: Durability.TRANSIENT_LOCAL}
 
 
 @dataclass(frozen=True, slots=True)
@@ -54,23 +50,6 @@ class PlayResult:
     """Topics not played: a type otonav does not know."""
     sim_span: float
     """s of sim time from the first message played to the last."""
-
-
-def recorded_qos(metadata: Mapping[str, str]) -> QoS:
-    """The QoS a channel was recorded with (its first ``offered_qos_profiles`` entry, as
-    rosbag2 or otonav wrote it); ROS 2's default (reliable, volatile, 10) without one."""
-    try:
-        profiles = yaml.safe_load(metadata.get("offered_qos_profiles", "") or "[]")
-        first = profiles[0] if isinstance(profiles, list) and profiles else {}
-        depth = first.get("depth", 10) if isinstance(first, dict) else 10
-        depth = depth if isinstance(depth, int) and 0 < depth <= 10_000 else 10
-        reliability = _RELIABILITY.get(first.get("reliability"), Reliability.BEST_EFFORT)
-        durability = _TRANSIENT.get(first.get("durability"), Durability.VOLATILE)
-    except (yaml.YAMLError, AttributeError, TypeError):
-        return QoS()
-    if not first:
-        return QoS()
-    return QoS(reliability, depth=depth, durability=durability)
 
 
 def play(
@@ -116,8 +95,9 @@ def _play(
 ) -> PlayResult:
     with path.open("rb") as f:
         reader = make_reader(f, validate_crcs=True)
-        channels = reader.get_summary().channels  # type: ignore[union-attr]
-        schemas = reader.get_summary().schemas  # type: ignore[union-attr]
+        summary = reader.get_summary()
+        assert summary is not None, "summarize() refused a file without one"
+        channels, schemas = summary.channels, summary.schemas
         present = {channel.topic for channel in channels.values()}
         unknown = [name for name in wanted if name not in present]
         if unknown:
@@ -135,7 +115,9 @@ def _play(
             if message is None or channel.message_encoding != "cdr":
                 skipped.append(channel.topic)
                 continue
-            policy = dds_qos(recorded_qos(channel.metadata), message)
+            policy = dds_qos(
+                recorded_qos(channel.metadata.get("offered_qos_profiles", "")), message
+            )
             writers[channel_id] = participant.writer(dds_topic(channel.topic), message, policy)
         played = tuple(sorted(channels[i].topic for i in writers))
         if on_start is not None:

@@ -8,8 +8,7 @@ from pathlib import Path
 import pytest
 from conftest import CliFails
 
-from otonav.record.qos_profile import offered_qos_yaml
-from otonav.ros2.play import recorded_qos
+from otonav.record.qos_profile import offered_qos_yaml, recorded_qos
 from otonav.runtime import LATCHED_QOS, SENSOR_DATA_QOS, QoS
 
 pytestmark = pytest.mark.unit
@@ -17,14 +16,15 @@ pytestmark = pytest.mark.unit
 
 @pytest.mark.parametrize("qos", [QoS(depth=10), SENSOR_DATA_QOS, LATCHED_QOS, QoS(depth=100)])
 def test_the_recorded_qos_is_what_the_recording_says(qos: QoS) -> None:
-    assert recorded_qos({"offered_qos_profiles": offered_qos_yaml([qos])}) == qos
+    assert recorded_qos(offered_qos_yaml([qos])) == qos
 
 
 def test_rosbag2s_integer_enums_and_a_missing_profile() -> None:
     text = "- history: 1\n  depth: 1\n  reliability: 1\n  durability: 1\n"
-    assert recorded_qos({"offered_qos_profiles": text}) == LATCHED_QOS
-    assert recorded_qos({}) == QoS()
-    assert recorded_qos({"offered_qos_profiles": "{not: [a list"}) == QoS()
+    assert recorded_qos(text) == LATCHED_QOS
+    assert recorded_qos("") == QoS()
+    assert recorded_qos("{not: [a list") == QoS()
+    assert recorded_qos("- reliability: sometimes\n") == QoS()
 
 
 def test_a_file_that_is_not_a_recording_is_one_line(cli_fails: CliFails, tmp_path: Path) -> None:
