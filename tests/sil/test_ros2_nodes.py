@@ -64,6 +64,16 @@ def _process(argv: list[str], env: dict[str, str]) -> Iterator[subprocess.Popen[
         proc.communicate()
 
 
+@contextmanager
+def _qos_peer(distro: str, env: dict[str, str]) -> Iterator[subprocess.Popen[str]]:
+    """tests/ros2/qos_peer.py in ``distro``'s venv, once it said ``ready`` (its
+    subscriptions exist); it reports once its ROS time passed 2 s."""
+    with _process([str(_python(distro)), str(NODES / "qos_peer.py"), "2.0"], env) as peer:
+        assert peer.stdout is not None
+        assert peer.stdout.readline().strip() == "ready"
+        yield peer
+
+
 def _otonav(*args: str) -> list[str]:
     return [sys.executable, "-m", "otonav", "run", "--ros2", *args]
 
@@ -81,10 +91,7 @@ def test_a_plain_rclpy_node_receives_odom_scan_imu_and_clock_and_sees_the_actors
     scenario.write_text("name: short\nscene: empty\ngoal: {x: 3.0, y: 0.0}\nsim_budget: 3.0\n")
     with exclusive_domain() as domain:
         env = _env(domain)
-        peer_argv = [str(_python(distro)), str(NODES / "qos_peer.py"), "2.0"]
-        with _process(peer_argv, env) as peer:
-            assert peer.stdout is not None
-            assert peer.stdout.readline().strip() == "ready"
+        with _qos_peer(distro, env) as peer:
             run = _otonav(
                 "--ros2-wait", "60", "--scale", "4", "--scenario", str(scenario),
                 "--no-record", "--out", str(tmp_path / "out"),
@@ -164,10 +171,7 @@ def test_otonav_play_drives_a_use_sim_time_nodes_clock(tmp_path: Path, distro: s
     assert (out / "recording.mcap").exists(), recorded.stderr
     with exclusive_domain() as domain:
         env = _env(domain)
-        peer_argv = [str(_python(distro)), str(NODES / "qos_peer.py"), "2.0"]
-        with _process(peer_argv, env) as peer:
-            assert peer.stdout is not None
-            assert peer.stdout.readline().strip() == "ready"
+        with _qos_peer(distro, env) as peer:
             player = [
                 sys.executable, "-m", "otonav", "play", str(out / "recording.mcap"),
                 "--wait", "60", "--rate", "4",
