@@ -3,12 +3,14 @@
 Layers, top to bottom; imports point down only (import-linter contracts in pyproject.toml):
     cli, testing, embed  what users touch: ``python -m otonav``, the pytest plugin and
                          fixtures, a live stack and fast runs inside an asyncio service
-    sweep, replay, ros2  families of runs on a pool or Ray (sweep.backends); re-simulating
+    sweep, replay, ros2, foxglove
+                         families of runs on a pool or Ray (sweep.backends); re-simulating
                          actors against a recording; the ROS 2 bridge over DDS (only ros2.dds
-                         imports cyclonedds)
+                         imports cyclonedds); the Foxglove live view (only foxglove.protocol
+                         imports websockets)
     scenario             run a scenario in sim time, judge it from ground truth, plot it
     stack                the launch file as data: robot description + actors -> world + actors
-    actors               bridge, base controller, navigator, safety layer, recorder, live view
+    actors               bridge, base controller, navigator, safety layer, recorder
     record               MCAP recordings in ROS 2 CDR: write, read, info, salvage, bags
     hal                  RobotHardwareInterface, FakeHardware, robot descriptions, the viewer
                          window; hal.mujoco (the MuJoCo world: scene, prepare, derive, world;

@@ -12,8 +12,8 @@ if TYPE_CHECKING:  # the command's imports are in main(): --help stays fast
 
     from rich.console import Console
 
-    from otonav.actors.live_view import LiveView
     from otonav.cli.signals import StopOnSignals
+    from otonav.foxglove.view import LiveView
     from otonav.runtime import System
     from otonav.scenario import Verdict
 
@@ -379,7 +379,7 @@ def _live_view(args: argparse.Namespace) -> tuple[Any, tuple[Any, ...]]:
 
     if not args.foxglove:
         return None, ()
-    from otonav.actors.live_view import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
+    from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
 
     try:
         options = LiveViewOptions(

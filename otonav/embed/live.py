@@ -11,8 +11,8 @@ from types import TracebackType
 from typing import Any, Generic, TypeVar
 
 from otonav.actors import topics
-from otonav.actors.live_view import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.embed._wait import _wait_done
+from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.hal import RobotHardwareInterface
 from otonav.limits import check_scale
 from otonav.msgs import Header, Message, Point, Pose, PoseStamped, Time
@@ -346,7 +346,7 @@ async def open_live_stack(
     normally, its :class:`~otonav.runtime.ActorCrashedError` is raised on exit.
     A ``scale`` outside [0.01, 100] raises ``ValueError`` (``otonav.limits``).
 
-    ``foxglove=True`` (or :class:`~otonav.actors.live_view.LiveViewOptions`) also serves
+    ``foxglove=True`` (or :class:`~otonav.foxglove.view.LiveViewOptions`) also serves
     every topic to Foxglove over WebSocket (127.0.0.1:8765 by default; ``live.foxglove``
     is the server, stopped on exit).
 

@@ -18,8 +18,8 @@ from websockets.asyncio.client import ClientConnection, connect
 from websockets.typing import Subprotocol
 
 from otonav.actors import topics
-from otonav.actors.live_view import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.embed import HOST_QOS, open_live_stack
+from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.msgs import Odometry, PoseStamped
 from otonav.record.reader import read_messages
 from otonav.record.schemas import schema_for

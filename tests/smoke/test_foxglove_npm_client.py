@@ -15,8 +15,8 @@ import anyio
 import pytest
 
 from otonav.actors import topics
-from otonav.actors.live_view import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.embed import open_live_stack
+from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.record.reader import read_messages
 from otonav.runtime import until
 from otonav.stack import StackConfig

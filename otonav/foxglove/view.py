@@ -4,7 +4,7 @@ the robot, its scan and /tf live), stamped with sim time.
 
 Two parts (docs/adr/0031-live-view-over-foxglove-sdk.md, amended by 0032):
 
-- :class:`FoxgloveServer` serves the protocol (:mod:`otonav.actors.foxglove_protocol`,
+- :class:`FoxgloveServer` serves the protocol (:mod:`otonav.foxglove.protocol`,
   on ``websockets``: the optional extra ``otonav[foxglove]``), under both its names,
   ``foxglove.sdk.v1`` and ``foxglove.websocket.v1``. The server runs on its own thread;
   handing it a message queues a frame and returns, and each client has a bounded
@@ -99,7 +99,7 @@ class FoxgloveServer:
 
     def __init__(self, options: LiveViewOptions = LiveViewOptions()) -> None:
         try:
-            from otonav.actors.foxglove_protocol import Parameters, ProtocolServer
+            from otonav.foxglove.protocol import Parameters, ProtocolServer
         except ImportError:
             raise LiveViewError(
                 "--foxglove needs the foxglove extra: pip install 'otonav[foxglove]'"

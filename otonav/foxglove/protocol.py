@@ -1,7 +1,7 @@
 """A Foxglove WebSocket server (protocol v1) on ``websockets``, in its own thread.
 
 The only module that imports ``websockets`` (an import-linter contract); the live view
-(:mod:`otonav.actors.live_view`) is its one user.
+(:mod:`otonav.foxglove.view`) is its one user.
 
 It speaks the part of the protocol a live view needs (docs/adr/0032, 0044):
 ``serverInfo`` with the ``time`` capability, ``advertise`` of channels (topic, ``cdr``
