@@ -34,7 +34,6 @@ every 64 KiB when recording).
 """
 
 from otonav.embed.live import HOST_QOS, LiveStack, LiveSubscription, open_live_stack
-from otonav.embed.paced import PacedClock
 from otonav.embed.runs import DEFAULT_MAX_RUNS, check_run, default_limiter, run_scenario_async
 
 __all__ = (
@@ -42,7 +41,6 @@ __all__ = (
     "HOST_QOS",
     "LiveStack",
     "LiveSubscription",
-    "PacedClock",
     "check_run",
     "default_limiter",
     "open_live_stack",

@@ -150,7 +150,6 @@ class LiveStack:
         self._task: asyncio.Task[None] | None = None
         self._subscriptions: list[LiveSubscription[Any]] = []
         self._publishers: dict[tuple[str, type[Any], QoS], Publisher[Any]] = {}
-        self._leaving: list[Subscription[Any]] = []
         self._closing = False
         self._closed = False
         self._close_done: asyncio.Future[None] | None = None
@@ -277,13 +276,7 @@ class LiveStack:
 
     def _forget(self, sub: Subscription[Any]) -> None:
         self._subscriptions = [s for s in self._subscriptions if s._sub is not sub]
-        self._leaving.append(sub)
-        self._unsubscribe_when_safe()
-
-    def _unsubscribe_when_safe(self) -> None:
-        for sub in self._leaving:
-            self._system.bus.unsubscribe(sub)
-        self._leaving = []
+        self._system.bus.unsubscribe(sub)
 
     async def close(self) -> None:
         """Stop every actor (each ``on_stop`` runs), finish the recording, release the

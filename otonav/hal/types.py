@@ -31,12 +31,6 @@ class WheelSetpoint:
     right: float
 
 
-WheelCommand = WheelSetpoint
-"""The old name of :class:`WheelSetpoint`, which clashed with the stamped message
-``otonav.msgs.WheelCommand`` on /wheel_cmd (ADR 0056). Kept one round, unexported, so
-code written against it still runs; ``otonav.hal.WheelCommand`` warns."""
-
-
 @dataclass(frozen=True, slots=True)
 class WheelState:
     """Wheel encoders: joint angles (rad, unwrapped) and angular velocities (rad/s)."""

@@ -9,7 +9,6 @@ their last ``depth`` messages for subscribers that join late.
 from __future__ import annotations
 
 import asyncio
-import warnings
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -300,22 +299,6 @@ class Publisher(Generic[M]):
         for subscription in self._topic.subscriptions:
             while not subscription._offer(message):
                 await subscription._wait_for_room()
-
-    def try_publish(self, message: M) -> bool:
-        """Deprecated (ADR 0056): :meth:`publish_nowait`, which raises
-        ``anyio.WouldBlock`` where this returned False. Kept one round for callers
-        outside otonav; warns."""
-        warnings.warn(
-            "Publisher.try_publish is deprecated: use publish_nowait, which raises "
-            "anyio.WouldBlock where try_publish returned False (ADR 0056)",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        try:
-            self.publish_nowait(message)
-        except anyio.WouldBlock:
-            return False
-        return True
 
     def try_publish_all(self, messages: Sequence[M]) -> bool:
         """Deliver all of ``messages`` now, in order, as one :meth:`publish_nowait` after

@@ -6,7 +6,6 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from otonav.actors import topics
 from otonav.hal import BoxObstacle
@@ -28,12 +27,6 @@ def recorded_path(
         (t, m.pose.pose.position.x, m.pose.pose.position.y)
         for _topic, t, m in read_messages(recording, [topics.ODOM], damage=damage)
     ]
-
-
-def recorded_verdict(recording: Path) -> dict[str, Any] | None:
-    """The verdict figures stored in the recording's metadata, if any."""
-    meta = summarize(recording).metadata.get("otonav", {})
-    return json.loads(meta["verdict"]) if "verdict" in meta else None
 
 
 def recorded_goal(

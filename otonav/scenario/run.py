@@ -29,8 +29,6 @@ from otonav.runtime import (
     LATCHED_QOS,
     Actor,
     ActorCrashedError,
-    Clock,
-    RealTimeClock,
     SimTimeoutError,
     System,
     until,
@@ -166,28 +164,6 @@ def effective_stack(scenario: ScenarioConfig, stack: StackConfig) -> StackConfig
         return stack
     world = stack.world.model_copy(update={"scene": scenario.scene})
     return stack.model_copy(update={"world": world})
-
-
-async def drive_to_goal(
-    scenario: ScenarioConfig,
-    stack: StackConfig,
-    hal: RobotHardwareInterface,
-    judge: Judge,
-    *,
-    before: tuple[Actor, ...] = (),
-    clock: Clock | None = None,
-) -> System:
-    """Bring the stack up on ``hal`` (after the ``before`` actors), publish the goal on
-    /goal, and wait in sim time until the judge's arrival check settles or the budget
-    is spent. Returns the stopped system; ``hal`` stays open (the caller's). ``clock``:
-    a :class:`RealTimeClock` for real-time mode (default: the virtual loop's time).
-    The runners use :class:`~otonav.stack.session.StackSession` directly."""
-    if clock is not None and not isinstance(clock, RealTimeClock):
-        raise TypeError(f"drive_to_goal: clock must be a RealTimeClock, got {type(clock)}")
-    actors = build_actors(stack, hal, initial_pose=scenario.start.as_tuple())
-    session = StackSession(hal, [*before, *actors, judge], realtime=clock)
-    await drive(session, scenario, judge)
-    return session.system
 
 
 def scenario_session(

@@ -26,7 +26,7 @@ from otonav.stack.overrides import apply_overrides
 if TYPE_CHECKING:
     from otonav.stack.build import build_actors, build_world
     from otonav.stack.loading import load_stack_file
-    from otonav.stack.session import RealTime, StackSession
+    from otonav.stack.session import StackSession
 
 __all__ = (
     "BaseConfig",
@@ -35,7 +35,6 @@ __all__ = (
     "GuardConfig",
     "NavConfig",
     "RatesConfig",
-    "RealTime",
     "SafetyConfig",
     "StackConfig",
     "StackSession",
@@ -52,7 +51,6 @@ _LAZY = {
     "build_actors": "otonav.stack.build",
     "build_world": "otonav.stack.build",
     "load_stack_file": "otonav.stack.loading",
-    "RealTime": "otonav.stack.session",
     "StackSession": "otonav.stack.session",
 }
 

@@ -21,16 +21,13 @@ Each step runs even if an earlier one raised. Time mode: ``realtime=None`` is vi
 time (the world is the running :class:`~otonav.runtime.VirtualTimeLoop`'s time
 source); a :class:`~otonav.runtime.RealTimeClock` of the world paces it to the wall clock
 on any loop, with a pacer task stepping it in small batches while every actor sleeps.
-(:class:`RealTime`, which made that clock, is deprecated: ADR 0055.)
 """
 
 from __future__ import annotations
 
 import asyncio
 import contextlib
-import warnings
 from collections.abc import AsyncIterator, Callable, Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 from otonav.actors.recorder import Recorder
@@ -42,27 +39,7 @@ from otonav.runtime.loop import VirtualTimeLoop
 from otonav.stack.rosout import attach_rosout
 from otonav.stack.worldmeta import WORLD_METADATA, world_metadata
 
-__all__ = ("RealTime", "StackSession")
-
-
-@dataclass(frozen=True, slots=True)
-class RealTime:
-    """Deprecated (ADR 0055): pass ``realtime=RealTimeClock(hal, scale=...)``, the same
-    clock with the same ``max_step_batch`` default. Constructing one warns."""
-
-    scale: float = 1.0
-    max_step_batch: float = MAX_STEP_BATCH
-
-    def __post_init__(self) -> None:
-        warnings.warn(
-            "otonav.stack.RealTime is deprecated: pass realtime=RealTimeClock(hal, scale=...) "
-            "(otonav.runtime) to StackSession",
-            DeprecationWarning,
-            stacklevel=3,
-        )
-
-    def clock(self, source: TimeSource) -> RealTimeClock:
-        return RealTimeClock(source, scale=self.scale, max_step_batch=self.max_step_batch)
+__all__ = ("StackSession",)
 
 
 class StackSession:
@@ -85,7 +62,7 @@ class StackSession:
         hal: RobotHardwareInterface,
         actors: Sequence[Actor],
         *,
-        realtime: float | RealTimeClock | RealTime | None = None,
+        realtime: float | RealTimeClock | None = None,
         record_to: Path | RecordingWriter | None = None,
         restart: RestartPolicy | Mapping[str, RestartPolicy] | None = None,
         max_step_batch: float | None = MAX_STEP_BATCH,
@@ -98,9 +75,7 @@ class StackSession:
         self._loop: VirtualTimeLoop | None = None
         self._previous_source: TimeSource | None = None
         try:
-            if isinstance(realtime, RealTime):
-                realtime = realtime.clock(hal)
-            elif isinstance(realtime, int | float):
+            if isinstance(realtime, int | float):
                 realtime = RealTimeClock(hal, scale=realtime, max_step_batch=max_step_batch)
             self.realtime_clock: RealTimeClock | None = realtime
             if record_to is not None:

@@ -149,12 +149,3 @@ def test_deterministic_and_guarded() -> None:
             hw.write(WheelSetpoint(math.nan, 0.0))
     with pytest.raises(RuntimeError, match="closed"):
         hw.advance(1)
-
-
-def test_the_old_name_of_the_wheel_setpoint_warns_and_still_works() -> None:
-    """hal.WheelCommand clashed with msgs.WheelCommand (ADR 0056): renamed WheelSetpoint."""
-    import otonav.hal
-
-    with pytest.warns(DeprecationWarning, match="WheelSetpoint"):
-        old = otonav.hal.WheelCommand
-    assert old is WheelSetpoint

@@ -69,7 +69,6 @@ PINNED: dict[str, tuple[str, ...]] = {
         "HOST_QOS",
         "LiveStack",
         "LiveSubscription",
-        "PacedClock",
         "check_run",
         "default_limiter",
         "open_live_stack",
@@ -190,6 +189,12 @@ PINNED: dict[str, tuple[str, ...]] = {
         "TopicComparison",
         "replay_recording",
     ),
+    "otonav.foxglove": (
+        "FoxgloveServer",
+        "LiveView",
+        "LiveViewError",
+        "LiveViewOptions",
+    ),
     "otonav.ros2": (
         "Ros2Bridge",
         "Ros2Error",
@@ -269,7 +274,6 @@ PINNED: dict[str, tuple[str, ...]] = {
         "GuardConfig",
         "NavConfig",
         "RatesConfig",
-        "RealTime",
         "SafetyConfig",
         "StackConfig",
         "StackSession",

@@ -377,16 +377,3 @@ def test_publish_nowait_delivers_to_all_or_to_none() -> None:
     assert [m.n for m in strict.drain()] == [3]
     with pytest.raises(TopicTypeError):
         pub.publish_nowait("not a ping")  # type: ignore[arg-type]
-
-
-def test_try_publish_is_a_deprecated_spelling_of_publish_nowait() -> None:
-    """One non-waiting publish (ADR 0056): the old bool-returning name warns and does
-    what publish_nowait does."""
-    bus = Bus()
-    pub = bus.publisher("/data", Ping, endpoint=Endpoint("p", "out"))
-    strict = bus.subscribe("/data", Ping, QoS(depth=1), endpoint=Endpoint("b", "in"))
-    with pytest.warns(DeprecationWarning, match="publish_nowait"):
-        assert pub.try_publish(Ping(0))
-    with pytest.warns(DeprecationWarning, match="publish_nowait"):
-        assert not pub.try_publish(Ping(1))
-    assert [m.n for m in strict.drain()] == [0]

@@ -37,24 +37,6 @@ def test_a_real_time_clock_caps_one_advance_at_max_step_batch_by_default() -> No
     assert RealTimeClock(JumpSource(0.002), max_step_batch=None).max_batch_ticks is None
 
 
-def test_the_paced_clock_is_the_real_time_clock_with_a_warning() -> None:
-    from otonav.embed import PacedClock
-
-    with pytest.warns(DeprecationWarning, match="RealTimeClock"):
-        paced = PacedClock(JumpSource(0.002), scale=2.0)
-    assert isinstance(paced, RealTimeClock)
-    assert (paced.scale, paced.max_batch_ticks) == (2.0, 25)
-
-
-def test_realtime_mode_spec_still_makes_that_clock_with_a_warning() -> None:
-    from otonav.stack import RealTime
-
-    with pytest.warns(DeprecationWarning, match="RealTimeClock"):
-        mode = RealTime(3.0)
-    clock = mode.clock(JumpSource(0.002))
-    assert (clock.scale, clock.max_batch_ticks) == (3.0, 25)
-
-
 def _batch_literals(source: str, where: str) -> list[str]:
     """``max_step_batch`` given a number (a keyword, a default, a field) in ``source``."""
     found = []
