@@ -185,7 +185,7 @@ def clutter_curve(counts: tuple[int, ...], reps: int, *, profile: bool) -> list[
     from otonav.bench.harness import run_in_children
 
     cases = [Case("clutter", boxes=n) for _ in range(reps) for n in counts]
-    samples = run_in_children(cases)
+    samples = run_in_children(cases, run_clutter)
     profiles: dict[int, dict[str, float]] = {}
     if profile:
         import multiprocessing

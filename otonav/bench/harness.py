@@ -6,7 +6,7 @@ from __future__ import annotations
 import asyncio
 import resource
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from tempfile import TemporaryDirectory
@@ -155,10 +155,6 @@ def run_case(case: Case) -> Sample:
         return _fixed_costs()
     if case.kind == "scenario":
         return _scenario()
-    if case.kind == "clutter":
-        from otonav.bench.clutter import run_clutter
-
-        return run_clutter(case)
     scenario = ScenarioConfig()
     stack = StackConfig(world=WorldConfig(lidar_beams=case.beams))  # the obstacle scene
     if case.overrides:
@@ -184,11 +180,13 @@ def run_case(case: Case) -> Sample:
     return Sample(wall, case.duration, rss, cpu)
 
 
-def run_in_children(cases: Sequence[Case]) -> list[Sample]:
-    """Each case in a fresh spawned process, one after another (never two at once on
-    this 2-core machine)."""
+def run_in_children(
+    cases: Sequence[Case], run: Callable[[Case], Sample] = run_case
+) -> list[Sample]:
+    """``run(case)`` for each case in a fresh spawned process, one after another (never
+    two at once on this 2-core machine); ``run`` is a module-level function."""
     import multiprocessing
 
     ctx = multiprocessing.get_context("spawn")
     with ctx.Pool(1, maxtasksperchild=1) as pool:
-        return pool.map(run_case, cases, chunksize=1)
+        return pool.map(run, cases, chunksize=1)

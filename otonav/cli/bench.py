@@ -15,9 +15,10 @@ def add_parser(commands: Any) -> None:
     p.add_argument("--json", type=Path, default=Path("out/bench.json"), help="write figures here")
     p.add_argument("--no-scaling", action="store_true", help="skip the beams / subscribers tables")
     p.add_argument(
-        "--no-clutter",
+        "--clutter",
         action="store_true",
-        help="skip the clutter curve (RTF with 0 to 3000 boxes, otonav.bench.clutter)",
+        help="also the clutter curve (RTF with 0 to 3000 boxes, otonav.bench.clutter; "
+        "several minutes: also benchmarks/clutter_bench.py)",
     )
     p.add_argument("--clutter-reps", type=int, default=5, help="runs per box count (default 5)")
     p.add_argument("--quick", action="store_true", help="2 s, 1 run, no scaling: checks it runs")
@@ -56,9 +57,9 @@ def main(args: argparse.Namespace) -> int:
         raise ConfigFileError(f"--duration {duration:g}: must be in (0, 86400] s of sim time")
     if not 1 <= reps <= 1000:
         raise ConfigFileError(f"--reps {reps}: must be in [1, 1000]")
-    clutter: tuple[tuple[int, ...], int] | None = (CLUTTER_COUNTS, args.clutter_reps)
-    if args.no_clutter:
-        clutter = None
+    clutter: tuple[tuple[int, ...], int] | None = None
+    if args.clutter:
+        clutter = (CLUTTER_COUNTS, args.clutter_reps)
     if args.quick:
         duration, reps, scaling = 2.0, 1, False
         clutter = None if clutter is None else ((0, 100), 1)

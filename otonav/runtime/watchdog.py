@@ -32,12 +32,22 @@ import sys
 import threading
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from otonav.runtime.errors import LoopHeldError, WallClockCeilingError
 
-if TYPE_CHECKING:
-    from otonav.runtime.loop import VirtualTimeLoop
+
+class WatchedLoop(Protocol):
+    """What the watchdog watches: :class:`~otonav.runtime.loop.VirtualTimeLoop`."""
+
+    beats: int
+    waiting: bool
+    held_by: str | None
+
+    def time(self) -> float: ...
+
+    def fail_threadsafe(self, error: BaseException) -> None: ...
+
 
 POLL_S = 0.1
 """How often a due watchdog looks at the beat count."""
@@ -68,7 +78,7 @@ def describe_holder(loop: asyncio.AbstractEventLoop, thread_id: int) -> str:
 class LoopWatchdog:
     """Watches ``loop`` run by the calling thread; see the module docstring."""
 
-    def __init__(self, loop: VirtualTimeLoop, ceiling: float | None, grace: float) -> None:
+    def __init__(self, loop: WatchedLoop, ceiling: float | None, grace: float) -> None:
         self._loop = loop
         self._ceiling = ceiling
         self._grace = grace
@@ -122,7 +132,9 @@ class LoopWatchdog:
             self._wake.clear()
 
     def _held(self, for_s: float) -> None:
-        holder = describe_holder(self._loop, self._thread_id)
+        loop = self._loop
+        assert isinstance(loop, asyncio.AbstractEventLoop)  # a VirtualTimeLoop
+        holder = describe_holder(loop, self._thread_id)
         self._loop.held_by = holder
         held = f"{holder} held the loop (no pass for {for_s:.1f} s: it never yields)"
         if self._why is None:  # the ceiling: the run fails with it

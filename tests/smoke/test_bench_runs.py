@@ -17,7 +17,7 @@ def test_bench_quick_mode_runs_and_writes_its_figures(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
     figures = tmp_path / "bench.json"
-    assert main(["bench", "--quick", "--json", str(figures)]) == 0
+    assert main(["bench", "--quick", "--clutter", "--json", str(figures)]) == 0
     out = capsys.readouterr().out
     for label in (
         "(a0) bare loop, old law",

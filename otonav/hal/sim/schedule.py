@@ -10,14 +10,30 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from otonav.hal.can.protocol import AxisError
 
-if TYPE_CHECKING:
-    from otonav.hal.sim.emulator import DriveEmulator
+__all__ = ["FaultPlan", "FaultSchedule", "FaultTarget", "Window"]
 
-__all__ = ["FaultPlan", "FaultSchedule", "Window"]
+
+class _Faults(Protocol):
+    drop_rate: float
+    delay: float
+    jitter: float
+
+
+class FaultTarget(Protocol):
+    """What a schedule drives: the drive emulator (:mod:`otonav.hal.sim.emulator`)."""
+
+    @property
+    def faults(self) -> _Faults: ...
+
+    def set_bus_off(self, off: bool) -> None: ...
+
+    def silence_heartbeat(self, node_id: int, silent: bool = True) -> None: ...
+
+    def inject_axis_error(self, node_id: int, code: int = ...) -> None: ...
 
 
 @dataclass(frozen=True, slots=True)
@@ -88,7 +104,7 @@ class FaultSchedule:
         """The next instant at which the faults change (inf: none left)."""
         return self._edges[self._next] if self._next < len(self._edges) else math.inf
 
-    def apply(self, emulator: DriveEmulator, t: float) -> None:
+    def apply(self, emulator: FaultTarget, t: float) -> None:
         """Bring the emulator's faults to what the plan says at ``t`` (s of sim time)."""
         if t < self.next_time:
             return
