@@ -79,7 +79,7 @@ from otonav.hal.mujoco import SceneError, scene_names
 from otonav.limits import check_scale
 from otonav.msgs import Odometry
 from otonav.record import RotatingRecordingWriter
-from otonav.runtime import QoS, Reliability
+from otonav.runtime import QoS, RealTime, Reliability
 from otonav.scenario import BUILTIN, Coordinate, GoalSpec, ScenarioConfig, Verdict, check_goal
 from otonav.stack import (
     ConfigFileError,
@@ -500,7 +500,7 @@ class Service:
                     else None
                 )
                 self.live = await stack.enter_async_context(
-                    open_live_stack(self.stack, scale=self.live_scale, record_to=record)
+                    open_live_stack(self.stack, time=RealTime(self.live_scale), record_to=record)
                 )
             try:
                 yield

@@ -233,7 +233,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
     from otonav.limits import check_scale
     from otonav.record.diskfull import DiskFullError, is_disk_full
     from otonav.record.outlock import lock_output
-    from otonav.runtime import WallClockCeilingError
+    from otonav.runtime import RealTime, Virtual, WallClockCeilingError
     from otonav.scenario import ScenarioConfig, run_scenario
     from otonav.scenario.builtin import BUILTIN
     from otonav.scenario.crash import RunCrashedError
@@ -310,7 +310,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
             source=source,
             on_start=on_start,
             extra_actors=extra,
-            realtime=scale if paced else None,
+            time=RealTime(scale) if paced else Virtual(),
             gui=args.gui,
             hold=hold if paced and args.hold else None,
             on_system=_on_system(None if server is None else _serve_parameters(extra[0]), bridge),

@@ -14,13 +14,11 @@ from otonav.actors import topics
 from otonav.embed._wait import _wait_done
 from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.hal import RobotHardwareInterface
-from otonav.limits import check_scale
 from otonav.msgs import Header, Message, Point, Pose, PoseStamped, Time
 from otonav.record.writer import RecordingWriter
 from otonav.runtime import (
     DEFAULT_QOS,
     LATCHED_QOS,
-    MAX_STEP_BATCH,
     Actor,
     Clock,
     Durability,
@@ -28,6 +26,7 @@ from otonav.runtime import (
     MailboxStatistics,
     Publisher,
     QoS,
+    RealTime,
     RealTimeClock,
     Reliability,
     Subscription,
@@ -316,17 +315,17 @@ def _foxglove_server(foxglove: bool | LiveViewOptions) -> FoxgloveServer | None:
 async def open_live_stack(
     stack: StackConfig = StackConfig(),
     *,
-    scale: float = 1.0,
+    time: RealTime = RealTime(),
     record_to: Path | RecordingWriter | None = None,
     goal: tuple[float, float] | None = None,
     navigator: bool = True,
     extra_actors: Sequence[Actor] = (),
-    max_step_batch: float = MAX_STEP_BATCH,
     foxglove: bool | LiveViewOptions = False,
     ros2: bool = False,
 ) -> AsyncIterator[LiveStack]:
     """Bring the robot stack up on the running (stock asyncio) loop in real-time mode,
-    the world stepped to follow the wall clock times ``scale``; yield a
+    the world stepped to follow the wall clock (``time``: ``RealTime(scale)``, default
+    scale 1; a live stack shares the host's stock loop, so it is never virtual); yield a
     :class:`LiveStack`. With ``record_to`` every topic goes to that MCAP file, finished
     on every exit (or to that writer, e.g. a size-capped
     :class:`~otonav.record.rotating.RotatingRecordingWriter`). ``goal``: an initial
@@ -337,7 +336,6 @@ async def open_live_stack(
     On exit (normal, an exception, or the host's cancellation) the stack stops and the
     recording is finished. If an actor crashed and stopped the stack while the body ran
     normally, its :class:`~otonav.runtime.ActorCrashedError` is raised on exit.
-    A ``scale`` outside [0.01, 100] raises ``ValueError`` (``otonav.limits``).
 
     ``foxglove=True`` (or :class:`~otonav.foxglove.view.LiveViewOptions`) also serves
     every topic to Foxglove over WebSocket (127.0.0.1:8765 by default; ``live.foxglove``
@@ -347,9 +345,11 @@ async def open_live_stack(
     ROS 2 node does and takes the section's ``inputs`` in (the ``otonav[ros2]`` extra;
     ADR 0047): ``live.ros2`` is the bridge.
     """
-    problem = check_scale(scale, "scale")
-    if problem is not None:
-        raise ValueError(problem)
+    if not isinstance(time, RealTime):
+        raise TypeError(
+            f"open_live_stack(time={time!r}): a live stack runs in real time on the host's "
+            "loop: RealTime(scale); for virtual time use running_stack or run_scenario"
+        )
     server = _foxglove_server(foxglove)
     try:
         hal = build_world(stack)
@@ -375,9 +375,7 @@ async def open_live_stack(
                 server.close()
             raise
         try:  # the session owns the world from here (it closes it if it fails)
-            session = StackSession(
-                hal, actors, realtime=scale, record_to=record_to, max_step_batch=max_step_batch
-            )
+            session = StackSession(hal, actors, time=time, record_to=record_to)
         except BaseException:
             if server is not None:
                 server.close()

@@ -4,7 +4,8 @@
   ``watchdog``: its wall-clock ceiling and stop requests, enforced from a thread.
 - ``timesource``: what advances time (a physics world, or ``JumpSource``).
 - ``clock``: sim time for actors, one contract (``Clock``) and its two modes
-  (``VirtualClock``, ``RealTimeClock``, capped at ``MAX_STEP_BATCH`` per advance); ``Rate``.
+  (``VirtualClock``, ``RealTimeClock``, capped at ``MAX_STEP_BATCH`` per advance); ``Rate``;
+  ``timemode``: the mode a run is asked for, as a value (``Virtual()``, ``RealTime(scale)``).
 - ``qos`` / ``mailbox``: QoS with ROS 2 matching, typed topics, publishers, mailboxes.
 - ``actor`` / ``system``: actors with typed ports, wired and supervised by a ``System``;
   ``events``: what the system reports about them (``SystemEvent``, ``EventKind``).
@@ -47,6 +48,7 @@ from otonav.runtime.qos import (
     Reliability,
 )
 from otonav.runtime.system import RestartPolicy, System
+from otonav.runtime.timemode import RealTime, TimeMode, Virtual
 from otonav.runtime.timesource import JumpSource, TimeSource
 from otonav.runtime.waits import next_message, until
 
@@ -76,6 +78,7 @@ __all__ = (
     "QoS",
     "QoSIncompatibleError",
     "Rate",
+    "RealTime",
     "RealTimeClock",
     "Reliability",
     "RestartPolicy",
@@ -83,9 +86,11 @@ __all__ = (
     "Subscription",
     "System",
     "SystemEvent",
+    "TimeMode",
     "TimeSource",
     "TimeSourceError",
     "TopicTypeError",
+    "Virtual",
     "VirtualClock",
     "VirtualTimeLoop",
     "WallClockCeilingError",

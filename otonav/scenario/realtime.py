@@ -15,8 +15,7 @@ import anyio
 
 from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
-from otonav.limits import check_scale
-from otonav.runtime import Actor, RealTimeClock, System
+from otonav.runtime import Actor, RealTime, RealTimeClock, System
 from otonav.runtime.timesource import tick_rate
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
@@ -87,7 +86,7 @@ def run_scenario_realtime(
     out_dir: Path | None = None,
     record: bool = True,
     plot: bool = True,
-    scale: float = 1.0,
+    time: RealTime = RealTime(),
     gui: bool = False,
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
     extra_actors: tuple[Actor, ...] = (),
@@ -97,7 +96,7 @@ def run_scenario_realtime(
     progress: Callable[[Judge, float], None] | None = None,
     on_system: Callable[[System], None] | None = None,
 ) -> Verdict:
-    """:func:`~otonav.scenario.run.run_scenario` with ``realtime=scale`` (and ``gui``,
+    """:func:`~otonav.scenario.run.run_scenario` with ``time=RealTime(scale)`` (and ``gui``,
     ``hold``), which is how to ask for it: sim time follows the wall clock times
     ``scale``; the same world, judge, artifacts and endings (:func:`judged_run`).
 
@@ -114,9 +113,6 @@ def run_scenario_realtime(
     ``loop_factory``: the loop to run on (default: a stock one, the wall clock); a test
     passes a loop whose clock it controls, so a paced run is exact.
     """
-    problem = check_scale(scale, "scale")
-    if problem is not None:
-        raise ValueError(problem)
     if gui:
         check_display()
     with opened_scenario(
@@ -127,7 +123,7 @@ def run_scenario_realtime(
         source,
         progress,
         extra_actors,
-        realtime=scale,
+        time=time,
         on_system=on_system,
     ) as (scenario, stack, hal, judge, session):
         viewer: ViewerHandle | None = None

@@ -29,8 +29,11 @@ from otonav.runtime import (
     LATCHED_QOS,
     Actor,
     ActorCrashedError,
+    RealTime,
     SimTimeoutError,
     System,
+    TimeMode,
+    Virtual,
     until,
     virtual_loop_factory,
 )
@@ -173,20 +176,17 @@ def scenario_session(
     judge: Judge,
     *,
     extra_actors: tuple[Actor, ...] = (),
-    realtime: float | None = None,
+    time: TimeMode = Virtual(),
     recording: Path | None = None,
 ) -> StackSession:
-    """The session of a scenario run: the recorder (with ``recording``), the extra
-    actors, the robot stack starting at the scenario's start pose, and the judge;
-    ``realtime``: the scale of a real-time run (None: virtual time)."""
+    """The session of a scenario run in ``time``: the recorder (with ``recording``), the
+    extra actors, the robot stack starting at the scenario's start pose, and the judge."""
     try:
         robot = build_actors(stack, hal, initial_pose=scenario.start.as_tuple())
     except BaseException:
         hal.close()
         raise
-    session = StackSession(
-        hal, [*extra_actors, *robot, judge], realtime=realtime, record_to=recording
-    )
+    session = StackSession(hal, [*extra_actors, *robot, judge], time=time, record_to=recording)
     if session.writer is not None:
         session.writer.add_metadata(RUN_METADATA, run_metadata(scenario, stack))
     return session
@@ -276,7 +276,7 @@ def opened_scenario(
     source: str,
     progress: Callable[[Judge, float], None] | None,
     extra_actors: tuple[Actor, ...],
-    realtime: float | None = None,
+    time: TimeMode = Virtual(),
     on_system: Callable[[System], None] | None = None,
 ) -> Iterator[tuple[ScenarioConfig, StackConfig, RobotHardwareInterface, Judge, StackSession]]:
     """What a judged run opens, in the virtual and the real-time runner alike: the lock
@@ -298,7 +298,7 @@ def opened_scenario(
             stack,
             hal,
             judge,
-            realtime=realtime,
+            time=time,
             extra_actors=extra_actors,
             recording=out_dir / "recording.mcap" if out_dir and record else None,
         )
@@ -323,7 +323,7 @@ def run_scenario(
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
     source: str = "scenario",
     progress: Callable[[Judge, float], None] | None = None,
-    realtime: float | None = None,
+    time: TimeMode = Virtual(),
     gui: bool = False,
     hold: Callable[[Verdict], None] | None = None,
     on_system: Callable[[System], None] | None = None,
@@ -346,12 +346,12 @@ def run_scenario(
     raises :class:`~otonav.record.diskfull.DiskFullError` naming the file, once the
     recording is closed (readable) and the world too.
 
-    ``realtime=scale`` paces sim time to the wall clock times ``scale`` instead (the same
-    actors, judge and artifacts; ``wall_ceiling`` does not apply); ``gui=True`` (real
+    ``time=RealTime(scale)`` paces sim time to the wall clock times ``scale`` instead (the
+    same actors, judge and artifacts; ``wall_ceiling`` does not apply); ``gui=True`` (real
     time, scale 1 unless given) shows the run in MuJoCo's viewer, and ``hold(verdict)``
     keeps its window open at the end: see
     :func:`~otonav.scenario.realtime.run_scenario_realtime`."""
-    if realtime is not None or gui:
+    if isinstance(time, RealTime) or gui:
         from otonav.scenario.realtime import run_scenario_realtime
 
         return run_scenario_realtime(
@@ -360,7 +360,7 @@ def run_scenario(
             out_dir=out_dir,
             record=record,
             plot=plot,
-            scale=1.0 if realtime is None else realtime,
+            time=time if isinstance(time, RealTime) else RealTime(),
             gui=gui,
             on_start=on_start,
             extra_actors=tuple(extra_actors),

@@ -17,10 +17,11 @@ ends the run (ADR 0007):
 6. in virtual time, the loop gets back the time source it had before: code running on
    the loop after the session (a test's next ``sleep``) does not step a closed world.
 
-Each step runs even if an earlier one raised. Time mode: ``realtime=None`` is virtual
-time (the world is the running :class:`~otonav.runtime.VirtualTimeLoop`'s time
-source); a :class:`~otonav.runtime.RealTimeClock` of the world paces it to the wall clock
-on any loop, with a pacer task stepping it in small batches while every actor sleeps.
+Each step runs even if an earlier one raised. Time mode (``time=``, ADR 0082):
+:class:`~otonav.runtime.Virtual` (the default) makes the world the running
+:class:`~otonav.runtime.VirtualTimeLoop`'s time source; :class:`~otonav.runtime.RealTime`
+paces it to the wall clock on any loop, with a pacer task stepping it in small batches
+while every actor sleeps.
 """
 
 from __future__ import annotations
@@ -33,8 +34,17 @@ from pathlib import Path
 from otonav.actors.recorder import Recorder
 from otonav.hal import RobotHardwareInterface
 from otonav.record.writer import RecordingWriter
-from otonav.runtime import Actor, Clock, RealTimeClock, RestartPolicy, System, TimeSource
-from otonav.runtime.clock import MAX_STEP_BATCH
+from otonav.runtime import (
+    Actor,
+    Clock,
+    RealTime,
+    RealTimeClock,
+    RestartPolicy,
+    System,
+    TimeMode,
+    TimeSource,
+    Virtual,
+)
 from otonav.runtime.loop import VirtualTimeLoop
 from otonav.stack.rosout import attach_rosout
 from otonav.stack.worldmeta import WORLD_METADATA, world_metadata
@@ -51,10 +61,9 @@ class StackSession:
     ``session.running(close=False)`` followed by :meth:`close` when something must be
     appended to the recording after the run (a scenario's verdict).
 
-    Time: ``realtime=None`` is virtual time; ``realtime=scale`` (a number) paces the
-    world to the wall clock times ``scale`` with a :class:`~otonav.runtime.RealTimeClock`
-    the session makes (``max_step_batch`` per advance at most); a ready
-    ``RealTimeClock`` of ``hal`` is taken as it is.
+    Time: ``time=Virtual()`` (the default) or ``time=RealTime(scale)``, which paces the
+    world to the wall clock with a :class:`~otonav.runtime.RealTimeClock` the session
+    makes (:attr:`realtime_clock`).
     """
 
     def __init__(
@@ -62,10 +71,9 @@ class StackSession:
         hal: RobotHardwareInterface,
         actors: Sequence[Actor],
         *,
-        realtime: float | RealTimeClock | None = None,
+        time: TimeMode = Virtual(),
         record_to: Path | RecordingWriter | None = None,
         restart: RestartPolicy | Mapping[str, RestartPolicy] | None = None,
-        max_step_batch: float | None = MAX_STEP_BATCH,
     ) -> None:
         self.hal = hal
         self.writer: RecordingWriter | None = None
@@ -75,8 +83,10 @@ class StackSession:
         self._loop: VirtualTimeLoop | None = None
         self._previous_source: TimeSource | None = None
         try:
-            if isinstance(realtime, int | float):
-                realtime = RealTimeClock(hal, scale=realtime, max_step_batch=max_step_batch)
+            if not isinstance(time, Virtual | RealTime):
+                raise TypeError(f"time= takes Virtual() or RealTime(scale), got {time!r}")
+            self.time = time
+            realtime = time.clock(hal)
             self.realtime_clock: RealTimeClock | None = realtime
             if record_to is not None:
                 # A path, or a writer of the caller's (e.g. a RotatingRecordingWriter)
@@ -153,8 +163,7 @@ class StackSession:
             raise RuntimeError(
                 "a stack in virtual time needs a running VirtualTimeLoop (a test marked "
                 "@pytest.mark.sim, or asyncio.Runner(loop_factory=virtual_loop_factory())); "
-                "for real-time mode on this loop, ask for it (realtime_scale= / "
-                "RealTimeClock(hal))"
+                "for real-time mode on this loop, ask for it (time=RealTime(scale))"
             )
         if loop.source is not self.hal:
             self._loop, self._previous_source = loop, loop.source

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from otonav.hal import BoxObstacle, RobotHardwareInterface
-from otonav.runtime import Actor, System
+from otonav.runtime import Actor, System, TimeMode, Virtual
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.loading import load_stack_file
 from otonav.stack.session import StackSession
@@ -31,7 +31,7 @@ async def running_stack(
     navigator: bool = True,
     extra_actors: Sequence[Actor] = (),
     extra_obstacles: Sequence[BoxObstacle] = (),
-    realtime_scale: float | None = None,
+    time: TimeMode = Virtual(),
     record_to: Path | None = None,
 ) -> AsyncIterator[RunningStack]:
     """Bring up the stack ``config`` launches (world, bridge, base, the planner
@@ -39,7 +39,7 @@ async def running_stack(
     ``actors``) for the body of an ``async with``.
 
     On a :class:`VirtualTimeLoop` (``@pytest.mark.sim``) the world becomes the loop's time
-    source: sim time is loop time. With ``realtime_scale`` set, the stack runs on the
+    source: sim time is loop time. With ``time=RealTime(scale)``, the stack runs on the
     current (stock) loop, the world paced to the wall clock times that scale. With
     ``record_to`` every topic is recorded to that MCAP file, finished on every exit.
     On exit the stack is torn down as every runner's is (:mod:`otonav.stack.session`):
@@ -73,7 +73,7 @@ async def running_stack(
     session = StackSession(
         hal,
         actors,
-        realtime=realtime_scale,
+        time=time,
         record_to=record_to,
     )
     async with session.running() as system:

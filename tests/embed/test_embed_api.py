@@ -27,6 +27,7 @@ from otonav.runtime import (
     ActorCrashedError,
     JumpSource,
     QoSIncompatibleError,
+    RealTime,
     RealTimeClock,
     TopicTypeError,
     until,
@@ -54,7 +55,7 @@ def _host_subscribers(live: LiveStack, topic: str) -> int:
 async def test_live_stack_on_the_host_loop(tmp_path: Path) -> None:
     record = tmp_path / "live.mcap"
     with anyio.fail_after(WALL_CEILING):
-        async with open_live_stack(record_to=record, scale=2.0) as live:
+        async with open_live_stack(record_to=record, time=RealTime(2.0)) as live:
             odom = live.subscribe(topics.ODOM, Odometry, HOST_QOS)
             first = await anext(odom)
             assert isinstance(first, Odometry)

@@ -28,7 +28,7 @@ from otonav.replay.feed import FLAT_LAYOUTS
 from otonav.replay.lazy import input_maker
 from otonav.replay.nodes import stack_actor_names
 from otonav.replay.recording import load_recording
-from otonav.runtime import JumpSource, VirtualTimeLoop
+from otonav.runtime import JumpSource, RealTime, VirtualTimeLoop
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.stack import NavConfig, SafetyConfig, StackConfig, build_world
 from otonav.stack.worldmeta import WORLD_METADATA, geometry_from_metadata, world_metadata
@@ -267,7 +267,7 @@ def test_a_real_time_recording_replays_with_recorded_wakes(tmp_path: Path) -> No
     run_scenario_realtime(
         ScenarioConfig(sim_budget=2.0),
         out_dir=tmp_path,
-        scale=10.0,
+        time=RealTime(10.0),
         plot=False,
         loop_factory=LateWallLoop,
     )

@@ -23,7 +23,7 @@ from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.msgs import Odometry, PoseStamped
 from otonav.record.reader import read_messages
 from otonav.record.schemas import schema_for
-from otonav.runtime import until
+from otonav.runtime import RealTime, until
 from otonav.stack import StackConfig
 
 pytestmark = pytest.mark.smoke
@@ -61,7 +61,7 @@ async def test_a_client_sets_a_parameter_and_sends_a_goal_that_is_reached(
     speeds: list[float] = []
     with anyio.fail_after(CEILING):
         async with open_live_stack(
-            stack, scale=4.0, record_to=record, extra_actors=(view,)
+            stack, time=RealTime(4.0), record_to=record, extra_actors=(view,)
         ) as live:
             view.serve_parameters(live.system.actor(a.name) for a in live.graph().actors)
             protocol = [Subprotocol("foxglove.websocket.v1")]

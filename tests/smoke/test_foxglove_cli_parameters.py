@@ -22,7 +22,7 @@ from websockets.asyncio.client import ClientConnection, connect
 
 from otonav.actors import topics
 from otonav.record.reader import read_messages
-from otonav.runtime import ActorStatus, System
+from otonav.runtime import ActorStatus, RealTime, System, Virtual
 from otonav.scenario import run_scenario
 from otonav.scenario.builtin import BUILTIN
 
@@ -171,7 +171,13 @@ def test_both_runners_hand_the_wired_system_to_on_system_before_it_runs(
         assert system.actor("nav").name == "nav"  # the actors themselves, not only names
 
     short = BUILTIN["empty"].model_copy(update={"sim_budget": 0.5})
-    verdict = run_scenario(short, record=False, plot=False, realtime=realtime, on_system=on_system)
+    verdict = run_scenario(
+        short,
+        record=False,
+        plot=False,
+        time=Virtual() if realtime is None else RealTime(realtime),
+        on_system=on_system,
+    )
     assert verdict.sim_time_s > 0.4  # then the run went on as usual
     names = [name for name, _ in seen]
     assert {"nav", "safety", "judge"} <= set(names)

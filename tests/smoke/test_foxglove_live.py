@@ -25,7 +25,7 @@ from otonav.embed import open_live_stack
 from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
 from otonav.msgs import LaserScan
 from otonav.record.reader import read_messages, summarize
-from otonav.runtime import SENSOR_DATA_QOS, Actor, Output
+from otonav.runtime import SENSOR_DATA_QOS, Actor, Output, RealTime
 from otonav.scenario import ScenarioConfig, run_scenario
 
 pytestmark = pytest.mark.smoke
@@ -227,7 +227,7 @@ def test_cli_realtime_run_serves_live(tmp_path: Path, capsys: pytest.CaptureFixt
 
 @pytest.mark.asyncio
 async def test_open_live_stack_serves_foxglove_on_the_host_loop() -> None:
-    async with open_live_stack(scale=5.0, foxglove=LiveViewOptions(port=0)) as live:
+    async with open_live_stack(time=RealTime(5.0), foxglove=LiveViewOptions(port=0)) as live:
         server = live.foxglove
         assert server is not None
         assert server.url.startswith("ws://127.0.0.1:")

@@ -18,7 +18,7 @@ from otonav.actors import topics
 from otonav.embed import open_live_stack
 from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.record.reader import read_messages
-from otonav.runtime import until
+from otonav.runtime import RealTime, until
 from otonav.stack import StackConfig
 
 pytestmark = pytest.mark.smoke
@@ -57,7 +57,7 @@ async def test_the_npm_client_sets_a_parameter_and_sends_a_goal_that_is_reached(
     events: list[dict[str, Any]] = []
     with anyio.fail_after(CEILING):
         async with open_live_stack(
-            stack, scale=4.0, record_to=record, extra_actors=(view,)
+            stack, time=RealTime(4.0), record_to=record, extra_actors=(view,)
         ) as live:
             view.serve_parameters(live.system.actor(a.name) for a in live.graph().actors)
             args = [*node_client, server.url, str(GOAL[0]), str(GOAL[1]), str(SLOW)]

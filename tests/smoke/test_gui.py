@@ -39,9 +39,10 @@ NO_DISPLAY_CHILD = """
 import sys
 from otonav.hal.viewer import NoDisplayError
 from otonav.scenario.builtin import BUILTIN
+from otonav.runtime import RealTime
 from otonav.scenario.realtime import run_scenario_realtime
 try:
-    run_scenario_realtime(BUILTIN["empty"], scale=5.0, gui=True, record=False, plot=False)
+    run_scenario_realtime(BUILTIN["empty"], time=RealTime(5.0), gui=True, record=False, plot=False)
 except NoDisplayError as exc:
     print(f"{type(exc).__name__}: {exc}", flush=True)
     sys.exit(0)
@@ -57,6 +58,7 @@ GUI_CHILD = """
 import json, os, sys
 from otonav.hal.mujoco import MujocoInterface
 from otonav.scenario.builtin import BUILTIN
+from otonav.runtime import RealTime
 from otonav.scenario.realtime import run_scenario_realtime
 
 mode, scale = sys.argv[1], float(sys.argv[2])
@@ -83,7 +85,7 @@ def held(verdict):  # "run": the window stays up (and Xvfb with it) until "close
         handles[0]._handle.close()
 
 verdict = run_scenario_realtime(
-    BUILTIN["empty"], scale=scale, gui=True, record=False, plot=False, on_start=on_start,
+    BUILTIN["empty"], time=RealTime(scale), gui=True, record=False, plot=False, on_start=on_start,
     hold=held if mode == "run" else None,
 )
 if mode != "run":

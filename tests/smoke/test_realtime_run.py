@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from otonav.record.outlock import OutputBusyError, lock_output
+from otonav.runtime import RealTime
 from otonav.scenario import run_scenario
 from otonav.scenario.builtin import BUILTIN
 from otonav.scenario.realtime import run_scenario_realtime
@@ -19,7 +20,7 @@ SCALE = 10.0  # the "empty" scenario takes ~8.5 s of sim time: ~0.85 s of wall t
 
 def test_realtime_run_reaches_the_goal_paced_to_the_scaled_wall_clock(tmp_path: Path) -> None:
     # One entry point for a judged run: real time is a mode of run_scenario (ADR 0055).
-    verdict = run_scenario(BUILTIN["empty"], out_dir=tmp_path, realtime=SCALE)
+    verdict = run_scenario(BUILTIN["empty"], out_dir=tmp_path, time=RealTime(SCALE))
 
     assert verdict.passed, verdict.reason
     assert verdict.reached
@@ -39,8 +40,8 @@ def test_realtime_run_reaches_the_goal_paced_to_the_scaled_wall_clock(tmp_path: 
 
 @pytest.mark.parametrize("scale", [0.0, 1e308, 1e-9])
 def test_realtime_run_rejects_a_scale_it_cannot_honour(scale: float) -> None:
-    with pytest.raises(ValueError, match=r"scale .*must be a number in \[0.01, 100\]"):
-        run_scenario_realtime(BUILTIN["empty"], scale=scale, record=False, plot=False)
+    with pytest.raises(ValueError, match=r"scale.*must be a number in \[0.01, 100\]"):
+        run_scenario_realtime(BUILTIN["empty"], time=RealTime(scale), record=False, plot=False)
 
 
 def test_a_realtime_run_refuses_an_out_dir_another_run_writes_to(tmp_path: Path) -> None:
@@ -58,7 +59,7 @@ def test_a_realtime_run_refuses_an_out_dir_another_run_writes_to(tmp_path: Path)
     try:
         assert entered.wait(30)
         with pytest.raises(OutputBusyError, match="another otonav"):
-            run_scenario(BUILTIN["empty"], out_dir=out, realtime=SCALE)
+            run_scenario(BUILTIN["empty"], out_dir=out, time=RealTime(SCALE))
     finally:
         release.set()
         thread.join()

@@ -19,7 +19,7 @@ from dds_domain import exclusive_domain
 
 from otonav.embed import open_live_stack
 from otonav.ros2 import Ros2Bridge, Ros2Options
-from otonav.runtime import until
+from otonav.runtime import RealTime, until
 from otonav.stack import StackConfig
 
 pytestmark = pytest.mark.smoke
@@ -58,7 +58,7 @@ async def _reads_odom_and_sends_a_goal(way: str, domain: int) -> None:
             extra = ()
         with anyio.fail_after(CEILING):
             async with open_live_stack(
-                stack, scale=4.0, extra_actors=extra, ros2=way == "embedding_option"
+                stack, time=RealTime(4.0), extra_actors=extra, ros2=way == "embedding_option"
             ) as live:
                 if way == "embedding_option":
                     assert isinstance(live.ros2, Ros2Bridge)

@@ -11,7 +11,7 @@ import pytest
 
 from otonav.actors import topics
 from otonav.msgs import Clock, Imu, LaserScan, Odometry, Twist
-from otonav.runtime import Subscription, until
+from otonav.runtime import RealTime, Subscription, TimeMode, Virtual, until
 from otonav.stack import StackConfig
 from otonav.testing import running_stack
 
@@ -31,10 +31,10 @@ SENSORS: dict[str, type[Any]] = {
 }
 
 
-async def _drive_and_watch(realtime_scale: float | None, within: float) -> dict[str, int]:
+async def _drive_and_watch(time: TimeMode, within: float) -> dict[str, int]:
     counts = dict.fromkeys(SENSORS, 0)
     last_odom: list[Odometry] = []
-    async with running_stack(BASE_ONLY, realtime_scale=realtime_scale) as stack:
+    async with running_stack(BASE_ONLY, time=time) as stack:
         system = stack.system
         start_x = stack.hal.ground_truth().x
         subs: dict[str, Subscription[Any]] = {
@@ -78,7 +78,7 @@ async def _drive_and_watch(realtime_scale: float | None, within: float) -> dict[
 @pytest.mark.sim(wall_ceiling=45)
 async def test_sensors_arrive_and_cmd_vel_moves_the_robot() -> None:
     loop = asyncio.get_running_loop()
-    counts = await _drive_and_watch(None, within=3.0)
+    counts = await _drive_and_watch(Virtual(), within=3.0)
     # 0.3 m/s after a 1 m/s² ramp: past 0.1 m in well under a second of sim time.
     assert loop.time() < 1.0
     assert counts[topics.ODOM] >= 50
@@ -87,7 +87,7 @@ async def test_sensors_arrive_and_cmd_vel_moves_the_robot() -> None:
 
 async def _realtime() -> tuple[dict[str, int], float]:
     wall = time.monotonic()
-    counts = await _drive_and_watch(1.0, within=3.0)
+    counts = await _drive_and_watch(RealTime(1.0), within=3.0)
     return counts, time.monotonic() - wall
 
 

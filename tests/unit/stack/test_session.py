@@ -15,7 +15,14 @@ from otonav.embed import open_live_stack
 from otonav.hal.fake import FakeHardware
 from otonav.msgs import Point, Pose, PoseStamped
 from otonav.record.reader import read_messages
-from otonav.runtime import Actor, JumpSource, Output, VirtualTimeLoop, virtual_loop_factory
+from otonav.runtime import (
+    Actor,
+    JumpSource,
+    Output,
+    RealTime,
+    VirtualTimeLoop,
+    virtual_loop_factory,
+)
 from otonav.stack import StackConfig
 from otonav.stack.session import StackSession
 from otonav.testing import running_stack
@@ -55,11 +62,11 @@ def _virtual(path: Path, actor: Actor) -> AbstractAsyncContextManager[object]:
 
 
 def _realtime(path: Path, actor: Actor) -> AbstractAsyncContextManager[object]:
-    return running_stack(BASE_ONLY, record_to=path, extra_actors=[actor], realtime_scale=20)
+    return running_stack(BASE_ONLY, record_to=path, extra_actors=[actor], time=RealTime(20))
 
 
 def _live(path: Path, actor: Actor) -> AbstractAsyncContextManager[object]:
-    return open_live_stack(BASE_ONLY, record_to=path, extra_actors=[actor], scale=20)
+    return open_live_stack(BASE_ONLY, record_to=path, extra_actors=[actor], time=RealTime(20))
 
 
 async def _run_stack(runner: Runner, path: Path) -> None:
