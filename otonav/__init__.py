@@ -3,6 +3,8 @@
 Layers, top to bottom; imports point down only (import-linter contracts in pyproject.toml):
     cli, testing, embed  what users touch: ``python -m otonav``, the pytest plugin and
                          fixtures, a live stack and fast runs inside an asyncio service
+    engine               what the entry points share above the stack: the config's optional
+                         sections (foxglove, ros2) wired in one place
     sweep, replay, ros2, foxglove
                          families of runs on a pool or Ray (sweep.backends); re-simulating
                          actors against a recording; the ROS 2 bridge over DDS (only ros2.dds

@@ -7,13 +7,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # the command's imports are in main(): --help stays fast
-    from collections.abc import Callable
     from contextlib import ExitStack
 
     from rich.console import Console
 
     from otonav.cli.signals import StopOnSignals
-    from otonav.foxglove.view import LiveView
+    from otonav.engine import Extras
     from otonav.runtime import System
     from otonav.scenario import Verdict
 
@@ -105,15 +104,16 @@ def add_parser(commands: Any) -> None:
     live.add_argument(
         "--foxglove-port",
         type=int,
-        default=8765,
+        default=None,
         metavar="PORT",
-        help="TCP port (default 8765; 0: any free port)",
+        help="TCP port (default: foxglove.port, 8765; 0: any free port)",
     )
     live.add_argument(
         "--foxglove-host",
-        default="127.0.0.1",
+        default=None,
         metavar="HOST",
-        help="interface to bind (default 127.0.0.1, loopback only; 0.0.0.0: every interface)",
+        help="interface to bind (default: foxglove.host, 127.0.0.1, loopback only; 0.0.0.0: "
+        "every interface)",
     )
     live.add_argument(
         "--foxglove-wait",
@@ -276,11 +276,12 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
         shutil.rmtree(out / BAG_DIR, ignore_errors=True)
         guard.attach(loop, task)  # a signal now cancels the run, which then finishes
 
-    server, extra = _live_view(args)
-    bridge = _ros2_bridge(args, stack)
+    stack = _with_flags(args, stack)
+    extras = _extras(stack)
+    locks.callback(extras.close)
+    _announce(args, extras)
+    bridge = extras.ros2
     lockstep = bridge is not None and bool(bridge.options.lockstep)
-    if bridge is not None:
-        extra = (*extra, bridge)
     console = make_console()
     held: list[Verdict] = []
 
@@ -309,11 +310,11 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
             progress=None if paced else progress,
             source=source,
             on_start=on_start,
-            extra_actors=extra,
+            extra_actors=extras.actors,
             time=RealTime(scale) if paced else Virtual(),
             gui=args.gui,
             hold=hold if paced and args.hold else None,
-            on_system=_on_system(None if server is None else _serve_parameters(extra[0]), bridge),
+            on_system=lambda system: _serve_parameters(extras, system),
         )
     except RunCrashedError as crash:
         # An actor crashed (one line on stderr from the log; the traceback is on
@@ -337,10 +338,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
     finally:
         if progress is not None:
             progress.clear()
-        if server is not None:
-            server.close()
-        if bridge is not None:
-            bridge.close()
+        extras.close()
     if guard.received is not None:  # the run had ended; the signal came while saving
         return guard.report()
     out.mkdir(parents=True, exist_ok=True)
@@ -370,81 +368,49 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
     return 0 if verdict.passed else 1
 
 
-def _live_view(args: argparse.Namespace) -> tuple[Any, tuple[Any, ...]]:
-    """The Foxglove server and its actor when ``--foxglove`` (one line, exit 2, when it
-    cannot start); ``(None, ())`` otherwise."""
-    import sys
-
+def _extras(stack: Any) -> Extras:
+    """The Foxglove view and the ROS 2 bridge the config enables (one line, exit 2, when
+    one cannot start): made in one place for every entry point (otonav.engine)."""
+    from otonav.engine import ExtrasError, open_extras
     from otonav.stack.files import ConfigFileError
-
-    if not args.foxglove:
-        return None, ()
-    from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
 
     try:
-        options = LiveViewOptions(
-            host=args.foxglove_host, port=args.foxglove_port, wait_for_subscriber=args.foxglove_wait
-        )
-        server = FoxgloveServer(options)
-    except LiveViewError as exc:
+        return open_extras(stack)
+    except ExtrasError as exc:
         raise ConfigFileError(str(exc)) from None
-    hint = ""
-    if not (args.realtime or args.gui) and args.foxglove_wait is None:
-        hint = "; in virtual time the run may be over before a client connects: --foxglove-wait S"
-    print(
-        f"foxglove: serving every topic on {server.url} (Foxglove: Open connection -> "
-        f"Foxglove WebSocket){hint}",
-        file=sys.stderr,
-        flush=True,
-    )
-    return server, (LiveView(server),)
 
 
-def _on_system(
-    foxglove: Callable[[System], None] | None, bridge: Any
-) -> Callable[[System], None] | None:
-    """The run's ``on_system``: the Foxglove view's parameters, and the ROS 2 bridge's
-    (served as ROS 2 parameter services when rclpy is importable: ADR 0065)."""
-    if foxglove is None and bridge is None:
-        return None
+def _with_flags(args: argparse.Namespace, stack: Any) -> Any:
+    """The stack config with the ``--foxglove*`` and ``--ros2*`` flags applied to its
+    ``foxglove`` and ``ros2`` sections, checked as the config is (one line naming the
+    flag and what is valid)."""
+    from pydantic import ValidationError
 
-    def on_system(system: System) -> None:
-        if foxglove is not None:
-            foxglove(system)
-        if bridge is not None:
-            bridge.serve_parameters(system.actor(a.name) for a in system.graph().actors)
+    from otonav.stack.config import FoxgloveConfig
+    from otonav.stack.files import ConfigFileError, describe_validation_error
 
-    return on_system
-
-
-def _serve_parameters(view: LiveView) -> Callable[[System], None]:
-    """What ``run_scenario`` calls with the run's system: ``view`` serves the parameters
-    of every actor of it (Foxglove's Parameters panel, as ros-foxglove-bridge serves a
-    robot's nodes'; docs/adr/0044), and the command says which ones can be set."""
-    import sys
-
-    def serve(system: System) -> None:
-        table = view.serve_parameters(system.actor(a.name) for a in system.graph().actors)
-        names = list(table.values())
-        settable = sorted({n.split(".")[0] for n in names if table.settable(n)})
-        fields = ", ".join(f"{actor}.params.FIELD" for actor in settable) or "none"
-        print(
-            f"foxglove: serving the parameters of the run's actors ({len(names)}; "
-            f"Foxglove: Parameters panel); numbers settable while it runs: {fields}",
-            file=sys.stderr,
-            flush=True,
+    fox: dict[str, Any] = {
+        key: value
+        for key, value in (
+            ("host", args.foxglove_host),
+            ("port", args.foxglove_port),
+            ("wait_for_subscriber", args.foxglove_wait),
         )
-
-    return serve
-
-
-def _ros2_bridge(args: argparse.Namespace, stack: Any) -> Any:
-    """The ROS 2 bridge when ``--ros2`` or ``ros2.enabled`` (one line, exit 2, when it
-    cannot start); None otherwise."""
-    import sys
-
-    from otonav.stack.files import ConfigFileError
-
+        if value is not None
+    }
+    if fox and not (args.foxglove or stack.foxglove.enabled):
+        named = "/".join(f"--foxglove-{k.split('_')[0]}" for k in fox)
+        raise ConfigFileError(f"{named}: only with --foxglove (or foxglove.enabled)")
+    update: dict[str, Any] = {}
+    if args.foxglove or fox:
+        try:
+            update["foxglove"] = FoxgloveConfig.model_validate(
+                {**stack.foxglove.model_dump(), **fox, "enabled": True}
+            )
+        except ValidationError as exc:
+            field = str(exc.errors()[0]["loc"][0]) if exc.errors() else ""
+            flag = f"--foxglove-{field.split('_')[0]}" if field in fox else f"foxglove.{field}"
+            raise ConfigFileError(describe_validation_error(flag, exc)) from None
     section = stack.ros2
     if not (args.ros2 or section.enabled):
         flags = {
@@ -456,32 +422,63 @@ def _ros2_bridge(args: argparse.Namespace, stack: Any) -> Any:
         given = [flag for flag, used in flags.items() if used]
         if given:
             raise ConfigFileError(f"{'/'.join(given)}: only with --ros2")
-        return None
-    from otonav.ros2 import Ros2Error, bridge_for
-
-    section = _ros2_section(args, section)
-    try:
-        bridge = bridge_for(
-            section,
-            domain_id=args.ros2_domain,
-            inputs=args.ros2_inputs or (),
-            base_frame=stack.robot.frames.base,
-        )
-    except Ros2Error as exc:
-        raise ConfigFileError(str(exc)) from None
-    options = bridge.options
-    if options.lockstep:
-        answers = ", ".join(f"{name} every {period:g} s" for name, period in options.lockstep)
-        timing = f"in lockstep: sim time waits for {answers}"
     else:
-        timing = "paced to the wall clock"
+        update["ros2"] = _ros2_section(args, section)
+    return stack.model_copy(update=update) if update else stack
+
+
+def _announce(args: argparse.Namespace, extras: Extras) -> None:
+    """Say on stderr where the live view and the bridge serve, before the run starts."""
+    import sys
+
+    server = extras.foxglove
+    if server is not None:
+        hint = ""
+        if not (args.realtime or args.gui) and server.options.wait_for_subscriber is None:
+            hint = (
+                "; in virtual time the run may be over before a client connects: --foxglove-wait S"
+            )
+        print(
+            f"foxglove: serving every topic on {server.url} (Foxglove: Open connection -> "
+            f"Foxglove WebSocket){hint}",
+            file=sys.stderr,
+            flush=True,
+        )
+    bridge = extras.ros2
+    if bridge is not None:
+        options = bridge.options
+        if options.lockstep:
+            answers = ", ".join(f"{name} every {period:g} s" for name, period in options.lockstep)
+            timing = f"in lockstep: sim time waits for {answers}"
+        else:
+            timing = "paced to the wall clock"
+        print(
+            f"ros2: every topic on DDS domain {bridge.domain_id} (rt/odom ...), seen from "
+            f"{bridge.discovery.scope}; taking {', '.join(options.inputs)} in; {timing}",
+            file=sys.stderr,
+            flush=True,
+        )
+
+
+def _serve_parameters(extras: Extras, system: System) -> None:
+    """What ``run_scenario`` calls with the run's system: the extras serve the parameters
+    of every actor of it (Foxglove's Parameters panel, as ros-foxglove-bridge serves a
+    robot's nodes', docs/adr/0044; ROS 2 parameter services, 0065), and the command says
+    which ones Foxglove can set."""
+    import sys
+
+    table = extras.serve_parameters(system)
+    if table is None:
+        return
+    names = list(table.values())
+    settable = sorted({n.split(".")[0] for n in names if table.settable(n)})
+    fields = ", ".join(f"{actor}.params.FIELD" for actor in settable) or "none"
     print(
-        f"ros2: every topic on DDS domain {bridge.domain_id} (rt/odom ...), seen from "
-        f"{bridge.discovery.scope}; taking {', '.join(options.inputs)} in; {timing}",
+        f"foxglove: serving the parameters of the run's actors ({len(names)}; "
+        f"Foxglove: Parameters panel); numbers settable while it runs: {fields}",
         file=sys.stderr,
         flush=True,
     )
-    return bridge
 
 
 def _ros2_section(args: argparse.Namespace, section: Any) -> Any:
@@ -512,6 +509,11 @@ def _ros2_section(args: argparse.Namespace, section: Any) -> Any:
         )
     if args.ros2_wait is not None:
         update["wait"] = args.ros2_wait
+    if args.ros2_domain is not None:
+        update["domain_id"] = args.ros2_domain
+    if args.ros2_inputs:
+        update["inputs"] = tuple(args.ros2_inputs)
+    update["enabled"] = True
     lockstep = update.get("lockstep", section.lockstep)
     if lockstep and (args.realtime or args.gui or args.scale is not None):
         raise ConfigFileError(
@@ -519,10 +521,18 @@ def _ros2_section(args: argparse.Namespace, section: Any) -> Any:
         )
     if lockstep and update.get("wait", section.wait) is None:
         update["wait"] = 30.0  # a node started a moment later must not miss the start
-    if not update:
-        return section
-    flag = "--lockstep" if "lockstep" in update else "--ros2-wait"
     try:
         return Ros2Config.model_validate({**section.model_dump(), **update})
     except ValidationError as exc:
+        field = str(exc.errors()[0]["loc"][0]) if exc.errors() else ""
+        flag = _ROS2_FLAGS.get(field, "--ros2") if field in update else f"ros2.{field}"
         raise ConfigFileError(describe_validation_error(flag, exc)) from None
+
+
+_ROS2_FLAGS = {
+    "lockstep": "--lockstep",
+    "wait": "--ros2-wait",
+    "domain_id": "--ros2-domain",
+    "inputs": "--ros2-in",
+}
+"""The flag that sets each field of the ``ros2`` section, for its one-line error."""

@@ -8,11 +8,11 @@ from collections.abc import AsyncIterator, Sequence
 from contextlib import asynccontextmanager
 from pathlib import Path
 from types import TracebackType
-from typing import Any, Generic, TypeVar
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 from otonav.actors import topics
 from otonav.embed._wait import _wait_done
-from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewOptions
+from otonav.engine import open_extras
 from otonav.hal import RobotHardwareInterface
 from otonav.msgs import Header, Message, Point, Pose, PoseStamped, Time
 from otonav.record.writer import RecordingWriter
@@ -34,6 +34,9 @@ from otonav.runtime import (
 )
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.session import StackSession
+
+if TYPE_CHECKING:
+    from otonav.foxglove import FoxgloveServer
 
 M = TypeVar("M")
 
@@ -154,9 +157,9 @@ class LiveStack:
         self._close_done: asyncio.Future[None] | None = None
         self._failure: BaseException | None = None
         self.foxglove: FoxgloveServer | None = None
+        """The Foxglove live view's server (``foxglove.enabled``), else None."""
         self.ros2: Actor | None = None
-        """The ROS 2 bridge (``open_live_stack(ros2=True)``), else None."""
-        """The Foxglove live view's server, when asked for (``foxglove=True``)."""
+        """The ROS 2 bridge (``ros2.enabled``), else None."""
 
     # -- what a host reads
 
@@ -305,12 +308,6 @@ class LiveStack:
             raise asyncio.CancelledError
 
 
-def _foxglove_server(foxglove: bool | LiveViewOptions) -> FoxgloveServer | None:
-    if foxglove is False:
-        return None
-    return FoxgloveServer(foxglove if isinstance(foxglove, LiveViewOptions) else LiveViewOptions())
-
-
 @asynccontextmanager
 async def open_live_stack(
     stack: StackConfig = StackConfig(),
@@ -318,10 +315,7 @@ async def open_live_stack(
     time: RealTime = RealTime(),
     record_to: Path | RecordingWriter | None = None,
     goal: tuple[float, float] | None = None,
-    navigator: bool = True,
     extra_actors: Sequence[Actor] = (),
-    foxglove: bool | LiveViewOptions = False,
-    ros2: bool = False,
 ) -> AsyncIterator[LiveStack]:
     """Bring the robot stack up on the running (stock asyncio) loop in real-time mode,
     the world stepped to follow the wall clock (``time``: ``RealTime(scale)``, default
@@ -330,63 +324,48 @@ async def open_live_stack(
     on every exit (or to that writer, e.g. a size-capped
     :class:`~otonav.record.rotating.RotatingRecordingWriter`). ``goal``: an initial
     goal for the navigator (or publish one later). Which planner runs, and whether the
-    safety layer does, is the stack config's (``nav.planner``, ``safety.enabled``);
-    ``navigator=False`` is the deprecated spelling of ``nav.planner: external``.
+    safety layer does, is the stack config's (``nav.planner``, ``safety.enabled``).
 
     On exit (normal, an exception, or the host's cancellation) the stack stops and the
     recording is finished. If an actor crashed and stopped the stack while the body ran
     normally, its :class:`~otonav.runtime.ActorCrashedError` is raised on exit.
 
-    ``foxglove=True`` (or :class:`~otonav.foxglove.view.LiveViewOptions`) also serves
-    every topic to Foxglove over WebSocket (127.0.0.1:8765 by default; ``live.foxglove``
-    is the server, stopped on exit).
-
-    ``ros2=True`` (or ``ros2.enabled`` in ``stack``) also mirrors every topic on DDS as a
-    ROS 2 node does and takes the section's ``inputs`` in (the ``otonav[ros2]`` extra;
-    ADR 0047): ``live.ros2`` is the bridge.
+    The stack config's optional sections run too, made as every entry point makes them
+    (:func:`otonav.engine.open_extras`): ``foxglove.enabled`` serves every topic and the
+    actors' parameters to Foxglove over WebSocket (``live.foxglove`` is the server);
+    ``ros2.enabled`` mirrors every topic on DDS as a ROS 2 node does and takes the
+    section's ``inputs`` in (the ``otonav[ros2]`` extra; ADR 0047): ``live.ros2`` is the
+    bridge. Both stop on exit. One that cannot start raises
+    :class:`~otonav.engine.ExtrasError` (one line) before anything runs.
     """
     if not isinstance(time, RealTime):
         raise TypeError(
             f"open_live_stack(time={time!r}): a live stack runs in real time on the host's "
             "loop: RealTime(scale); for virtual time use running_stack or run_scenario"
         )
-    server = _foxglove_server(foxglove)
+    extras = open_extras(stack)
     try:
         hal = build_world(stack)
     except BaseException:
-        if server is not None:
-            server.close()
+        extras.close()
         raise
     live: LiveStack | None = None
     try:
         try:
-            actors = [*build_actors(stack, hal, navigator=navigator, goal=goal), *extra_actors]
-            if server is not None:
-                actors.append(LiveView(server))
-            bridge = None
-            if ros2 or stack.ros2.enabled:
-                from otonav.ros2 import bridge_for
-
-                bridge = bridge_for(stack.ros2, base_frame=stack.robot.frames.base)
-                actors.append(bridge)
-        except BaseException:
-            hal.close()
-            if server is not None:
-                server.close()
-            raise
-        try:  # the session owns the world from here (it closes it if it fails)
+            actors = [*build_actors(stack, hal, goal=goal), *extra_actors, *extras.actors]
+            # the session owns the world from here (it closes it if it fails)
             session = StackSession(hal, actors, time=time, record_to=record_to)
         except BaseException:
-            if server is not None:
-                server.close()
+            hal.close()
+            extras.close()
             raise
         clock = session.realtime_clock
         assert clock is not None
-        if server is not None:
-            session.add_cleanup(server.close)
+        session.add_cleanup(extras.close)
+        extras.serve_parameters(session.system)
         live = LiveStack(session, clock)
-        live.foxglove = server
-        live.ros2 = bridge
+        live.foxglove = extras.foxglove
+        live.ros2 = extras.ros2
         live._start()
         yield live
     finally:

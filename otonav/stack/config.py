@@ -614,6 +614,23 @@ class Ros2Config(_Section):
     (``--ros2-wait``; null: do not wait, or 30 s in lockstep), in (0, 3600]."""
 
 
+class FoxgloveConfig(_Section):
+    """The Foxglove live view (``otonav run --foxglove``, the extra ``otonav[foxglove]``;
+    ADR 0031): every topic served over the Foxglove WebSocket protocol."""
+
+    enabled: bool = False
+    """Serve every topic (and the actors' parameters) to Foxglove clients."""
+    host: Annotated[str, Field(min_length=1, max_length=253, pattern=r"^[A-Za-z0-9.:\-]+$")] = (
+        "127.0.0.1"
+    )
+    """Interface to bind: loopback unless asked (``0.0.0.0`` serves every interface)."""
+    port: int = Field(8765, ge=0, le=65535)
+    """TCP port (Foxglove's convention, 8765); 0 picks a free one."""
+    wait_for_subscriber: float | None = Field(None, gt=0.0, le=3600.0)
+    """s of wall time, at most, that sim time holds at 0 until a client subscribes
+    (``--foxglove-wait``; null: do not wait), in (0, 3600]."""
+
+
 class StackConfig(_Section):
     """Everything needed to bring the robot stack up."""
 
@@ -626,6 +643,7 @@ class StackConfig(_Section):
     hal: HalConfig = HalConfig()
     robot: RobotConfig = RobotConfig()
     ros2: Ros2Config = Ros2Config()
+    foxglove: FoxgloveConfig = FoxgloveConfig()
     actors: tuple[ActorConfig, ...] = ()
     """Extra nodes, or replacements of built-in ones, in launch order."""
 

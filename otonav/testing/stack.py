@@ -6,12 +6,17 @@ from collections.abc import AsyncIterator, Sequence
 from contextlib import asynccontextmanager
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
+from otonav.engine import open_extras
 from otonav.hal import BoxObstacle, RobotHardwareInterface
 from otonav.runtime import Actor, System, TimeMode, Virtual
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.loading import load_stack_file
 from otonav.stack.session import StackSession
+
+if TYPE_CHECKING:
+    from otonav.foxglove import FoxgloveServer
 
 
 @dataclass(slots=True)
@@ -22,6 +27,8 @@ class RunningStack:
     hal: RobotHardwareInterface
     ros2: Actor | None = None
     """The ROS 2 bridge, when the config's ``ros2.enabled`` (ADR 0047, 0065)."""
+    foxglove: FoxgloveServer | None = None
+    """The Foxglove live view's server, when the config's ``foxglove.enabled``."""
 
 
 @asynccontextmanager
@@ -52,29 +59,29 @@ async def running_stack(
     /cmd_vel straight to the base. ``navigator=False`` is the deprecated spelling of
     ``nav.planner: external`` (ADR 0055).
 
-    With ``ros2.enabled`` in the config, the ROS 2 bridge runs too (``stack.ros2``), as
-    ``otonav run --ros2`` has it; with ``ros2.lockstep`` your ROS 2 nodes run in the
-    test's sim time (ADR 0065).
+    The config's optional sections run too, made as every entry point makes them
+    (:func:`otonav.engine.open_extras`): with ``ros2.enabled`` the ROS 2 bridge
+    (``stack.ros2``), as ``otonav run --ros2`` has it (with ``ros2.lockstep`` your ROS 2
+    nodes run in the test's sim time, ADR 0065); with ``foxglove.enabled`` the Foxglove
+    live view (``stack.foxglove``: watch a test as it runs, with ``wait_for_subscriber``).
     """
     if not isinstance(config, StackConfig):
         config = load_stack_file(config)
-    hal = build_world(config, extra_obstacles=extra_obstacles)
+    extras = open_extras(config)
     try:
-        actors = [*build_actors(config, hal, navigator=navigator), *extra_actors]
-        bridge: Actor | None = None
-        if config.ros2.enabled:
-            from otonav.ros2 import bridge_for
-
-            bridge = bridge_for(config.ros2, base_frame=config.robot.frames.base)
-            actors.append(bridge)
+        hal = build_world(config, extra_obstacles=extra_obstacles)
+    except BaseException:
+        extras.close()
+        raise
+    try:
+        actors = [*build_actors(config, hal, navigator=navigator), *extra_actors, *extras.actors]
+        # the session owns the world from here (it closes it if it fails)
+        session = StackSession(hal, actors, time=time, record_to=record_to)
     except BaseException:
         hal.close()
+        extras.close()
         raise
-    session = StackSession(
-        hal,
-        actors,
-        time=time,
-        record_to=record_to,
-    )
+    session.add_cleanup(extras.close)
+    extras.serve_parameters(session.system)
     async with session.running() as system:
-        yield RunningStack(system, hal, bridge)
+        yield RunningStack(system, hal, extras.ros2, extras.foxglove)

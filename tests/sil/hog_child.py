@@ -13,7 +13,6 @@ from __future__ import annotations
 import os
 import signal
 import sys
-from typing import Any
 
 from otonav.runtime import Actor
 
@@ -34,14 +33,17 @@ class Hog(Actor):
 def main() -> int:
     import otonav.cli.run as run_command
     from otonav.cli import main as cli
+    from otonav.engine import Extras
 
     out, name = sys.argv[1], sys.argv[2]
     hog = Hog({"INT": signal.SIGINT, "TERM": signal.SIGTERM}[name])
 
-    def live_view(_args: Any) -> tuple[None, tuple[Actor, ...]]:
-        return None, (hog,)
+    class HogExtras(Extras):
+        @property
+        def actors(self) -> tuple[Actor, ...]:
+            return (hog,)
 
-    vars(run_command)["_live_view"] = live_view  # the CLI's hook for extra actors
+    vars(run_command)["_extras"] = lambda _stack: HogExtras()  # the CLI's extras hook
     return cli(["run", "--out", out])
 
 

@@ -14,6 +14,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import anyio
 import pytest
 from foxglove_client import FoxgloveClient
 from websockets.asyncio.client import connect
@@ -25,8 +26,10 @@ from otonav.embed import open_live_stack
 from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
 from otonav.msgs import LaserScan
 from otonav.record.reader import read_messages, summarize
-from otonav.runtime import SENSOR_DATA_QOS, Actor, Output, RealTime
+from otonav.runtime import SENSOR_DATA_QOS, Actor, Output, RealTime, run_blocking
 from otonav.scenario import ScenarioConfig, run_scenario
+from otonav.stack import StackConfig
+from otonav.testing import running_stack
 
 pytestmark = pytest.mark.smoke
 
@@ -186,7 +189,8 @@ def test_bad_live_view_options_are_one_line_errors(capsys: pytest.CaptureFixture
     assert "pick another --foxglove-port" in err
     assert len(err.strip().splitlines()) == 1
     assert cli_main(["run", "--foxglove", "--foxglove-wait", "-1"]) == 2
-    assert "--foxglove-wait -1.0: must be" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "--foxglove-wait: wait_for_subscriber: Input should be greater than 0" in err
 
 
 def _free_port() -> int:
@@ -227,7 +231,8 @@ def test_cli_realtime_run_serves_live(tmp_path: Path, capsys: pytest.CaptureFixt
 
 @pytest.mark.asyncio
 async def test_open_live_stack_serves_foxglove_on_the_host_loop() -> None:
-    async with open_live_stack(time=RealTime(5.0), foxglove=LiveViewOptions(port=0)) as live:
+    stack = StackConfig.model_validate({"foxglove": {"enabled": True, "port": 0}})
+    async with open_live_stack(stack, time=RealTime(5.0)) as live:
         server = live.foxglove
         assert server is not None
         assert server.url.startswith("ws://127.0.0.1:")
@@ -239,6 +244,28 @@ async def test_open_live_stack_serves_foxglove_on_the_host_loop() -> None:
     assert server.closed  # stopped with the stack
     stamps = [t for t, _ in client.received["/odom"]]
     assert stamps == sorted(stamps)
+
+
+@pytest.mark.sim
+async def test_a_pytest_stack_serves_foxglove_from_its_config() -> None:
+    """running_stack wires the config's foxglove section as the CLI does (one place:
+    otonav.engine); a client sees the topics at the test's sim time, and the actors'
+    parameters are served."""
+    stack = StackConfig.model_validate(
+        {"foxglove": {"enabled": True, "port": 0, "wait_for_subscriber": 30}}
+    )
+    async with running_stack(stack) as running:
+        server = running.foxglove
+        assert server is not None
+        client = FoxgloveClient(server.url, expect={"/odom"}, subscribe={"/odom"})
+        await run_blocking(client.start)  # sim time holds at 0 until it subscribed
+        await anyio.sleep(2.0)  # of sim time: /odom is published into the server's queue
+        arrived = await run_blocking(client.wait_for, "/odom", 20)
+        await run_blocking(client.stop)
+        served = server.parameter_sink.get_parameters([])  # what a client's getParameters gets
+    assert arrived >= 20
+    assert server.closed
+    assert any(p["name"].startswith("nav.params.") for p in served)
 
 
 @pytest.mark.asyncio

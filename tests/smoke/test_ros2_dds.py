@@ -53,13 +53,13 @@ async def _reads_odom_and_sends_a_goal(way: str, domain: int) -> None:
             extra: tuple[Ros2Bridge, ...] = (bridge,)
         else:  # the embedding API's own option, from the stack config's ros2 section
             stack = stack.model_copy(
-                update={"ros2": stack.ros2.model_copy(update={"domain_id": domain})}
+                update={
+                    "ros2": stack.ros2.model_copy(update={"domain_id": domain, "enabled": True})
+                }
             )
             extra = ()
         with anyio.fail_after(CEILING):
-            async with open_live_stack(
-                stack, time=RealTime(4.0), extra_actors=extra, ros2=way == "embedding_option"
-            ) as live:
+            async with open_live_stack(stack, time=RealTime(4.0), extra_actors=extra) as live:
                 if way == "embedding_option":
                     assert isinstance(live.ros2, Ros2Bridge)
                     bridge = live.ros2
