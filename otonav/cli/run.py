@@ -509,8 +509,16 @@ def _ros2_section(args: argparse.Namespace, section: Any) -> Any:
         )
     if args.ros2_wait is not None:
         update["wait"] = args.ros2_wait
-    if args.ros2_domain is not None:
-        update["domain_id"] = args.ros2_domain
+    from otonav.ros2.naming import Ros2Error, dds_topic, domain_id
+
+    try:  # the flags' own one-line messages (the bridge's checks)
+        if args.ros2_domain is not None:
+            update["domain_id"] = domain_id(args.ros2_domain, {})
+        for topic in args.ros2_inputs or ():
+            dds_topic(topic)
+    except Ros2Error as exc:
+        prefix = "" if str(exc).startswith("--") else "--ros2-in "
+        raise ConfigFileError(prefix + str(exc)) from None
     if args.ros2_inputs:
         update["inputs"] = tuple(args.ros2_inputs)
     update["enabled"] = True
