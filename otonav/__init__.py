@@ -13,7 +13,8 @@ Layers, top to bottom; imports point down only (import-linter contracts in pypro
     scenario             run a scenario in sim time, judge it from ground truth, plot it
     stack                the launch file as data: robot description + actors -> world + actors
     actors               bridge, base controller, navigator, safety layer, recorder
-    record               MCAP recordings in ROS 2 CDR: write, read, info, salvage, bags
+    record               MCAP recordings in ROS 2 CDR (record.cdr: the codec, both ways):
+                         write, read, info, salvage, bags
     hal                  RobotHardwareInterface, FakeHardware, robot descriptions, the viewer
                          window; hal.mujoco (the MuJoCo world: scene, prepare, derive, world;
                          only its _lib imports mujoco); hal.can (wheels over CAN, only

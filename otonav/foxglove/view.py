@@ -44,8 +44,7 @@ from pydantic import ValidationError
 from otonav.actors import topics
 from otonav.actors.live_parameters import ActorParameters, ParameterError
 from otonav.msgs import Log, Message, Time
-from otonav.record.cdr import encode
-from otonav.record.cdr_decode import decode
+from otonav.record.cdr import decode, encode
 from otonav.record.schemas import schema_for
 from otonav.runtime import Actor, Bus, Durability, Output, QoS, Reliability, run_blocking
 from otonav.runtime.mailbox import Endpoint, Publisher, Subscription, Topic

@@ -16,8 +16,7 @@ from dataclasses import dataclass
 from typing import Any, Literal, NamedTuple
 
 from otonav.msgs import Message
-from otonav.record.cdr import encode
-from otonav.record.cdr_decode import decode
+from otonav.record.cdr import decode, encode
 from otonav.replay.recording import RecordedMessage
 
 Kind = Literal["content", "missing", "extra"]

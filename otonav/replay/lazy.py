@@ -8,7 +8,7 @@ acceptance recording's 1342. Decoding them all was a quarter of a navigator repl
 A lazy message is an instance of a subclass of its message class that holds only its CDR
 bytes. Its first attribute access of any kind (a field, a method, ``__dict__``, which
 every pydantic method goes through, and the comparison and hash operators) decodes it
-with :func:`~otonav.record.cdr_decode.decode`, takes the decoded fields and switches the
+with :func:`~otonav.record.cdr.decode`, takes the decoded fields and switches the
 object's class to the message class itself. From then on it is that message, field for
 field, type for type: ``type(m) is Odometry``, equal to and hashing like the eagerly
 decoded one (tests check each operation). Before its first use only ``type(m)`` tells
@@ -36,7 +36,7 @@ from otonav.msgs.stand_in import set_dict as _set_dict
 from otonav.msgs.stand_in import set_extra as _set_extra
 from otonav.msgs.stand_in import set_fields_set as _set_fields_set
 from otonav.msgs.stand_in import set_private as _set_private
-from otonav.record.cdr_decode import decode, flat_values
+from otonav.record.cdr import decode, flat_values
 from otonav.record.schemas import layout_for
 
 __all__ = ("input_maker", "is_lazy", "lazy", "lazy_maker", "materialize")

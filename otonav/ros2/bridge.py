@@ -53,8 +53,7 @@ from otonav.msgs import (
     Twist,
     TwistStamped,
 )
-from otonav.record.cdr import encode
-from otonav.record.cdr_decode import decode
+from otonav.record.cdr import decode, encode
 from otonav.ros2.naming import (
     DdsQos,
     Discovery,

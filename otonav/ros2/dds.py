@@ -3,7 +3,7 @@
 A :class:`Participant` on one DDS domain makes raw writers and readers: a writer takes
 the CDR bytes of :func:`otonav.record.cdr.encode` (encapsulation header included) and
 hands them to Cyclone unchanged (``ddspy_write``); a reader returns the bytes of each
-sample as they came (``ddspy_take``), for :func:`otonav.record.cdr_decode.decode`. So a
+sample as they came (``ddspy_take``), for :func:`otonav.record.cdr.decode`. So a
 message is encoded once, by the encoder the recordings use, and never goes through
 Cyclone's Python serializer.
 

@@ -20,7 +20,7 @@ from otonav.hal import RobotHardwareInterface
 from otonav.msgs import Clock, Imu, Message, Odometry, PoseStamped, TFMessage, Twist
 from otonav.msgs.flat import is_flat
 from otonav.nav import GoalCommand, go_to_goal
-from otonav.record.cdr_decode import decode
+from otonav.record.cdr import decode
 from otonav.record.reader import MAGIC, read_messages, summarize
 from otonav.record.writer import RecordingWriter
 from otonav.replay import nodes, replay_recording

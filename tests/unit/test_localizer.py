@@ -19,8 +19,7 @@ from otonav.hal import FakeHardware
 from otonav.msgs import OccupancyGrid, Odometry, Time, WheelCommand
 from otonav.nav.navigation import NavigationParams
 from otonav.nav.scan_match import compose, inverse
-from otonav.record.cdr import encode
-from otonav.record.cdr_decode import decode
+from otonav.record.cdr import decode, encode
 from otonav.runtime import QoS, Reliability, System, virtual_loop_factory
 
 pytestmark = pytest.mark.unit

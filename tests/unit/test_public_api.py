@@ -189,11 +189,22 @@ PINNED: dict[str, tuple[str, ...]] = {
         "TopicComparison",
         "replay_recording",
     ),
+    "otonav.engine": (
+        "Extras",
+        "ExtrasError",
+        "open_extras",
+    ),
     "otonav.foxglove": (
         "FoxgloveServer",
         "LiveView",
         "LiveViewError",
         "LiveViewOptions",
+    ),
+    "otonav.record.cdr": (
+        "ENCAPSULATION",
+        "decode",
+        "encode",
+        "flat_values",
     ),
     "otonav.ros2": (
         "Ros2Bridge",

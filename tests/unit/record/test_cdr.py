@@ -55,8 +55,8 @@ from otonav.msgs import (
     WheelCommand,
 )
 from otonav.msgs import KeyValue as DiagKeyValue
+from otonav.record.cdr import decode as decode_cdr
 from otonav.record.cdr import encode
-from otonav.record.cdr_decode import decode as decode_cdr
 from otonav.record.schemas import schema_for
 
 pytestmark = pytest.mark.unit

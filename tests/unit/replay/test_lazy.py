@@ -25,8 +25,7 @@ from otonav.msgs import (
     Vector3,
 )
 from otonav.msgs.flat import flat_state, is_flat
-from otonav.record.cdr import encode
-from otonav.record.cdr_decode import decode
+from otonav.record.cdr import decode, encode
 from otonav.replay.feed import FLAT_LAYOUTS
 from otonav.replay.lazy import input_maker, is_lazy, lazy, materialize
 from otonav.runtime import QoS, Reliability, TopicTypeError
