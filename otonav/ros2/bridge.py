@@ -311,8 +311,21 @@ class Ros2Bridge(Actor):
         topic.subscriptions.append(mirror)
         self._mirrors[topic.name] = mirror
         if self._bus is not None and self._started:
-            self._open_writer(topic, mirror)
-            self._announce()
+            # A topic made after the start (a test's latched /goal): its first publisher
+            # is added just after this call, and the writer must offer what it offers
+            # (a transient-local reader never matches a volatile writer). Opened once it
+            # exists, before sim time moves on.
+            asyncio.get_running_loop().call_soon(self._open_late, topic, mirror)
+
+    def _open_late(self, topic: Topic[Any], mirror: _Mirror) -> None:
+        if mirror.writer is not None or not self._started:
+            return
+        self._open_writer(topic, mirror)
+        self._announce()
+        if self.options.lockstep and self.options.wait_for_peers is not None:
+            # The nodes' readers match it a moment later; in lockstep sim time holds
+            # until they did (the loop is held: nothing else may move meanwhile).
+            self.participant.wait_quiet(_DISCOVERY_QUIET, self.options.wait_for_peers)
 
     def _wire_type(self, msg_type: type[Message]) -> type[Message]:
         """The type a topic has on DDS: TwistStamped for a Twist with ``twist_stamped``."""
