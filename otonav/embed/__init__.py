@@ -2,8 +2,9 @@
 
 Two shapes, one entry point each:
 
-- :func:`open_live_stack`: a live robot on the host's (stock) loop in real-time mode:
-  the world is stepped to follow the wall clock (times ``scale``). The host subscribes
+- :func:`open_live_stack` (from :mod:`otonav.engine`): a live robot on the host's (stock)
+  loop in real-time mode: the world is stepped to follow the wall clock
+  (``time=RealTime(scale)``). The host subscribes
   to topics (async iterators of typed messages), publishes goals and commands, reads
   the graph and its statistics; the stack closes cleanly, its recording finished, when
   the ``async with`` exits or the host task is cancelled.
@@ -33,8 +34,8 @@ on the host's loop is the actors' own (a lidar scan ~0.1 ms, an MCAP chunk compr
 every 64 KiB when recording).
 """
 
-from otonav.embed.live import HOST_QOS, LiveStack, LiveSubscription, open_live_stack
 from otonav.embed.runs import DEFAULT_MAX_RUNS, check_run, default_limiter, run_scenario_async
+from otonav.engine import HOST_QOS, LiveStack, LiveSubscription, open_live_stack
 
 __all__ = (
     "DEFAULT_MAX_RUNS",

@@ -13,7 +13,7 @@ from typing import TypeVar
 import anyio
 import anyio.to_thread
 
-from otonav.embed._wait import _wait_done
+from otonav.engine._wait import _wait_done
 from otonav.runtime import (
     Actor,
 )

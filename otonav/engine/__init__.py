@@ -1,7 +1,22 @@
-"""What the entry points share above the stack: the optional parts a stack config asks
-for (its ``foxglove`` and ``ros2`` sections), wired in one place for the CLI, the
-embedding and the pytest helper (:func:`open_extras`)."""
+"""What every entry point shares above the stack.
+
+- :func:`open_live_stack`: a stack held open on the running loop, in real time (a host
+  service) or virtual time (a pytest test): subscribe, publish, goals, the graph; one
+  teardown (:class:`LiveStack`). ``otonav.embed`` and ``otonav.testing.running_stack``
+  are this function.
+- :func:`open_extras`: the config's optional sections (``foxglove``, ``ros2``) as actors,
+  wired in one place for the CLI, the embedding and pytest (:class:`Extras`).
+"""
 
 from otonav.engine.extras import Extras, ExtrasError, open_extras
+from otonav.engine.live import HOST_QOS, LiveStack, LiveSubscription, open_live_stack
 
-__all__ = ("Extras", "ExtrasError", "open_extras")
+__all__ = (
+    "HOST_QOS",
+    "Extras",
+    "ExtrasError",
+    "LiveStack",
+    "LiveSubscription",
+    "open_extras",
+    "open_live_stack",
+)

@@ -7,6 +7,6 @@
 """
 
 from otonav.testing.replay import ReplayCrashError, replay
-from otonav.testing.stack import RunningStack, running_stack
+from otonav.testing.stack import running_stack
 
-__all__ = ("ReplayCrashError", "RunningStack", "replay", "running_stack")
+__all__ = ("ReplayCrashError", "replay", "running_stack")

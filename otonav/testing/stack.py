@@ -4,46 +4,30 @@ from __future__ import annotations
 
 from collections.abc import AsyncIterator, Sequence
 from contextlib import asynccontextmanager
-from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
 
-from otonav.engine import open_extras
-from otonav.hal import BoxObstacle, RobotHardwareInterface
-from otonav.runtime import Actor, System, TimeMode, Virtual
-from otonav.stack import StackConfig, build_actors, build_world
+from otonav.engine import LiveStack, open_live_stack
+from otonav.hal import BoxObstacle
+from otonav.runtime import Actor, TimeMode, Virtual
+from otonav.stack import StackConfig
 from otonav.stack.loading import load_stack_file
-from otonav.stack.session import StackSession
-
-if TYPE_CHECKING:
-    from otonav.foxglove import FoxgloveServer
-
-
-@dataclass(slots=True)
-class RunningStack:
-    """The system (subscribe, publish, graph) and the world (ground truth) of a test."""
-
-    system: System
-    hal: RobotHardwareInterface
-    ros2: Actor | None = None
-    """The ROS 2 bridge, when the config's ``ros2.enabled`` (ADR 0047, 0065)."""
-    foxglove: FoxgloveServer | None = None
-    """The Foxglove live view's server, when the config's ``foxglove.enabled``."""
 
 
 @asynccontextmanager
 async def running_stack(
     config: StackConfig | Path | str = StackConfig(),
     *,
-    navigator: bool = True,
     extra_actors: Sequence[Actor] = (),
     extra_obstacles: Sequence[BoxObstacle] = (),
     time: TimeMode = Virtual(),
     record_to: Path | None = None,
-) -> AsyncIterator[RunningStack]:
+) -> AsyncIterator[LiveStack]:
     """Bring up the stack ``config`` launches (world, bridge, base, the planner
     ``nav.planner`` names, the safety layer unless ``safety.enabled: false``, its
-    ``actors``) for the body of an ``async with``.
+    ``actors``) for the body of an ``async with``: :func:`otonav.engine.open_live_stack`
+    with virtual time as its default and a config file accepted. It yields the same
+    :class:`~otonav.engine.LiveStack` (``stack.system``, ``stack.hal`` for ground truth,
+    ``stack.publish_goal``, ``stack.subscribe``).
 
     On a :class:`VirtualTimeLoop` (``@pytest.mark.sim``) the world becomes the loop's time
     source: sim time is loop time. With ``time=RealTime(scale)``, the stack runs on the
@@ -56,8 +40,7 @@ async def running_stack(
     file ``otonav run --config`` takes, with its robot and its ``actors``. To drive the
     robot yourself, say so there: ``nav.planner: external`` (your node publishes
     /cmd_vel_nav, behind the safety layer), plus ``safety.enabled: false`` to publish
-    /cmd_vel straight to the base. ``navigator=False`` is the deprecated spelling of
-    ``nav.planner: external`` (ADR 0055).
+    /cmd_vel straight to the base.
 
     The config's optional sections run too, made as every entry point makes them
     (:func:`otonav.engine.open_extras`): with ``ros2.enabled`` the ROS 2 bridge
@@ -67,21 +50,11 @@ async def running_stack(
     """
     if not isinstance(config, StackConfig):
         config = load_stack_file(config)
-    extras = open_extras(config)
-    try:
-        hal = build_world(config, extra_obstacles=extra_obstacles)
-    except BaseException:
-        extras.close()
-        raise
-    try:
-        actors = [*build_actors(config, hal, navigator=navigator), *extra_actors, *extras.actors]
-        # the session owns the world from here (it closes it if it fails)
-        session = StackSession(hal, actors, time=time, record_to=record_to)
-    except BaseException:
-        hal.close()
-        extras.close()
-        raise
-    session.add_cleanup(extras.close)
-    extras.serve_parameters(session.system)
-    async with session.running() as system:
-        yield RunningStack(system, hal, extras.ros2, extras.foxglove)
+    async with open_live_stack(
+        config,
+        time=time,
+        record_to=record_to,
+        extra_actors=extra_actors,
+        extra_obstacles=extra_obstacles,
+    ) as stack:
+        yield stack

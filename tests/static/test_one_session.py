@@ -18,7 +18,7 @@ RUNNERS = [
     "otonav/scenario/run.py",
     "otonav/scenario/realtime.py",
     "otonav/testing/stack.py",
-    "otonav/embed/live.py",
+    "otonav/engine/live.py",
     "otonav/bench/harness.py",
 ]
 #: What only the session may make or do: it owns recording, time mode and teardown.

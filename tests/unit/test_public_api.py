@@ -190,9 +190,13 @@ PINNED: dict[str, tuple[str, ...]] = {
         "replay_recording",
     ),
     "otonav.engine": (
+        "HOST_QOS",
         "Extras",
         "ExtrasError",
+        "LiveStack",
+        "LiveSubscription",
         "open_extras",
+        "open_live_stack",
     ),
     "otonav.foxglove": (
         "FoxgloveServer",
@@ -323,7 +327,6 @@ PINNED: dict[str, tuple[str, ...]] = {
     ),
     "otonav.testing": (
         "ReplayCrashError",
-        "RunningStack",
         "replay",
         "running_stack",
     ),
