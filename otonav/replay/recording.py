@@ -10,6 +10,7 @@ the instant it published, and may sit later in the file).
 
 from __future__ import annotations
 
+import json
 from collections.abc import Collection
 from dataclasses import dataclass, field
 from operator import itemgetter
@@ -22,6 +23,7 @@ from pydantic import ValidationError
 from otonav.record.fastreader import ChunkDamageError, read_raw_messages
 from otonav.record.reader import CUT_OFF_ERRORS, MAGIC
 from otonav.record.verify import _finished, _one_line, describe_damage
+from otonav.scenario.config import StartSpec
 from otonav.stack import StackConfig
 
 
@@ -64,6 +66,22 @@ class Recording:
     summary: Any = None
     """mcap's parsed summary section (channels, schemas, chunk indexes), for
     :func:`read_topics`."""
+
+    @property
+    def start(self) -> tuple[float, float, float]:
+        """Where the run started (x, y, yaw): the stored scenario's start, where its
+        odometry and its navigator's map are anchored; the origin when none is stored
+        (a recording made with ``running_stack``, which starts there by default)."""
+        text = self.metadata.get("otonav", {}).get("scenario_config")
+        if text is None:
+            return (0.0, 0.0, 0.0)
+        try:
+            start = StartSpec.model_validate(json.loads(text).get("start", {}))
+        except (ValueError, AttributeError):  # not JSON, not an object, not a start
+            raise ReplayInputError(
+                f"{self.path}: its stored scenario has no readable start pose"
+            ) from None
+        return start.as_tuple()
 
 
 def _cut_off(path: Path) -> ReplayInputError:

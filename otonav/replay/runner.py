@@ -218,7 +218,7 @@ def _replay(
         config = apply_overrides(config, overrides)
     names = [n for n in nodes if isinstance(n, str)]
     geometry = recorded_geometry(meta, config)
-    built = iter(build_nodes(names, config, geometry)) if names else iter(())
+    built = iter(build_nodes(names, config, geometry, meta.start)) if names else iter(())
     actors: list[Actor] = [next(built) if isinstance(n, str) else n for n in nodes]
     if not actors:
         raise ReplayInputError("--node: name at least one node to replay")
