@@ -17,12 +17,13 @@ from operator import itemgetter
 from pathlib import Path
 from typing import Any, BinaryIO, NamedTuple
 
+from mcap.exceptions import McapError
 from mcap.reader import NonSeekingReader, make_reader
 from pydantic import ValidationError
 
 from otonav.record.fastreader import ChunkDamageError, read_raw_messages
 from otonav.record.reader import CUT_OFF_ERRORS, MAGIC
-from otonav.record.verify import _finished, _one_line, describe_damage
+from otonav.record.verify import _finished, _one_line, describe_damage, summary_damage
 from otonav.scenario.config import StartSpec
 from otonav.stack import StackConfig
 
@@ -115,10 +116,16 @@ def load_recording(path: Path, topics: Collection[str] | None) -> Recording:
             reader = make_reader(f)
             try:
                 summary = reader.get_summary()
-            except OSError:  # too short to hold a footer: a seek before its start
-                raise _cut_off(path) from None
+            except OSError as exc:  # too short to hold a footer: a seek before its start
+                raise _unreadable(path, exc) from None
             if summary is None or summary.statistics is None:
-                raise _cut_off(path)
+                raise _unreadable(path, McapError("no index"))
+            index = summary_damage(path)
+            if index is not None:
+                raise ReplayInputError(
+                    f"{path}: damaged: {index.problem.partition(':')[0]}; 'otonav salvage "
+                    f"{path} FIXED.mcap' rewrites its intact chunks with a new index"
+                )
             types: dict[str, str] = {}
             schemas: dict[str, RecordedSchema] = {}
             for channel in summary.channels.values():
