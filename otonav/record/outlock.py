@@ -132,7 +132,17 @@ def lock_output(path: Path, *, what: str = "--out", is_file: bool = False) -> It
             held.depth -= 1
             if held.depth == 0:
                 del _held[key]
-                if created and os.fstat(held.fd).st_size == 0:
+                if created and _still_empty(path, held.fd):
                     with contextlib.suppress(OSError):
                         path.unlink()
                 os.close(held.fd)  # releases the flock
+
+
+def _still_empty(path: Path, fd: int) -> bool:
+    """``path`` is still the empty file the lock created (not a file renamed over it)."""
+    try:
+        here = os.stat(path)
+    except OSError:
+        return False
+    held = os.fstat(fd)
+    return held.st_size == 0 and (here.st_dev, here.st_ino) == (held.st_dev, held.st_ino)
