@@ -178,8 +178,7 @@ def _index_damage(path: Path, exc: BaseException) -> Damage | None:
         return None
     return Damage(
         summary_start(path) or path.stat().st_size,
-        f"the index (summary section) does not read ({_one_line(exc)}): read front to back "
-        "instead",
+        f"the index (summary section) does not read ({_one_line(exc)}): read front to back instead",
     )
 
 

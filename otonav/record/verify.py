@@ -128,8 +128,7 @@ def _verified_from(
                     inner = breakup_chunk(record, validate_crc=True)
                 except Exception as exc:
                     problem = (
-                        f"CRC mismatch (recorded {exc.expected:#010x}, "
-                        f"computed {exc.actual:#010x})"
+                        f"CRC mismatch (recorded {exc.expected:#010x}, computed {exc.actual:#010x})"
                         if isinstance(exc, CRCValidationError)
                         else f"does not decode ({_one_line(exc)})"
                     )
