@@ -1,12 +1,13 @@
-"""Users' nodes that end a run at a known sim instant (``--actor ending_actors:NAME``):
-one raises, one deletes the run's out directory (``OTONAV_TEST_OUT``)."""
+"""Users' nodes that end a run (``--actor ending_actors:NAME``): one raises at a known sim
+instant, one deletes the run's out directory (``OTONAV_TEST_OUT``) then, one floods."""
 
 from __future__ import annotations
 
 import os
 import shutil
 
-from otonav.runtime import Actor
+from otonav.msgs import Twist
+from otonav.runtime import Actor, Output, QoS
 
 AT_S = 0.5
 
@@ -21,3 +22,14 @@ class DeletesTheOut(Actor):
     async def run(self) -> None:
         await self.clock.sleep(AT_S)
         shutil.rmtree(os.environ["OTONAV_TEST_OUT"])
+
+
+class Floods(Actor):
+    """Publishes in a tight loop and never sleeps: sim time never moves on."""
+
+    out = Output("/flood", Twist, QoS(depth=10))
+
+    async def run(self) -> None:
+        message = Twist()
+        while True:
+            await self.out.publish(message)
