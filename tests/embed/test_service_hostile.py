@@ -12,6 +12,8 @@ real (a subprocess on an ephemeral port) and driven over real TCP connections:
 from __future__ import annotations
 
 import contextlib
+import importlib.util
+import re
 import resource
 import selectors
 import signal
@@ -154,6 +156,20 @@ def test_the_schema_walk_finds_the_known_path_keys() -> None:
     assert {"robot.model", "world.scene", "actors"} <= set(PATH_KEYS), PATH_KEYS
     assert SCENARIO_PATH_KEYS == ["scene"]
     assert len(STACK_KEYS) > 150  # every section was entered
+
+
+def test_the_readme_says_what_a_client_may_set() -> None:
+    """The README's list is the allow-list the code enforces, key for key."""
+    spec = importlib.util.spec_from_file_location("otonav_service_app_hostile", APP)
+    assert spec is not None
+    assert spec.loader is not None
+    app = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = app  # its dataclasses look their module up
+    spec.loader.exec_module(app)
+    readme = (APP.parent / "README.md").read_text()
+    allowed = readme.split("allow-list and nothing else:")[1].split("(numbers")[0]
+    listed = re.findall(r"`([^`]+)`", allowed)
+    assert listed == list(app.CLIENT_KEYS)
 
 
 def _plant(where: Path) -> dict[str, Path]:
