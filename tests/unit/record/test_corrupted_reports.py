@@ -23,7 +23,7 @@ pytestmark = pytest.mark.unit
 
 N = 300
 STEP = 0.01
-SCHEMA, METADATA, DATA_END, FOOTER = 0x03, 0x0C, 0x0F, 0x02
+SCHEMA, CHUNK, METADATA, DATA_END = 0x03, 0x06, 0x0C, 0x0F
 
 
 def _record(path: Path) -> None:
@@ -103,6 +103,21 @@ def test_a_cut_off_file_is_said_to_be_cut_off(
     assert main(["info", str(path)]) == 0
     (line,) = _stderr_lines(capsys)
     assert "was cut off (no index)" in line
+
+
+def test_a_cut_off_file_with_a_damaged_chunk_is_one_line(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    path = tmp_path / "cut_and_damaged.mcap"
+    _record(path)
+    data = bytearray(path.read_bytes())
+    offset, _op, _length = [r for r in _records(bytes(data)) if r[1] == CHUNK][1]
+    data[offset + 9 + 24] ^= 0x01  # its uncompressed CRC
+    path.write_bytes(bytes(data[: len(data) * 2 // 3]))
+    for argv in (["info", str(path)], ["plot", str(path), "--out", str(tmp_path / "p.png")]):
+        assert main(argv) == 1
+        (line,) = [line for line in _stderr_lines(capsys) if line.startswith("otonav: ")]
+        assert "was cut off (no index) and 1 damaged chunk: chunk at byte" in line, line
 
 
 def test_random_flips_in_full_length_files_are_never_called_cut_off(
