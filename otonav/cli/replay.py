@@ -108,6 +108,8 @@ def main(args: argparse.Namespace) -> int:
                 what = "nothing was written"
             elif written:
                 what = f"{args.out} was written before it (finished and indexed)"
+                if args.bag and len(written) < 2:
+                    what += f"; its bag {replay_bag_path(args.out)} was not finished"
             else:
                 before = "the earlier file there is as it was" if existed else "no file there"
                 what = f"{args.out} was not written ({before})"
@@ -148,6 +150,7 @@ def _replay(
             from otonav.record.bag import write_bag_directory
 
             bag = write_bag_directory(Path(written), replay_bag_path(Path(written)))
+            written_to.append(bag)
             console.print(f"bag: {bag}")
     return 0 if result.passed else 1
 
