@@ -387,6 +387,9 @@ class Runs:
             run.status = "cancelled"  # this task is the run: its cancellation ends here
         except (ConfigFileError, SceneError) as exc:
             run.status, run.error = "error", str(exc)
+        except OSError as exc:  # its directory removed, the disk full: one line, no trace
+            run.status, run.error = "error", f"{type(exc).__name__}: {exc}"
+            log.warning("run %s: %s", run.id, run.error)
         except Exception as exc:
             log.exception("run %s failed", run.id)
             run.status, run.error = "error", f"{type(exc).__name__}: {exc}"

@@ -16,6 +16,7 @@ import importlib.util
 import re
 import resource
 import selectors
+import shutil
 import signal
 import socket
 import subprocess
@@ -316,3 +317,28 @@ def test_a_client_leaving_mid_body_leaves_no_traceback(tmp_path: Path) -> None:
         sock.sendall(b'POST /runs HTTP/1.1\r\nHost: x\r\nContent-Length: 1000\r\n\r\n{"scen')
         sock.close()
         _health(server)
+
+
+@pytest.mark.timeout(120)
+def test_a_run_whose_directory_is_removed_ends_in_one_line(tmp_path: Path) -> None:
+    """Issue 41, case 16, through the service: the run's directory removed while it runs
+    is the run's error (one line), not a traceback in the log, not a success."""
+    endless = {
+        "name": "endless",
+        "scene": "empty",
+        "goal": {"x": 3.0, "y": -1.0},
+        "goal_tolerance": 0.001,
+        "sim_budget": 60.0,  # it runs to its budget: a second or two of wall time
+    }
+    with _serve(tmp_path) as server, httpx.Client(base_url=server.url) as client:
+        run_id = client.post("/runs", json={"scenario": endless}).json()["id"]
+        for _ in range(int(CEILING_S * 20)):  # until it has run a second of sim time
+            run = client.get(f"/runs/{run_id}", params={"wait": 0.05}).json()
+            if (run["sim_time_s"] or 0.0) >= 1.0:
+                break
+        shutil.rmtree(tmp_path / "runs" / run_id)
+        run = client.get(f"/runs/{run_id}", params={"wait": CEILING_S}, timeout=2 * CEILING_S)
+        run = run.json()
+        assert run["status"] == "error", run
+        assert "the recording was deleted while the run wrote it" in run["error"]
+        assert "\n" not in run["error"]
