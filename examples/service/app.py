@@ -869,6 +869,20 @@ class _Server(uvicorn.Server):
                 signal.signal(sig, handler)
 
 
+RESERVED_DESCRIPTORS = 64
+"""Descriptors the service keeps for itself (its recordings, MuJoCo, the loop)."""
+
+
+def _descriptor_limit() -> int:
+    """This process's open-file limit (``ulimit -n``); very large where unknown."""
+    try:
+        import resource
+    except ImportError:  # not on Windows
+        return 1 << 30
+    soft = resource.getrlimit(resource.RLIMIT_NOFILE)[0]
+    return 1 << 30 if soft == resource.RLIM_INFINITY else soft
+
+
 def create_app(**options: Any) -> Starlette:
     """The app; ``options`` are :class:`Service`'s (``out_root`` is required)."""
     return Service(**options).app()
@@ -960,6 +974,14 @@ def main(argv: list[str] | None = None) -> int:
         if not 1 <= args.max_connections <= 100_000:
             raise ConfigFileError(
                 f"--max-connections {args.max_connections}: must be in [1, 100000]"
+            )
+        descriptors = _descriptor_limit()
+        if args.max_connections > descriptors - RESERVED_DESCRIPTORS:
+            # Past it, accept() fails and asyncio logs a traceback per attempt (issue 41).
+            raise ConfigFileError(
+                f"--max-connections {args.max_connections}: more than this process's "
+                f"descriptor limit allows (ulimit -n {descriptors}, less "
+                f"{RESERVED_DESCRIPTORS} the service keeps for its own files)"
             )
     except ConfigFileError as exc:
         print(f"otonav: error: {exc}", file=sys.stderr)

@@ -342,3 +342,27 @@ def test_a_run_whose_directory_is_removed_ends_in_one_line(tmp_path: Path) -> No
         assert run["status"] == "error", run
         assert "the recording was deleted while the run wrote it" in run["error"]
         assert "\n" not in run["error"]
+
+
+def test_a_connection_cap_above_the_descriptor_limit_is_refused(tmp_path: Path) -> None:
+    """The cap keeps accept() from failing (a traceback per attempt): one above what the
+    descriptors allow is refused at start, in one line."""
+
+    def limit_descriptors() -> None:
+        _soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+        resource.setrlimit(resource.RLIMIT_NOFILE, (NOFILE, hard))
+
+    done = subprocess.run(
+        [
+            *(sys.executable, str(APP), "--port", "0", "--out", str(tmp_path), "--no-live"),
+            *("--max-connections", str(NOFILE)),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=CEILING_S,
+        preexec_fn=limit_descriptors,
+    )
+    assert done.returncode == 2, done.stderr
+    (line,) = done.stderr.strip().splitlines()
+    assert f"--max-connections {NOFILE}: more than this process's descriptor limit" in line
+    assert f"ulimit -n {NOFILE}" in line
