@@ -34,12 +34,14 @@ Bounds (issue 27 item 7; ADR 0050): at most ``--max-runs`` simulations run at on
 its files stay in OUT/runs/ID) ``--keep-finished-s`` seconds after it ended, or sooner
 when more than ``--keep-finished`` finished runs are known (oldest first).
 
-What a client may ask is narrower than the CLI (issue 17): built-in scenes and scenarios
-only, so the server reads no file a client names and its errors never say whether a path
-exists; no hardware (a CAN run is the emulated bus); bodies of at most 1 MiB of UTF-8
-JSON. Ctrl-C or SIGTERM cancels every run at once (each finishes its recording), ends the
-pose streams, then closes the live robot and its recording; a second signal is ignored
-until that is done.
+What a client may ask is narrower than the CLI (issues 17, 41; ADR 0076): ``set`` takes
+only the keys of :data:`CLIENT_KEYS` (tuning numbers, flags, choices), scenes and
+scenarios are built-in ones, so the server reads no file, imports no code and opens no
+hardware a client names, and its errors never say whether a path exists; bodies of at
+most 1 MiB of UTF-8 JSON, headers within ``--header-timeout`` s, a body within
+``--body-timeout`` s, at most ``--max-connections`` open. Ctrl-C or SIGTERM cancels every
+run at once (each finishes its recording), ends the pose streams, then closes the live
+robot and its recording; a second signal is ignored until that is done.
 """
 
 from __future__ import annotations
@@ -47,6 +49,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import fnmatch
 import json
 import logging
 import math
@@ -68,9 +71,10 @@ import anyio.to_thread
 import uvicorn
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from starlette.applications import Starlette
-from starlette.requests import Request
+from starlette.requests import ClientDisconnect, Request
 from starlette.responses import FileResponse, JSONResponse, Response, StreamingResponse
 from starlette.routing import Route
+from uvicorn.protocols.http.h11_impl import H11Protocol
 
 from otonav.actors import topics
 from otonav.cli import load_stack
@@ -97,13 +101,20 @@ MAX_WAIT_S = 60.0
 MAX_BODY_BYTES = 1 << 20
 """A request body: a run request is a few hundred bytes, an inline scenario a few kB."""
 SHOWN_CHARS = 200
+"""How much of a client's string an error quotes (a path fits; 10 MB does not)."""
 MAX_QUEUED = 64
 """Runs that may wait for a simulation slot (``--max-queued``): beyond, 503."""
 KEEP_FINISHED = 256
 """Finished runs the service remembers (``--keep-finished``); the oldest go first."""
 KEEP_FINISHED_S = 3600.0
 """Seconds a finished run is remembered (``--keep-finished-s``); its files stay."""
-"""How much of a client's string an error quotes (a path fits; 10 MB does not)."""
+HEADER_TIMEOUT_S = 10.0
+"""A connection's request line and headers must have come within this many seconds of
+its opening (or of its previous response): ``--header-timeout``."""
+BODY_TIMEOUT_S = 30.0
+"""A request's body must have come within this many seconds: ``--body-timeout``."""
+MAX_CONNECTIONS = 100
+"""Connections open at once (``--max-connections``; each pose stream holds one)."""
 
 
 def _short(value: str) -> str:
@@ -113,7 +124,8 @@ def _short(value: str) -> str:
 
 
 class BadRequest(Exception):
-    """A 4xx with a one-line message."""
+    """A 4xx with a one-line message. The connection is closed after a 408 or 413: the
+    rest of that body is not waited for."""
 
     def __init__(self, message: str, status: int = 400, retry_after: int | None = None) -> None:
         super().__init__(message)
@@ -148,12 +160,15 @@ def _parse(model: type[BaseModel], body: object, source: str) -> Any:
         raise BadRequest(describe_validation_error(source, exc)) from None
 
 
-async def _json_body(request: Request) -> object:
+async def _json_body(request: Request, within: float) -> object:
     raw = bytearray()
-    async for chunk in request.stream():  # bounded: never holds more than the cap
-        raw += chunk
-        if len(raw) > MAX_BODY_BYTES:
-            raise BadRequest(f"request body: larger than {MAX_BODY_BYTES // 1024} KiB", 413)
+    with anyio.move_on_after(within) as waited:  # a body trickled byte by byte ends
+        async for chunk in request.stream():  # bounded: never holds more than the cap
+            raw += chunk
+            if len(raw) > MAX_BODY_BYTES:
+                raise BadRequest(f"request body: larger than {MAX_BODY_BYTES // 1024} KiB", 413)
+    if waited.cancelled_caught:
+        raise BadRequest(f"request body: not received within {within:g} s", 408)
     if not raw.strip():  # not taken as {}: a client that sent nothing meant something
         raise BadRequest("request body: empty; send a JSON object (`{}` for every default)")
     try:
@@ -178,20 +193,31 @@ def _no_files(what: str, value: str, valid: tuple[str, ...]) -> ConfigFileError:
     )
 
 
-def check_client_stack(stack: StackConfig, base: StackConfig, source: str = "set") -> None:
-    """What a client's overrides (``stack``, made from the operator's ``base``) may not
-    ask of the server: a scene file (a read of a path the client names), real hardware
-    (a CAN interface other than the emulated one). What the operator configured stands."""
-    scene = stack.world.scene
-    if scene != base.world.scene and scene not in scene_names():
-        raise _no_files(f"{source}: world.scene", scene, scene_names())
-    can = stack.hal.can
-    hardware = stack.hal.kind == "can" and (can.interface != "virtual" or not can.emulate)
-    if hardware and stack.hal != base.hal:
-        raise ConfigFileError(
-            f"{source}: hal.can.interface {_short(can.interface)} (emulate: {can.emulate}): "
-            "the service simulates and opens no hardware; use interface virtual, emulate true"
-        )
+CLIENT_KEYS = (
+    *("nav.*", "guard.*", "safety.*", "base.*", "rates.*"),
+    *("world.timestep", "world.lidar_*", "world.odometry_error.*"),
+    *("robot.wheel_radius", "robot.wheel_separation", "robot.max_v", "robot.max_omega"),
+    *("robot.footprint", "hal.sim.*"),
+)
+"""What a client's ``set`` may name (fnmatch patterns; ADR 0076): numbers, flags and
+choices that tune the stack. Nothing else: no file (``robot.model``, ``world.scene``), no
+code (``actors``), no choice of HAL or hardware (``hal.kind``, ``hal.can``; the emulated
+drives' ``hal.sim`` faults are tuning), no DDS (``ros2``). An allow-list, so a key
+added to the config later is refused until someone decides a client may set it."""
+
+
+def check_client_keys(assignments: list[str]) -> None:
+    """Refuse an assignment whose key :data:`CLIENT_KEYS` does not allow, whatever its
+    value: the answer never depends on what the value names."""
+    for assignment in assignments:
+        key, sep, _value = assignment.partition("=")
+        key = key.strip()
+        if sep and not any(fnmatch.fnmatchcase(key, allowed) for allowed in CLIENT_KEYS):
+            raise BadRequest(
+                f"set: {_short(key)} is not a key a client may set (the service reads no "
+                f"files a client names, imports no code and opens no hardware); a client "
+                f"may set {', '.join(CLIENT_KEYS)}"
+            )
 
 
 def resolve_scenario(spec: str | dict[str, Any], seed: int | None) -> tuple[ScenarioConfig, str]:
@@ -361,6 +387,9 @@ class Runs:
             run.status = "cancelled"  # this task is the run: its cancellation ends here
         except (ConfigFileError, SceneError) as exc:
             run.status, run.error = "error", str(exc)
+        except OSError as exc:  # its directory removed, the disk full: one line, no trace
+            run.status, run.error = "error", f"{type(exc).__name__}: {exc}"
+            log.warning("run %s: %s", run.id, run.error)
         except Exception as exc:
             log.exception("run %s failed", run.id)
             run.status, run.error = "error", f"{type(exc).__name__}: {exc}"
@@ -422,10 +451,14 @@ def _errors_as_4xx(handler: Handler) -> Handler:
     async def wrapped(request: Request) -> Response:
         try:
             return await handler(request)
+        except ClientDisconnect:  # gone mid-body: nobody to answer, nothing to log
+            return Response(status_code=400)
         except BadRequest as exc:
             response = _json({"error": str(exc)}, exc.status)
             if exc.retry_after is not None:
                 response.headers["Retry-After"] = str(exc.retry_after)
+            if exc.status in (408, 413):
+                response.headers["Connection"] = "close"
             return response
         except (ConfigFileError, SceneError) as exc:
             return _json({"error": str(exc)}, 400)
@@ -448,9 +481,11 @@ class Service:
         max_queued: int = MAX_QUEUED,
         keep_finished: int = KEEP_FINISHED,
         keep_finished_s: float = KEEP_FINISHED_S,
+        body_timeout: float = BODY_TIMEOUT_S,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.stack = stack
+        self.body_timeout = body_timeout
         self.live_enabled = live
         self.live_scale = live_scale
         self.live_record = live_record
@@ -538,10 +573,12 @@ class Service:
         )
 
     async def post_run(self, request: Request) -> Response:
-        body: RunRequest = _parse(RunRequest, await _json_body(request), "request")
+        body: RunRequest = _parse(
+            RunRequest, await _json_body(request, self.body_timeout), "request"
+        )
         scenario, source = resolve_scenario(body.scenario, body.seed)
+        check_client_keys(body.set)
         stack = apply_overrides(self.stack, body.set, source="set")
-        check_client_stack(stack, self.stack)
         # What the CLI would reject before running (scene, goal): a 400 now, not a
         # failed run later. Building the world takes milliseconds: off the loop.
         try:
@@ -636,7 +673,9 @@ class Service:
 
     async def live_goal(self, request: Request) -> Response:
         live = self._live()
-        goal: GoalRequest = _parse(GoalRequest, await _json_body(request), "goal")
+        goal: GoalRequest = _parse(
+            GoalRequest, await _json_body(request, self.body_timeout), "goal"
+        )
         try:
             check_goal(
                 ScenarioConfig(scene=self.stack.world.scene, goal=GoalSpec(x=goal.x, y=goal.y)),
@@ -715,6 +754,79 @@ async def _poses(
             yield f"event: pose\ndata: {json.dumps(data)}\n\n"
 
 
+class _GuardedH11(H11Protocol):
+    """uvicorn's HTTP/1.1 connection with what it lacks against slow clients (issue 41,
+    ADR 0076). A connection that is not being served (no request yet, or its previous
+    response sent) is closed ``header_timeout`` s after it opened or after that
+    response, however it trickles. At most ``max_connections`` are open: one more
+    closes, to make room, the connection that has waited longest without sending a
+    whole request (no headers yet, or a body still coming); if every connection is
+    being served, the newcomer gets a 503. Subclassed per server by :func:`guarded`."""
+
+    header_timeout = HEADER_TIMEOUT_S
+    max_connections = MAX_CONNECTIONS
+    opened: dict[_GuardedH11, float]
+    """Open connections and when each started waiting (shared by one server's)."""
+
+    def connection_made(self, transport: asyncio.BaseTransport) -> None:
+        super().connection_made(transport)  # type: ignore[arg-type]
+        self._deadline: asyncio.TimerHandle | None = None
+        if len(self.opened) >= self.max_connections:
+            waiting = [c for c in self.opened if c.unserved(partly=True)]
+            if not waiting:
+                self.transport.write(_BUSY)
+                self.transport.close()
+                return
+            oldest = min(waiting, key=self.opened.__getitem__)
+            del self.opened[oldest]
+            oldest.transport.abort()
+        self._wait_for_request()
+
+    def connection_lost(self, exc: Exception | None) -> None:
+        self.opened.pop(self, None)
+        if self._deadline is not None:
+            self._deadline.cancel()
+        super().connection_lost(exc)
+
+    def on_response_complete(self) -> None:
+        super().on_response_complete()
+        if not self.transport.is_closing():
+            self._wait_for_request()
+
+    def unserved(self, *, partly: bool = False) -> bool:
+        """No request in progress (``partly``: or one whose body is still coming)."""
+        cycle = self.cycle
+        return cycle is None or cycle.response_complete or (partly and cycle.more_body)
+
+    def _wait_for_request(self) -> None:
+        if self._deadline is not None:
+            self._deadline.cancel()
+        self.opened[self] = self.loop.time()
+        self._deadline = self.loop.call_later(self.header_timeout, self._expire)
+
+    def _expire(self) -> None:
+        self._deadline = None
+        if self.unserved():
+            self.transport.abort()
+
+
+_BUSY_BODY = b'{"error": "busy: every connection is serving a request; retry"}'
+_BUSY = (
+    b"HTTP/1.1 503 Service Unavailable\r\ncontent-type: application/json\r\n"
+    b"retry-after: 1\r\nconnection: close\r\n"
+    b"content-length: %d\r\n\r\n%s" % (len(_BUSY_BODY), _BUSY_BODY)
+)
+
+
+def guarded(header_timeout: float, max_connections: int) -> type[H11Protocol]:
+    """A :class:`_GuardedH11` for one server (its own count of open connections)."""
+    return type(
+        "GuardedH11",
+        (_GuardedH11,),
+        {"header_timeout": header_timeout, "max_connections": max_connections, "opened": {}},
+    )
+
+
 class _Server(uvicorn.Server):
     """uvicorn, with the service's shutdown. The first SIGINT/SIGTERM starts it at once:
     every run is cancelled (each finishes its recording), waits and pose streams end,
@@ -755,6 +867,20 @@ class _Server(uvicorn.Server):
         finally:
             for sig, handler in original.items():
                 signal.signal(sig, handler)
+
+
+RESERVED_DESCRIPTORS = 64
+"""Descriptors the service keeps for itself (its recordings, MuJoCo, the loop)."""
+
+
+def _descriptor_limit() -> int:
+    """This process's open-file limit (``ulimit -n``); very large where unknown."""
+    try:
+        import resource
+    except ImportError:  # not on Windows
+        return 1 << 30
+    soft = resource.getrlimit(resource.RLIMIT_NOFILE)[0]
+    return 1 << 30 if soft == resource.RLIM_INFINITY else soft
 
 
 def create_app(**options: Any) -> Starlette:
@@ -803,6 +929,24 @@ def main(argv: list[str] | None = None) -> int:
         default=KEEP_FINISHED_S,
         help=f"seconds a finished run is remembered (default {KEEP_FINISHED_S:g})",
     )
+    parser.add_argument(
+        "--header-timeout",
+        type=float,
+        default=HEADER_TIMEOUT_S,
+        help=f"s a connection may take to send its headers (default {HEADER_TIMEOUT_S:g})",
+    )
+    parser.add_argument(
+        "--body-timeout",
+        type=float,
+        default=BODY_TIMEOUT_S,
+        help=f"s a request may take to send its body; 408 beyond (default {BODY_TIMEOUT_S:g})",
+    )
+    parser.add_argument(
+        "--max-connections",
+        type=int,
+        default=MAX_CONNECTIONS,
+        help=f"connections open at once (default {MAX_CONNECTIONS})",
+    )
     args = parser.parse_args(argv)
     try:
         stack = load_stack(args.config, args.overrides)
@@ -821,6 +965,24 @@ def main(argv: list[str] | None = None) -> int:
             raise ConfigFileError(f"--live-record-mb {args.live_record_mb:g}: must be >= 0.1")
         if args.live_record_keep < 0:
             raise ConfigFileError(f"--live-record-keep {args.live_record_keep}: must be >= 0")
+        for flag, seconds in (
+            ("--header-timeout", args.header_timeout),
+            ("--body-timeout", args.body_timeout),
+        ):
+            if not 0.1 <= seconds <= 3600:
+                raise ConfigFileError(f"{flag} {seconds:g}: must be in [0.1, 3600] s")
+        if not 1 <= args.max_connections <= 100_000:
+            raise ConfigFileError(
+                f"--max-connections {args.max_connections}: must be in [1, 100000]"
+            )
+        descriptors = _descriptor_limit()
+        if args.max_connections > descriptors - RESERVED_DESCRIPTORS:
+            # Past it, accept() fails and asyncio logs a traceback per attempt (issue 41).
+            raise ConfigFileError(
+                f"--max-connections {args.max_connections}: more than this process's "
+                f"descriptor limit allows (ulimit -n {descriptors}, less "
+                f"{RESERVED_DESCRIPTORS} the service keeps for its own files)"
+            )
     except ConfigFileError as exc:
         print(f"otonav: error: {exc}", file=sys.stderr)
         return 2
@@ -837,6 +999,7 @@ def main(argv: list[str] | None = None) -> int:
         max_queued=args.max_queued,
         keep_finished=args.keep_finished,
         keep_finished_s=args.keep_finished_s,
+        body_timeout=args.body_timeout,
     )
     # Bind first, so the address is known (port 0) before the server starts accepting.
     # proto=IPPROTO_TCP matters: asyncio sets TCP_NODELAY only on sockets that say they
@@ -849,7 +1012,12 @@ def main(argv: list[str] | None = None) -> int:
     host, port = sock.getsockname()[:2]
     print(f"otonav service listening on http://{host}:{port}", flush=True)
     config = uvicorn.Config(
-        service.app(), log_level="warning", lifespan="on", timeout_graceful_shutdown=2
+        service.app(),
+        http=guarded(args.header_timeout, args.max_connections),
+        ws="none",
+        log_level="warning",
+        lifespan="on",
+        timeout_graceful_shutdown=2,
     )
     server = _Server(config, service)
     server.run(sockets=[sock])

@@ -25,19 +25,28 @@ def add_parser(commands: Any) -> None:
 
 
 def warn_cut_off(summary: RecordingSummary, doing: str) -> None:
-    """One line on stderr: the file was cut off, what is used, how to fix it."""
+    """One line on stderr: the file was cut off (and what is damaged besides), what is
+    used, how to fix it."""
+    damaged = ""
+    if summary.damaged:
+        from otonav.record.verify import describe_damage
+
+        damaged = f" and {describe_damage(summary.path, summary.damaged).split(': ', 1)[1]}"
     print(
-        f"otonav: warning: {summary.path} was cut off (no index): {doing} the "
-        f"{summary.message_count} messages of its complete chunks; "
+        f"otonav: warning: {summary.path} was cut off (no index){damaged}: {doing} the "
+        f"{summary.message_count} messages of its intact complete chunks; "
         f"'otonav salvage {summary.path} FIXED.mcap' rewrites them as an indexed file",
         file=sys.stderr,
     )
 
 
 def warn_damaged(summary: RecordingSummary, doing: str) -> bool:
-    """One line on stderr if chunks failed their CRC; True if there were any."""
+    """One line on stderr if chunks failed their CRC (a cut-off file's are in
+    :func:`warn_cut_off`'s line); True if there were any."""
     if not summary.damaged:
         return False
+    if summary.truncated:
+        return True
     from otonav.record.verify import describe_damage
 
     print(

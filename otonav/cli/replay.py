@@ -5,8 +5,10 @@ compare their outputs with it. Exit 0: no divergence beyond the tolerance; 1: di
 from __future__ import annotations
 
 import argparse
+import asyncio
 import contextlib
 import math
+import signal
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -14,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from rich.console import Console
 
+    from otonav.cli.signals import StopOnSignals
     from otonav.replay import ReplayResult
 
 
@@ -88,27 +91,53 @@ def main(args: argparse.Namespace) -> int:
         raise ConfigFileError("--bag: only with --out (the bag holds the written MCAP)")
     if not (math.isfinite(args.tolerance) and args.tolerance >= 0):
         raise ConfigFileError(f"--tolerance {args.tolerance}: must be a finite number >= 0")
-    with contextlib.ExitStack() as held:
+    from otonav.cli.signals import EXIT_CODES, StopOnSignals
+
+    # The first SIGINT/SIGTERM cancels the replay (its loop shuts down as a run's does) or,
+    # once it has ended, abandons the output (it is all or nothing); a second is noted.
+    with StopOnSignals("the replay's output") as stop, contextlib.ExitStack() as held:
+        existed = args.out is not None and args.out.exists()
         if args.out is not None:  # one writer per file (issue 27)
             held.enter_context(lock_output(args.out, is_file=True))
-        return _replay(args, nodes)
+        written: list[Path] = []
+        try:
+            return _replay(args, nodes, stop, written)
+        except (KeyboardInterrupt, asyncio.CancelledError):
+            sig = stop.received or signal.SIGINT
+            if args.out is None:
+                what = "nothing was written"
+            elif written:
+                what = f"{args.out} was written before it (finished and indexed)"
+                if args.bag and len(written) < 2:
+                    what += f"; its bag {replay_bag_path(args.out)} was not finished"
+            else:
+                before = "the earlier file there is as it was" if existed else "no file there"
+                what = f"{args.out} was not written ({before})"
+            print(f"otonav: {sig.name}: the replay stopped; {what}", file=sys.stderr)
+            return EXIT_CODES[sig]
 
 
-def _replay(args: argparse.Namespace, nodes: list[str]) -> int:
+def _replay(
+    args: argparse.Namespace, nodes: list[str], stop: StopOnSignals, written_to: list[Path]
+) -> int:
     from otonav.cli.console import make_console
     from otonav.replay import ReplayInputError, replay_recording
     from otonav.replay.output import write_replay
     from otonav.stack.files import ConfigFileError
 
     try:
+        stop.arm()
         result = replay_recording(
             args.recording,
             nodes,
             overrides=args.overrides,
             tolerance=args.tolerance,
             wake=args.wake,
+            on_start=stop.attach,
         )
+        stop.disarm()
         written = write_replay(result, args.out) if args.out is not None else None
+        written_to.extend([written] if written is not None else [])
     except ReplayInputError as exc:
         raise ConfigFileError(str(exc)) from None
     except ValueError as exc:  # --out on the input file
@@ -121,6 +150,7 @@ def _replay(args: argparse.Namespace, nodes: list[str]) -> int:
             from otonav.record.bag import write_bag_directory
 
             bag = write_bag_directory(Path(written), replay_bag_path(Path(written)))
+            written_to.append(bag)
             console.print(f"bag: {bag}")
     return 0 if result.passed else 1
 

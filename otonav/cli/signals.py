@@ -35,7 +35,9 @@ _SIGNALS = (signal.SIGINT, signal.SIGTERM)
 class StopOnSignals:
     """Context manager; pass :meth:`attach` as the run's ``on_start``."""
 
-    def __init__(self) -> None:
+    def __init__(self, finishing: str = "the recording and the plot") -> None:
+        self.finishing = finishing
+        """What a further signal is told is still being finished."""
         self.received: signal.Signals | None = None
         self._armed = False
         self._noted = False
@@ -60,6 +62,13 @@ class StopOnSignals:
     def arm(self) -> None:
         """From now on a signal stops the run instead of raising."""
         self._armed = True
+
+    def disarm(self) -> None:
+        """The run is over: from now on a first signal raises KeyboardInterrupt again (what
+        follows is abandoned whole); one that came meanwhile raises it now."""
+        self._armed, self._target = False, None
+        if self.received is not None:
+            raise KeyboardInterrupt
 
     def attach(self, loop: asyncio.AbstractEventLoop, task: asyncio.Task[Any]) -> None:
         """The run's ``on_start``: its loop and task, to cancel on the first signal."""
@@ -86,7 +95,7 @@ class StopOnSignals:
         if not self._noted:
             self._noted = True
             print(
-                f"otonav: {sig.name} again: still finishing the recording and the plot "
+                f"otonav: {sig.name} again: still finishing {self.finishing} "
                 "(SIGKILL would lose the end of the recording)",
                 file=sys.stderr,
                 flush=True,

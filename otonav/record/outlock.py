@@ -71,12 +71,34 @@ def _busy(path: Path, what: str, pid: int | None) -> OutputBusyError:
     )
 
 
+class OutputPathError(UsageError):
+    """An output path that names the wrong kind of thing (a file for a directory, or
+    the other way round): one line saying which and what the option expects."""
+
+
+def _check_kind(path: Path, what: str, is_file: bool) -> None:
+    if is_file and path.is_dir():
+        raise OutputPathError(
+            f"{what} {path}: is a directory; {what} names the MCAP file to write "
+            f"(e.g. {path / 'replayed.mcap'})"
+        )
+    blocking = next((p for p in (path, *path.parents) if p.exists() and not p.is_dir()), None)
+    if blocking is not None and (blocking != path or not is_file):
+        where = "is" if blocking == path else f"is inside {blocking}, which is"
+        expects = "the MCAP file to write" if is_file else "the directory the run writes into"
+        raise OutputPathError(
+            f"{what} {path}: {where} a file, not a directory; {what} names {expects} "
+            "(remove that file or choose another path)"
+        )
+
+
 @contextlib.contextmanager
 def lock_output(path: Path, *, what: str = "--out", is_file: bool = False) -> Iterator[Path]:
     """Hold the exclusive lock on the output ``path`` (a directory, created if missing;
     with ``is_file``, a file) for the ``with`` block. Raises :class:`OutputBusyError`
     when another thread or process holds it; ``what`` names the option in the message."""
     created = False
+    _check_kind(path, what, is_file)
     if is_file:
         path.parent.mkdir(parents=True, exist_ok=True)
         created = not path.exists()
@@ -110,7 +132,17 @@ def lock_output(path: Path, *, what: str = "--out", is_file: bool = False) -> It
             held.depth -= 1
             if held.depth == 0:
                 del _held[key]
-                if created and os.fstat(held.fd).st_size == 0:
+                if created and _still_empty(path, held.fd):
                     with contextlib.suppress(OSError):
                         path.unlink()
                 os.close(held.fd)  # releases the flock
+
+
+def _still_empty(path: Path, fd: int) -> bool:
+    """``path`` is still the empty file the lock created (not a file renamed over it)."""
+    try:
+        here = os.stat(path)
+    except OSError:
+        return False
+    held = os.fstat(fd)
+    return held.st_size == 0 and (here.st_dev, here.st_ino) == (held.st_dev, held.st_ino)

@@ -18,9 +18,12 @@ from otonav.record.verify import (
     CUT_OFF_ERRORS,
     MAGIC,
     Damage,
+    _finished,
     _one_line,
     describe_damage,
     iter_verified,
+    summary_damage,
+    summary_start,
 )
 
 __all__ = [
@@ -123,8 +126,11 @@ def summarize(path: str | Path) -> RecordingSummary:
             by_topic = {t.topic: t for t in topics}
             of_channel = {ch.id: by_topic[ch.topic] for ch in summary.channels.values()}
             metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
-        except CUT_OFF_ERRORS:
-            return _scan_truncated(path, size)
+        except CUT_OFF_ERRORS as exc:
+            return _scan(path, size, _index_damage(path, exc))
+    index_damage = summary_damage(path)
+    if index_damage is not None:  # the index's counts cannot be trusted: count ourselves
+        return _scan(path, size, index_damage)
     # First/last time per topic for the rate, reading every chunk and checking its CRC
     # (the index alone would not notice a damaged chunk).
     damage: list[Damage] = []
@@ -165,7 +171,20 @@ def iter_readable(
         raise DamagedRecordingError(describe_damage(path, found))
 
 
-def _scan_truncated(path: Path, size: int) -> RecordingSummary:
+def _index_damage(path: Path, exc: BaseException) -> Damage | None:
+    """None when ``path`` was cut off (no index yet); a damaged index when it is finished
+    (it ends with the magic) and the index still does not read."""
+    if not _finished(path):
+        return None
+    return Damage(
+        summary_start(path) or path.stat().st_size,
+        f"the index (summary section) does not read ({_one_line(exc)}): read front to back instead",
+    )
+
+
+def _scan(path: Path, size: int, index_damage: Damage | None) -> RecordingSummary:
+    """The summary of a front-to-back read: of a cut-off file (``index_damage`` None:
+    ``truncated``) or of a finished one whose index is damaged."""
     damage: list[Damage] = []
     topics: dict[str, TopicSummary] = {}
     profile = library = ""
@@ -213,8 +232,8 @@ def _scan_truncated(path: Path, size: int) -> RecordingSummary:
         end,
         sorted(topics.values(), key=lambda t: t.topic),
         metadata,
-        truncated=True,
-        damaged=tuple(damage),
+        truncated=index_damage is None,
+        damaged=(*damage, *([index_damage] if index_damage else [])),
     )
 
 
@@ -241,10 +260,10 @@ def read_messages(
     with path.open("rb") as f:
         reader = make_reader(f, validate_crcs=True, decoder_factories=[DecoderFactory()])
         try:
-            indexed = reader.get_summary() is not None
+            indexed = reader.get_summary() is not None and summary_damage(path) is None
         except CUT_OFF_ERRORS:
             indexed = False
-        if not indexed:
+        if not indexed:  # cut off, or a damaged index: the chunks, front to back
             yield from _read_cut_off(path, topics, start, end)
             return
         messages = reader.iter_decoded_messages(
@@ -257,14 +276,31 @@ def read_messages(
                 _schema, channel, message, decoded = next(messages)
             except StopIteration:
                 return
-            except Exception:  # a chunk that does not verify or decode: say which
+            except Exception as exc:  # a chunk that does not verify or decode: say which
                 found: list[Damage] = []
                 for _record in iter_verified(path, found):
                     pass
                 if found:
                     raise DamagedRecordingError(describe_damage(path, found)) from None
-                raise
+                raise DamagedRecordingError(f"{path}: unreadable ({_one_line(exc)})") from None
             yield channel.topic, message.log_time / 1e9, decoded
+
+
+def _decoder(
+    path: Path, factory: DecoderFactory, channel: Channel, schemas: dict[int, Schema]
+) -> Any:
+    """The decoder of ``channel``'s messages; one line if its schema does not parse."""
+    schema = schemas.get(channel.schema_id)
+    try:
+        decoder = factory.decoder_for(channel.message_encoding, schema)
+        if decoder is None:
+            raise ValueError(f"no decoder for encoding {channel.message_encoding!r}")
+    except Exception as exc:
+        raise DamagedRecordingError(
+            f"{path}: the schema of {channel.topic} ({schema.name if schema else '?'}) "
+            f"does not parse ({_one_line(exc)})"
+        ) from None
+    return decoder
 
 
 def _read_cut_off(
@@ -285,8 +321,12 @@ def _read_cut_off(
             schemas[record.id] = record
         elif isinstance(record, Channel):
             if wanted is None or record.topic in wanted:
-                schema = schemas.get(record.schema_id)
-                channels[record.id] = (record, factory.decoder_for(record.message_encoding, schema))
+                try:
+                    channels[record.id] = (record, _decoder(path, factory, record, schemas))
+                except DamagedRecordingError:
+                    if damage is None:
+                        raise
+                    # Its schema was in a damaged chunk (reported): its messages are lost.
         elif isinstance(record, Message) and record.channel_id in channels:
             if (first is not None and record.log_time < first) or (
                 last is not None and record.log_time >= last

@@ -8,18 +8,21 @@ does not match its CRC or does not parse is a :class:`Damage` (where it is, whic
 time it covered, what is wrong) and is skipped; the chunks after it are still read.
 
 A file that ends with the MCAP magic was finished: a record that cannot be read before
-its end is damage too, not a cut-off.
+its end is damage too, not a cut-off (issue 41: it is skipped by its length when a record
+follows there), and so is an index (the summary section) that fails its CRC.
 """
 
 from __future__ import annotations
 
 import struct
-from collections.abc import Iterator, Sequence
+import zlib
+from collections.abc import Generator, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import BinaryIO
 
 from mcap.exceptions import McapError
-from mcap.records import Channel, Chunk, Message, Metadata, Schema
+from mcap.records import Channel, Chunk, DataEnd, Message, Metadata, Schema
 from mcap.stream_reader import CRCValidationError, StreamReader, breakup_chunk
 
 MAGIC = b"\x89MCAP0\r\n"
@@ -83,43 +86,123 @@ def _finished(path: Path) -> bool:
 
 
 def iter_verified(path: Path, damage: list[Damage]) -> Iterator[Record]:
-    """The schema, channel, message and metadata records of ``path`` in file order,
-    from every chunk that verifies; each damaged part is appended to ``damage`` and
-    skipped. Reading ends at a cut (a cut-off file ends mid-record)."""
+    """The schema, channel, message and metadata records of ``path``'s data section in
+    file order, from every chunk that verifies; each damaged part is appended to
+    ``damage`` and skipped. Reading ends at a cut (a cut-off file ends mid-record) and at
+    the end of the data section (the summary after it repeats schemas and channels and
+    indexes the rest; :func:`summary_damage` checks it). In a finished file a record that
+    does not parse is skipped by its length when a record follows it there."""
     finished = _finished(path)
     with path.open("rb") as f:
-        # validate_crcs: the data section's CRC too (schemas, channels and metadata
-        # outside the chunks), checked at its end.
-        reader = StreamReader(f, emit_chunks=True, validate_crcs=True)
-        offset = len(MAGIC)
-        try:
-            for record in reader.records:
-                end = f.tell()
-                if isinstance(record, Chunk):
-                    start = end - (_CHUNK_FIXED + len(record.compression) + len(record.data))
-                    try:
-                        # Any failure to decode one chunk (zstd, CRC, a record in it)
-                        # is damage to that chunk alone.
-                        inner = breakup_chunk(record, validate_crc=True)
-                    except Exception as exc:
-                        problem = (
-                            f"CRC mismatch (recorded {exc.expected:#010x}, "
-                            f"computed {exc.actual:#010x})"
-                            if isinstance(exc, CRCValidationError)
-                            else f"does not decode ({_one_line(exc)})"
-                        )
-                        first, last = record.message_start_time, record.message_end_time
-                        damage.append(Damage(start, problem, first, last))
-                    else:
-                        for item in inner:
-                            if isinstance(item, Schema | Channel | Message | Metadata):
-                                yield item
-                elif isinstance(record, Schema | Channel | Message | Metadata):
-                    yield record
-                offset = end
-        except CRCValidationError as exc:  # the data section's (a chunk's is caught above)
-            if not damage:  # a damaged chunk fails it too: said once is enough
-                damage.append(Damage(offset, f"a record outside the chunks: {_one_line(exc)}"))
-        except CUT_OFF_ERRORS as exc:
-            if finished:  # not a cut: a record in the middle cannot be read
-                damage.append(Damage(offset, f"unreadable from here on ({_one_line(exc)})"))
+        size = f.seek(0, 2)
+        f.seek(0)  # the first reader reads the magic
+        resume: int | None = len(MAGIC)
+        first = True
+        while resume is not None:
+            resume = yield from _verified_from(f, resume, first, finished, size, damage)
+            first = False
+            if resume is not None:
+                f.seek(resume)
+
+
+def _verified_from(
+    f: BinaryIO, offset: int, first: bool, finished: bool, size: int, damage: list[Damage]
+) -> Generator[Record, None, int | None]:
+    """:func:`iter_verified` from ``offset``; where to resume after a record that does
+    not parse (None: the end)."""
+    # validate_crcs: the data section's CRC too (schemas, channels and metadata outside
+    # the chunks), checked at its end; from the start of the file only.
+    reader = StreamReader(
+        f, skip_magic=not first, emit_chunks=True, validate_crcs=first, record_size_limit=size
+    )
+    try:
+        for record in reader.records:
+            end = f.tell()
+            if isinstance(record, DataEnd):
+                return None
+            if isinstance(record, Chunk):
+                start = end - (_CHUNK_FIXED + len(record.compression) + len(record.data))
+                try:
+                    # Any failure to decode one chunk (zstd, CRC, a record in it)
+                    # is damage to that chunk alone.
+                    inner = breakup_chunk(record, validate_crc=True)
+                except Exception as exc:
+                    problem = (
+                        f"CRC mismatch (recorded {exc.expected:#010x}, computed {exc.actual:#010x})"
+                        if isinstance(exc, CRCValidationError)
+                        else f"does not decode ({_one_line(exc)})"
+                    )
+                    first_ns, last_ns = record.message_start_time, record.message_end_time
+                    damage.append(Damage(start, problem, first_ns, last_ns))
+                else:
+                    for item in inner:
+                        if isinstance(item, Schema | Channel | Message | Metadata):
+                            yield item
+            elif isinstance(record, Schema | Channel | Message | Metadata):
+                yield record
+            offset = end
+    except CRCValidationError as exc:  # the data section's (a chunk's is caught above)
+        if not damage:  # a damaged chunk fails it too: said once is enough
+            damage.append(Damage(offset, f"a record outside the chunks: {_one_line(exc)}"))
+    except (*CUT_OFF_ERRORS, MemoryError) as exc:  # MemoryError: a length field flipped
+        if finished:  # not a cut: a record in the middle cannot be read
+            after = _next_record(f, offset, size)
+            said = "skipped" if after is not None else "unreadable from here on"
+            damage.append(Damage(offset, f"{said} ({_one_line(exc)})"))
+            return after
+    return None
+
+
+def _next_record(f: BinaryIO, offset: int, size: int) -> int | None:
+    """Where the record after the one at ``offset`` starts, if its length field leads to
+    the opcode of another record before the end of the file (else None)."""
+    f.seek(offset)
+    head = f.read(9)
+    if len(head) < 9 or not _OPCODES[0] <= head[0] <= _OPCODES[1]:
+        return None
+    after = offset + 9 + int.from_bytes(head[1:], "little")
+    if after >= size - len(MAGIC):
+        return None
+    f.seek(after)
+    opcode = f.read(1)
+    return after if opcode and _OPCODES[0] <= opcode[0] <= _OPCODES[1] else None
+
+
+_OPCODES = (0x01, 0x0F)
+"""MCAP's record opcodes: Header .. DataEnd."""
+
+
+def summary_start(path: Path) -> int | None:
+    """Where the summary section (the index) starts, as the footer says (None: no
+    plausible footer)."""
+    with path.open("rb") as f:
+        footer = f.seek(0, 2) - len(MAGIC) - _FOOTER_FIELDS
+        if footer < len(MAGIC):
+            return None
+        f.seek(footer)
+        (start,) = struct.unpack("<Q", f.read(8))
+    return start if len(MAGIC) <= start < footer else None
+
+
+def summary_damage(path: Path) -> Damage | None:
+    """The summary section (the index) when it fails the CRC the footer holds for it."""
+    start = summary_start(path)
+    if start is None:
+        return None
+    with path.open("rb") as f:
+        footer = f.seek(0, 2) - len(MAGIC) - _FOOTER_FIELDS
+        f.seek(footer + 16)
+        (crc,) = struct.unpack("<I", f.read(4))
+        f.seek(start)
+        computed = zlib.crc32(f.read(footer + 16 - start))
+    if crc == 0 or computed == crc:
+        return None
+    return Damage(
+        start,
+        f"the index (summary section) fails its CRC (recorded {crc:#010x}, computed "
+        f"{computed:#010x}): read front to back instead",
+    )
+
+
+_FOOTER_FIELDS = 8 + 8 + 4
+"""The footer's summary start, summary offset start and summary CRC."""

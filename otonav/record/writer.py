@@ -20,6 +20,7 @@ stamps. Crash-safe by construction (ADR 0004):
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import struct
 from collections.abc import Callable, Iterable, Sequence
@@ -51,6 +52,29 @@ _BARE_END = struct.pack("<BQI", 0x0F, 4, 0) + struct.pack("<BQQQI", 0x02, 20, 0,
 def _library() -> str:
     # The code's version, never the installed metadata on disk (otonav/_version.py).
     return f"otonav {__version__}"
+
+
+class RecordingGoneError(FileNotFoundError):
+    """The file was deleted (or replaced) while the run wrote it, e.g. its ``--out``
+    directory was removed: what was written went nowhere (issue 41)."""
+
+    def __init__(self, path: Path) -> None:
+        super().__init__(
+            errno.ENOENT,
+            f"the recording was deleted while the run wrote it (was {path.parent} removed?); "
+            "nothing of the run was kept",
+            str(path),
+        )
+
+
+def _still_at(path: Path, file: IO[bytes]) -> bool:
+    """``file`` is still the file at ``path`` (not deleted, not replaced)."""
+    try:
+        here = os.stat(path)
+    except FileNotFoundError:
+        return False
+    held = os.fstat(file.fileno())
+    return (here.st_dev, here.st_ino) == (held.st_dev, held.st_ino)
 
 
 class RecordingWriter:
@@ -198,10 +222,14 @@ class RecordingWriter:
         try:
             try:
                 self._writer.finish()  # type: ignore[no-untyped-call]
+                self._file.flush()
+                here = _still_at(self.path, self._file)
             finally:
                 self._file.close()
         except OSError as exc:
             raise self._disk_full(exc) from exc
+        if not here:
+            raise RecordingGoneError(self.path)
 
     def _disk_full(self, exc: OSError) -> OSError | DiskFullError:
         """On a full disk: close the file readable (see the module), remember and return

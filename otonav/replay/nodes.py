@@ -41,10 +41,14 @@ def stack_actor_names(stack: StackConfig, geometry: RobotGeometry | None = None)
     return [a.name for a in _stack_actors(stack, geometry) if a.name not in NOT_REPLAYABLE]
 
 
-def _stack_actors(stack: StackConfig, geometry: RobotGeometry | None) -> list[Actor]:
+def _stack_actors(
+    stack: StackConfig,
+    geometry: RobotGeometry | None,
+    start: tuple[float, float, float] = (0.0, 0.0, 0.0),
+) -> list[Actor]:
     hal = _robot(stack, geometry)
     try:
-        return build_actors(stack, hal)
+        return build_actors(stack, hal, initial_pose=start)
     except ImportError as exc:  # a CAN stack's modules without the extra
         raise ReplayInputError(
             f"hal.kind: {stack.hal.kind} needs a module that is not installed ({exc.name}): "
@@ -81,13 +85,17 @@ def _valid_names(stack_names: Sequence[str]) -> str:
 
 
 def build_nodes(
-    specs: Sequence[str], stack: StackConfig, geometry: RobotGeometry | None = None
+    specs: Sequence[str],
+    stack: StackConfig,
+    geometry: RobotGeometry | None = None,
+    start: tuple[float, float, float] = (0.0, 0.0, 0.0),
 ) -> list[Actor]:
     """The actors named by ``specs`` (stack names or import paths), built from ``stack``
-    for a robot of ``geometry`` (None: the one ``stack``'s world compiles to)."""
+    for a robot of ``geometry`` (None: the one ``stack``'s world compiles to) that
+    started at ``start`` (x, y, yaw: the run's, as the run built them)."""
     if not specs:
         raise ReplayInputError("--node: name at least one node to replay")
-    stack_actors = {a.name: a for a in _stack_actors(stack, geometry)}
+    stack_actors = {a.name: a for a in _stack_actors(stack, geometry, start)}
     replayable = [name for name in stack_actors if name not in NOT_REPLAYABLE]
     actors: list[Actor] = []
     for spec in specs:

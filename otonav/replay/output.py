@@ -11,17 +11,19 @@ can show both. The ``otonav`` metadata carries the config the replay ran with, a
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 from mcap.writer import CompressionType
 
+from otonav.msgs import Message
 from otonav.record.cdr import encode
 from otonav.record.fastwriter import FastWriter
 from otonav.record.qos_profile import offered_qos_yaml
 from otonav.record.schemas import schema_for
 from otonav.record.type_hash import rihs01
 from otonav.record.writer import CHUNK_SIZE
-from otonav.replay.recording import load_recording
+from otonav.replay.recording import Recording, load_recording
 from otonav.replay.runner import ReplayResult
 
 RECORDED_PREFIX = "/recorded"
@@ -41,13 +43,32 @@ def write_replay(result: ReplayResult, out: Path) -> Path:
             continue
         topic = RECORDED_PREFIX + message.topic if message.topic in outputs else message.topic
         rows.append((message.time_ns, len(rows), topic, message.data))
-    types = {}
+    types: dict[str, type[Message]] = {}
     for replayed in result.replayed:
         types[replayed.topic] = type(replayed.message)
         rows.append((replayed.time_ns, len(rows), replayed.topic, encode(replayed.message)))
     rows.sort()
     out.parent.mkdir(parents=True, exist_ok=True)
-    with out.open("wb") as f:
+    # All or nothing: written beside, renamed over ``out`` once finished and indexed (an
+    # interrupted replay leaves no partial file, and an earlier ``out`` as it was).
+    partial = out.with_name(f".{out.name}.partial")
+    try:
+        _write(result, source, rows, types, partial)
+        os.replace(partial, out)
+    except BaseException:
+        partial.unlink(missing_ok=True)
+        raise
+    return out
+
+
+def _write(
+    result: ReplayResult,
+    source: Recording,
+    rows: list[tuple[int, int, str, bytes]],
+    types: dict[str, type[Message]],
+    path: Path,
+) -> None:
+    with path.open("wb") as f:
         writer = FastWriter(f, chunk_size=CHUNK_SIZE, compression=CompressionType.ZSTD)
         writer.start(profile="ros2", library="otonav replay")
         schema_ids: dict[str, int] = {}
@@ -104,4 +125,3 @@ def write_replay(result: ReplayResult, out: Path) -> Path:
             },
         )
         writer.finish()  # type: ignore[no-untyped-call]
-    return out

@@ -10,18 +10,21 @@ the instant it published, and may sit later in the file).
 
 from __future__ import annotations
 
+import json
 from collections.abc import Collection
 from dataclasses import dataclass, field
 from operator import itemgetter
 from pathlib import Path
 from typing import Any, BinaryIO, NamedTuple
 
+from mcap.exceptions import McapError
 from mcap.reader import NonSeekingReader, make_reader
 from pydantic import ValidationError
 
 from otonav.record.fastreader import ChunkDamageError, read_raw_messages
 from otonav.record.reader import CUT_OFF_ERRORS, MAGIC
-from otonav.record.verify import _finished, _one_line, describe_damage
+from otonav.record.verify import _finished, _one_line, describe_damage, summary_damage
+from otonav.scenario.config import StartSpec
 from otonav.stack import StackConfig
 
 
@@ -65,6 +68,22 @@ class Recording:
     """mcap's parsed summary section (channels, schemas, chunk indexes), for
     :func:`read_topics`."""
 
+    @property
+    def start(self) -> tuple[float, float, float]:
+        """Where the run started (x, y, yaw): the stored scenario's start, where its
+        odometry and its navigator's map are anchored; the origin when none is stored
+        (a recording made with ``running_stack``, which starts there by default)."""
+        text = self.metadata.get("otonav", {}).get("scenario_config")
+        if text is None:
+            return (0.0, 0.0, 0.0)
+        try:
+            start = StartSpec.model_validate(json.loads(text).get("start", {}))
+        except (ValueError, AttributeError):  # not JSON, not an object, not a start
+            raise ReplayInputError(
+                f"{self.path}: its stored scenario has no readable start pose"
+            ) from None
+        return start.as_tuple()
+
 
 def _cut_off(path: Path) -> ReplayInputError:
     return ReplayInputError(
@@ -97,10 +116,16 @@ def load_recording(path: Path, topics: Collection[str] | None) -> Recording:
             reader = make_reader(f)
             try:
                 summary = reader.get_summary()
-            except OSError:  # too short to hold a footer: a seek before its start
-                raise _cut_off(path) from None
+            except OSError as exc:  # too short to hold a footer: a seek before its start
+                raise _unreadable(path, exc) from None
             if summary is None or summary.statistics is None:
-                raise _cut_off(path)
+                raise _unreadable(path, McapError("no index"))
+            index = summary_damage(path)
+            if index is not None:
+                raise ReplayInputError(
+                    f"{path}: damaged: {index.problem.partition(':')[0]}; 'otonav salvage "
+                    f"{path} FIXED.mcap' rewrites its intact chunks with a new index"
+                )
             types: dict[str, str] = {}
             schemas: dict[str, RecordedSchema] = {}
             for channel in summary.channels.values():

@@ -8,7 +8,7 @@ import asyncio
 import contextlib
 import gc
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Literal
@@ -158,6 +158,7 @@ def replay_recording(
     tolerance: float = 0.0,
     wake: Literal["timers", "recorded"] = "timers",
     wall_ceiling: float | None = 600.0,
+    on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
 ) -> ReplayResult:
     """Replay ``nodes`` (stack actor names, ``pkg.mod:Name`` paths, or actor objects)
     against ``recording``. Their config is the recording's stored stack config (or
@@ -166,6 +167,9 @@ def replay_recording(
     ``wake="recorded"``: wake each actor at the instants its outputs were recorded at
     instead of its own deadlines (a recording made in real time, where wake-ups followed
     the wall clock; see :class:`~otonav.replay.feed.ReplayClock`).
+
+    ``on_start(loop, task)``: called as the replay's task starts on its loop (to cancel
+    it from a signal handler; a cancelled replay raises ``asyncio.CancelledError``).
 
     Raises :class:`ReplayInputError` for bad input (file, node, topic, override).
     """
@@ -178,6 +182,7 @@ def replay_recording(
             tolerance=tolerance,
             wake=wake,
             wall_ceiling=wall_ceiling,
+            on_start=on_start,
         )
 
 
@@ -205,6 +210,7 @@ def _replay(
     tolerance: float = 0.0,
     wake: Literal["timers", "recorded"] = "timers",
     wall_ceiling: float | None = 600.0,
+    on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
 ) -> ReplayResult:
     """The body of :func:`replay_recording`."""
     if not tolerance >= 0:
@@ -218,7 +224,7 @@ def _replay(
         config = apply_overrides(config, overrides)
     names = [n for n in nodes if isinstance(n, str)]
     geometry = recorded_geometry(meta, config)
-    built = iter(build_nodes(names, config, geometry)) if names else iter(())
+    built = iter(build_nodes(names, config, geometry, meta.start)) if names else iter(())
     actors: list[Actor] = [next(built) if isinstance(n, str) else n for n in nodes]
     if not actors:
         raise ReplayInputError("--node: name at least one node to replay")
@@ -262,6 +268,9 @@ def _replay(
     async def main() -> None:
         loop = asyncio.get_running_loop()
         assert isinstance(loop, VirtualTimeLoop)
+        task = asyncio.current_task()
+        if on_start is not None and task is not None:
+            on_start(loop, task)
         system = System(actors)
         publishers = {
             topic: system.publisher(topic, msg_type, _feed_qos(qos), name="replay")

@@ -264,6 +264,11 @@ class VirtualTimeLoop(SteppedSelectorLoop):
                 )
             )
 
+    def check_ceiling_threadsafe(self) -> None:
+        """From any thread: check the wall-clock ceiling at the loop's next pass."""
+        with contextlib.suppress(RuntimeError):  # the loop has closed
+            self.call_soon_threadsafe(self.iteration_check)
+
     def fail_threadsafe(self, error: BaseException) -> None:
         """From any thread: fail the run with ``error`` (as the ceiling does)."""
         with contextlib.suppress(RuntimeError):  # the loop has closed: the run is over

@@ -8,6 +8,8 @@ callback that never yields holds every timer, the ceiling's too: ADR 0039). This
 watches the loop instead:
 
 - the loop counts its passes (``beats``) and says when it is waiting in its selector;
+- once the ceiling has passed and the loop still passes, it is asked to check its ceiling
+  at its next pass (a pass draining a flood can take 30 ms: 256 of them are 8 s);
 - once the ceiling has passed, or a stop was asked for (:meth:`LoopWatchdog.expect_progress`:
   a signal, a host cancelling a run), a loop whose beat count has not moved for ``grace``
   wall seconds while not waiting is *held*;
@@ -47,6 +49,8 @@ class WatchedLoop(Protocol):
     def time(self) -> float: ...
 
     def fail_threadsafe(self, error: BaseException) -> None: ...
+
+    def check_ceiling_threadsafe(self) -> None: ...
 
 
 POLL_S = 0.1
@@ -124,12 +128,21 @@ class LoopWatchdog:
                 continue
             beats = self._loop.beats
             if beats != last_beats or self._loop.waiting:
+                if self._why is None and last_beats >= 0:
+                    self._check_ceiling()
                 last_beats, still_since = beats, now
             elif now - still_since >= self._grace:
                 self._held(now - still_since)
                 still_since = now
             self._wake.wait(POLL_S)
             self._wake.clear()
+
+    def _check_ceiling(self) -> None:
+        """Past the ceiling, the loop still passing: have it check its ceiling at its
+        next pass. Its own check runs every 256 passes, and a pass that drained a flood
+        (an actor publishing in a tight loop) took 30 ms: the run went on 8 s past its
+        ceiling, and as long again before its failure stopped the loop (issue 41)."""
+        self._loop.check_ceiling_threadsafe()
 
     def _held(self, for_s: float) -> None:
         loop = self._loop

@@ -15,6 +15,8 @@ from otonav.scenario.clearance import ClearanceTracker
 ARRIVAL_SETTLE_S = 2.0
 #: m/s: the true speed below which the robot counts as stopped at the goal.
 ARRIVAL_MAX_SPEED = 0.02
+#: The most samples of the true path the judge keeps for the plot (:attr:`Judge.trajectory`).
+TRAIL_POINTS = 8192
 
 
 class Judge(Actor):
@@ -91,8 +93,22 @@ class Judge(Actor):
         """A permanent hardware fault (``HardwareHealth.permanent``), as the verdict's
         reason: the run ends on it (issue 27). None: none."""
         self.samples = 0
-        self.trajectory: list[tuple[float, float, float]] = []
+        self._trail: list[tuple[float, float, float]] = []
+        self._stride = 1  # keep every stride-th sample (doubles as the trail fills)
+        self._latest: tuple[float, float, float] | None = None
         self._last: tuple[float, float] | None = None
+
+    @property
+    def trajectory(self) -> list[tuple[float, float, float]]:
+        """(t, x, y) of the true path, for the plot: every sample of a run up to
+        :data:`TRAIL_POINTS` samples; past that every second kept one is dropped, and
+        from then on one sample in two (then four, ...) is kept, so a long run holds at
+        most that many (a 1,200 s run held 120,000: ~14 KB per sim second, issue 41).
+        The latest sample always ends it."""
+        trail, latest = self._trail, self._latest
+        if latest is None or (trail and trail[-1] is latest):
+            return list(trail)
+        return [*trail, latest]
 
     @property
     def entered(self) -> bool:
@@ -152,7 +168,13 @@ class Judge(Actor):
     def sample(self, now: float) -> None:
         x, y, vx, vy = self.hal.planar_truth()
         self.samples += 1
-        self.trajectory.append((now, x, y))
+        self._latest = point = (now, x, y)
+        if self.samples % self._stride == 0:
+            trail = self._trail
+            trail.append(point)
+            if len(trail) > TRAIL_POINTS:
+                del trail[1::2]  # the first stays; the latest is kept apart
+                self._stride *= 2
         if self._last is not None:
             self.path_length += math.hypot(x - self._last[0], y - self._last[1])
         self._last = (x, y)

@@ -108,7 +108,8 @@ def draw_trajectory(
             fontsize=8,
             color="#c0392b",
         )
-    ax.legend(loc="best", fontsize=8)
+    if ax.get_legend_handles_labels()[1]:  # nothing drawn (every chunk damaged): no legend
+        ax.legend(loc="best", fontsize=8)
     return fig
 
 

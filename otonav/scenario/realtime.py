@@ -72,11 +72,18 @@ async def _main(
     with run_task(on_start):
         clock = session.realtime_clock
         assert clock is not None
-        async with anyio.create_task_group() as tg:
-            if viewer is not None:
-                tg.start_soon(_show, viewer, clock, closed_at, tg.cancel_scope)
-            await drive(session, scenario, judge)
-            tg.cancel_scope.cancel()
+        try:
+            async with anyio.create_task_group() as tg:
+                if viewer is not None:
+                    tg.start_soon(_show, viewer, clock, closed_at, tg.cancel_scope)
+                await drive(session, scenario, judge)
+                tg.cancel_scope.cancel()
+        except BaseExceptionGroup as group:
+            # anyio wraps what drive raised (an actor's crash) in a group: the run ends on
+            # that exception itself, as a virtual run does (issue 41).
+            if len(group.exceptions) != 1:
+                raise
+            raise group.exceptions[0]  # noqa: B904 - its own cause is kept
 
 
 def run_scenario_realtime(

@@ -101,3 +101,23 @@ def test_a_file_lock_leaves_no_empty_file_behind(tmp_path: Path) -> None:
     with lock_output(target, is_file=True):
         assert target.exists()
     assert not target.exists()
+
+
+@pytest.mark.parametrize("command", ["run", "sweep"])
+def test_an_out_naming_a_file_says_so(
+    cli_fails: Callable[..., str], tmp_path: Path, command: str
+) -> None:
+    """Issue 41 case 24: ``--out afile`` said "afile: File exists"."""
+    afile = tmp_path / "afile"
+    afile.write_text("mine")
+    extra = ["--scenario", "acceptance", "--seeds", "1"] if command == "sweep" else []
+    for out in (afile, afile / "sub"):
+        cli_fails([command, *extra, "--out", str(out)], f"--out {out}: ", "a file, not a dir")
+    assert afile.read_text() == "mine"
+
+
+def test_a_replay_out_naming_a_directory_says_so(
+    cli_fails: Callable[..., str], tmp_path: Path
+) -> None:
+    argv = ["replay", str(tmp_path / "in.mcap"), "--node", "nav", "--out", str(tmp_path)]
+    cli_fails(argv, f"--out {tmp_path}: is a directory", "the MCAP file")
