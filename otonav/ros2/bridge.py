@@ -67,6 +67,7 @@ from otonav.ros2.naming import (
 from otonav.ros2.parameters import rclpy_available
 from otonav.runtime import Actor, Bus, Durability, Output, QoS, Reliability, run_blocking
 from otonav.runtime.mailbox import Endpoint, Publisher, Subscription, Topic
+from otonav.stack.door import Refusals, refusal
 
 if TYPE_CHECKING:
     from otonav.ros2.dds import GraphWriter, Participant, RawReader, RawWriter
@@ -144,7 +145,8 @@ class Ros2Statistics(NamedTuple):
     received: int
     """Messages taken from DDS and published on the bus."""
     rejected: int
-    """Messages from DDS that did not decode as the topic's type, or found it full."""
+    """Messages from DDS refused at the door (not the topic's type, a NaN, a goal beyond
+    the world: ``otonav.stack.door``) or dropped because the topic was full."""
 
 
 _DISCOVERY_QUIET = 0.5
@@ -258,6 +260,10 @@ class Ros2Bridge(Actor):
         self._started = False
         self.received = 0
         self.rejected = 0
+        """Messages from DDS dropped because the topic was full."""
+        self.refusals = Refusals(lambda text: self._log(Log.WARN, text))
+        """Messages from DDS the door refused (not the topic's type, a NaN, a goal
+        beyond the world: ``otonav.stack.door``), by source."""
         self._clock_mirror: _Mirror | None = None
         self._armed: asyncio.Event | None = None
         """Set by the idle watcher once a lockstep instant settled and /clock was written."""
@@ -585,20 +591,19 @@ class Ros2Bridge(Actor):
             reader = entry.reader
             if reader is None:
                 continue
+            source = f"ROS 2 ({dds_topic(entry.name)})"
             for data in reader.take():
                 try:
                     message = decode(entry.wire_type, data)
-                except (ValueError, IndexError, TypeError) as exc:
-                    self.rejected += 1
+                except (ValueError, IndexError, TypeError, OverflowError) as exc:
                     first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-                    self._log(Log.WARN, f"{entry.name}: not a {entry.wire_type.ros_type} ({first})")
+                    self.refusals.refuse(source, f"not a {entry.wire_type.ros_type} ({first})")
                     continue
                 if isinstance(message, TwistStamped):
                     message = message.twist
-                problem = _not_finite(message)
+                problem = refusal(message)
                 if problem is not None:  # outside data, checked at the door (issue 41)
-                    self.rejected += 1
-                    self._log(Log.WARN, f"{entry.name}: refused from ROS 2: {problem}")
+                    self.refusals.refuse(source, f"{entry.name}: {problem}")
                     continue
                 try:
                     entry.publisher.publish_nowait(message)
@@ -636,27 +641,8 @@ class Ros2Bridge(Actor):
             unread=sum(m.unread for m in mirrors),
             refused=sum(m.refused for m in mirrors),
             received=self.received,
-            rejected=self.rejected,
+            rejected=self.rejected + self.refusals.count,
         )
-
-
-def _not_finite(message: Any, path: str = "") -> str | None:
-    """The first field of ``message`` that is a NaN or an infinity (a goal at x = NaN
-    crashed the navigator), or None."""
-    if isinstance(message, float):
-        return None if math.isfinite(message) else f"{path or 'value'} is {message}"
-    if isinstance(message, tuple | list):
-        for i, item in enumerate(message):
-            problem = _not_finite(item, f"{path}[{i}]")
-            if problem is not None:
-                return problem
-        return None
-    if isinstance(message, Message):
-        for name in type(message).model_fields:
-            problem = _not_finite(getattr(message, name), f"{path}.{name}" if path else name)
-            if problem is not None:
-                return problem
-    return None
 
 
 def _node_name(actor: str) -> str:
