@@ -6,7 +6,7 @@ client (ROS 2's default rmw) matches a reply to its request by an identity that 
 in the RTPS inline QoS, which a plain Cyclone participant can neither read nor write. So
 the services are served by rclpy itself, in this process, when it is importable (a
 sourced ROS 2, or its wheels from PyPI): one rclpy node per actor, named as the actor,
-with the actor's parameters declared as :class:`~otonav.actors.live_parameters.
+with the actor's parameters declared as :class:`~otonav.stack.live_parameters.
 ActorParameters` lists them (``params.dwa.max_v`` on ``/nav``). The runtime-safe ones are
 settable; the others are declared read-only. A set is validated and applied on the run's
 loop (as the Foxglove panel's are): a refused value is an unsuccessful
@@ -24,8 +24,8 @@ import threading
 from collections.abc import Callable, Iterable
 from typing import Any
 
-from otonav.actors.live_parameters import ActorParameters, ParameterError
 from otonav.runtime import Actor
+from otonav.stack.live_parameters import ActorParameters, ParameterError
 
 __all__ = ("ParameterNodes", "rclpy_available")
 
