@@ -23,6 +23,15 @@ runs an asyncio loop with one writer task per client that sends what is queued. 
 client that does not read stops its writer (the socket's buffer is full); its queue
 then keeps the newest ``backlog`` data frames, dropping (and counting) the oldest.
 Control messages (serverInfo, advertisements, status) are never dropped.
+
+Bounded per client (issue 41, docs/adr/0074): at most :data:`CONTROL_BACKLOG` unread
+control messages, then the client is disconnected (close code 1008, with the reason);
+one subscription per channel (a second id for it is refused, as foxglove-sdk's servers
+do), so each message is one frame per client whatever a client asks, and one status
+answers a whole subscribe request; at most :data:`MAX_ADVERTISED` client channels. A
+malformed frame (ids that are not uint32, a non-object, deep JSON, a binary frame under
+5 bytes) is answered by a status and reported to ``on_refused``; none ends the
+connection.
 """
 
 from __future__ import annotations
@@ -159,8 +168,11 @@ class ProtocolServer:
         on_unsubscribe: Callable[[int, int], None] = lambda client, channel: None,
         on_client_message: Callable[[ClientChannel, bytes], str | None] | None = None,
         parameters: Parameters | None = None,
+        on_refused: Callable[[int, str], None] = lambda client, text: None,
     ) -> None:
         self.name = name
+        self._on_refused = on_refused
+        """``(client, text)``: a frame refused as malformed, or a client disconnected."""
         self._on_client_message = on_client_message
         """``(channel, payload) -> None`` taken, or one line why not (sent as a status)."""
         self._parameters = parameters
@@ -270,6 +282,8 @@ class ProtocolServer:
             self._loop.call_soon_threadsafe(self._close_client, client, reason)
 
     def _close_client(self, client: _Client, reason: str) -> None:  # the server's thread
+        self._on_refused(client.id, f"disconnected: {reason}")
+
         async def close() -> None:
             try:  # a client that does not read may never answer the close: abort it then
                 await asyncio.wait_for(client.connection.close(1008, reason), _CLOSE_TIMEOUT)
@@ -407,7 +421,9 @@ class ProtocolServer:
             else:
                 self._status(client, 1, f"unsupported operation {op!r}: this server only serves")
         except (ValueError, KeyError, TypeError, AttributeError, RecursionError) as exc:
-            self._status(client, 2, f"bad message ({type(exc).__name__}: {exc})")
+            text = f"bad message ({type(exc).__name__}: {exc})"
+            self._status(client, 2, text)
+            self._on_refused(client.id, text[:MAX_STATUS_CHARS])
 
     def _client_advertise(self, client: _Client, op: str, message: dict[str, Any]) -> None:
         if op == "unadvertise":

@@ -118,6 +118,8 @@ class FoxgloveServer:
         """Where client messages go (the live view sets it once wired)."""
         self.parameter_sink: Any = None
         """Who answers parameter requests (the live view, once given the actors)."""
+        self.refusal_sink: Callable[[str, str], None] = lambda source, text: None
+        """Told of malformed frames and disconnected clients (the live view counts them)."""
         outer = self
 
         class _Parameters(Parameters):
@@ -142,6 +144,9 @@ class FoxgloveServer:
                 on_unsubscribe=self._unsubscribed,
                 on_client_message=self._client_message if options.client_publish else None,
                 parameters=_Parameters(),
+                on_refused=lambda client, text: self.refusal_sink(
+                    f"foxglove client {client}", text
+                ),
             )
         except OSError as exc:
             raise LiveViewError(
@@ -314,7 +319,9 @@ class LiveView(Actor):
         self.client_messages = 0
         """Messages clients published that were taken."""
         self.refusals = Refusals(lambda text: self._log(Log.WARN, text))
-        """What clients sent that the door refused (``otonav.stack.door``), by client."""
+        """What clients sent that the door refused (``otonav.stack.door``), malformed
+        frames, and clients disconnected for going over a bound, by client."""
+        server.refusal_sink = self._refuse
 
     def on_wired(self, bus: Bus) -> None:
         for topic in list(bus.topics.values()):

@@ -455,6 +455,7 @@ class Ros2Bridge(Actor):
                 loop=asyncio.get_running_loop(),
                 node_name=_node_name,
                 on_change=self._parameter_changed,
+                on_refused=lambda text: self.refusals.refuse("ROS 2 parameters", text),
             )
             # rclpy's nodes put their own events on DDS: otonav's go to the recording only.
             events = self._mirrors.get(topics.PARAMETER_EVENTS)

@@ -50,6 +50,7 @@ class ParameterNodes:
         loop: asyncio.AbstractEventLoop,
         node_name: Any,
         on_change: Callable[[str, str, Any], None] | None = None,
+        on_refused: Callable[[str], None] | None = None,
     ) -> None:
         import rclpy
         from rcl_interfaces.msg import ParameterDescriptor
@@ -60,6 +61,8 @@ class ParameterNodes:
         self._loop = loop
         self._on_change = on_change
         """Called on the loop with (actor, key, new value) after each set it took."""
+        self._on_refused = on_refused
+        """Called on the loop with why, after each set it refused."""
         self._table = ActorParameters(actors)
         self._context = Context()
         rclpy.init(context=self._context, domain_id=domain_id)
@@ -115,6 +118,8 @@ class ParameterNodes:
             try:
                 _old, new = self._table.set(name, value)
             except ParameterError as exc:
+                if self._on_refused is not None:
+                    self._on_refused(str(exc))
                 return str(exc)
             if self._on_change is not None:
                 actor, _, key = name.partition(".")

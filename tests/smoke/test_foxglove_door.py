@@ -188,6 +188,10 @@ async def test_malformed_frames_are_answered_and_the_connection_goes_on(tmp_path
         reply = await _next_op(ws, "parameterValues")
         assert reply["id"] == "after"
         assert "safety.params.scales" in {p["name"] for p in reply["parameters"]}
+    assert run.view.refusals.count == len(frames)  # counted; the first ten logged
+    lines = [line for line in _rosout(run.record) if line.startswith("refused from foxglove")]
+    assert len(lines) == 10, lines
+    assert any("further refusals are counted, not logged" in line for line in _rosout(run.record))
 
 
 @pytest.mark.asyncio
@@ -236,6 +240,9 @@ async def test_a_client_that_never_reads_its_replies_is_disconnected(tmp_path: P
                 await flood()
         assert run.server.disconnected == 1
         assert sent > CONTROL_BACKLOG
+        assert run.view.refusals.count == 1
         # the server still serves the others
         async with connect(run.server.url, subprotocols=PROTOCOL) as other:
             assert (await _next_op(other, "serverInfo"))["name"] == "otonav"
+    (line,) = [line for line in _rosout(run.record) if "disconnected" in line]
+    assert f"{CONTROL_BACKLOG} replies unread" in line
