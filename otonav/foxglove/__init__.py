@@ -7,4 +7,4 @@ package comes with the ``otonav[foxglove]`` extra, imported only when a server s
 
 from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
 
-__all__ = ["FoxgloveServer", "LiveView", "LiveViewError", "LiveViewOptions"]
+__all__ = ("FoxgloveServer", "LiveView", "LiveViewError", "LiveViewOptions")

@@ -153,6 +153,7 @@ PINNED: dict[str, tuple[str, ...]] = {
         "Vector3",
         "WheelCommand",
     ),
+    "otonav.foxglove": ("FoxgloveServer", "LiveView", "LiveViewError", "LiveViewOptions"),
     "otonav.nav": (
         "DwaParams",
         "DwaResult",
@@ -167,6 +168,7 @@ PINNED: dict[str, tuple[str, ...]] = {
         "centre_clearance",
         "dwa_step",
         "go_to_goal",
+        "goal_problem",
         "guard_blocked",
         "safe_command",
         "wrap_angle",
