@@ -383,7 +383,7 @@ class LiveView(Actor):
             return f"{channel.topic}: {problem}"
         if loop is None or loop.is_closed():
             return f"{channel.topic}: not taken (the stack is not running)"
-        loop.call_soon_threadsafe(self._publish_client, publisher, message)
+        loop.call_soon_threadsafe(self._publish_client, publisher, message, channel.client)
         return None
 
     def _refuse(self, source: str, text: str) -> None:
@@ -395,12 +395,12 @@ class LiveView(Actor):
         with contextlib.suppress(RuntimeError):  # the loop has closed: the run is over
             loop.call_soon_threadsafe(self.refusals.refuse, source, text)
 
-    def _publish_client(self, publisher: Publisher[Any], message: Message) -> None:
+    def _publish_client(self, publisher: Publisher[Any], message: Message, client: int) -> None:
         try:
             publisher.publish_nowait(message)
             self.client_messages += 1
-        except anyio.WouldBlock:
-            self._log(Log.WARN, f"{publisher.topic}: a client's message dropped (full)")
+        except anyio.WouldBlock:  # counted and logged as refusals are: a flood stays bounded
+            self.refusals.refuse(f"foxglove client {client}", f"{publisher.topic}: full, dropped")
 
     def serve_parameters(self, actors: Iterable[Actor]) -> ActorParameters:
         """Serve the parameters of ``actors`` (the system's) to clients; the table served.

@@ -259,11 +259,10 @@ class Ros2Bridge(Actor):
         self._bus: Bus | None = None
         self._started = False
         self.received = 0
-        self.rejected = 0
-        """Messages from DDS dropped because the topic was full."""
         self.refusals = Refusals(lambda text: self._log(Log.WARN, text))
         """Messages from DDS the door refused (not the topic's type, a NaN, a goal
-        beyond the world: ``otonav.stack.door``), by source."""
+        beyond the world: ``otonav.stack.door``) or dropped (the topic was full), by
+        source."""
         self._clock_mirror: _Mirror | None = None
         self._armed: asyncio.Event | None = None
         """Set by the idle watcher once a lockstep instant settled and /clock was written."""
@@ -609,9 +608,8 @@ class Ros2Bridge(Actor):
                 try:
                     entry.publisher.publish_nowait(message)
                     self.received += 1
-                except anyio.WouldBlock:
-                    self.rejected += 1
-                    self._log(Log.WARN, f"{entry.name}: a ROS 2 message dropped (full)")
+                except anyio.WouldBlock:  # counted as refusals are: a flood stays bounded
+                    self.refusals.refuse(source, f"{entry.name}: full, dropped")
 
     async def on_stop(self) -> None:
         if self._remove_watcher is not None:
@@ -642,7 +640,7 @@ class Ros2Bridge(Actor):
             unread=sum(m.unread for m in mirrors),
             refused=sum(m.refused for m in mirrors),
             received=self.received,
-            rejected=self.rejected + self.refusals.count,
+            rejected=self.refusals.count,
         )
 
 
