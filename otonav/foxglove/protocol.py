@@ -28,7 +28,8 @@ Bounded per client (issue 41, docs/adr/0074): at most :data:`CONTROL_BACKLOG` un
 control messages, then the client is disconnected (close code 1008, with the reason);
 one subscription per channel (a second id for it is refused, as foxglove-sdk's servers
 do), so each message is one frame per client whatever a client asks, and one status
-answers a whole subscribe request; at most :data:`MAX_ADVERTISED` client channels. A
+answers a whole subscribe request; at most :data:`MAX_ADVERTISED` client channels and
+:data:`MAX_CHANGES` parameters per ``setParameters``. A
 malformed frame (ids that are not uint32, a non-object, deep JSON, a binary frame under
 5 bytes) is answered by a status and reported to ``on_refused``; none ends the
 connection.
@@ -63,6 +64,9 @@ read them before it is disconnected: a client sending bad requests and never rea
 the answers grew the queue without bound (issue 41: 146 -> 425 MB and rising)."""
 MAX_ADVERTISED = 64
 """Channels one client may advertise (clientPublish): a few topics are ever taken."""
+MAX_CHANGES = 64
+"""Parameters one ``setParameters`` may change: each is validated and applied on the
+stack's thread, which must not do work that grows with what a client asks."""
 MAX_STATUS_CHARS = 500
 """A status message quotes at most this much of what the client sent."""
 _UINT32 = 1 << 32
@@ -477,10 +481,10 @@ class ProtocolServer:
             names = [_text(n, "parameter name") for n in _list(message, "parameterNames")]
             reply(self._parameters.get(names), None)
         else:
-            changes = [
-                (_text(p["name"], "parameter name"), p.get("value"))
-                for p in _list(message, "parameters")
-            ]
+            asked = _list(message, "parameters")
+            if len(asked) > MAX_CHANGES:  # each is applied on the stack's thread
+                raise ValueError(f"{len(asked)} parameters in one request: at most {MAX_CHANGES}")
+            changes = [(_text(p["name"], "parameter name"), p.get("value")) for p in asked]
             self._parameters.set(changes, reply)
 
     def _subscribe_all(self, client: _Client, subscriptions: list[Any]) -> None:

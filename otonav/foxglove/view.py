@@ -229,6 +229,9 @@ class FoxgloveServer:
         self._server.close()
 
 
+_EARLY_CHANGES = 64
+"""``setParameters`` requests kept while the stack starts (applied as it does)."""
+
 # Matches every publisher (ROS 2 rules): tapping a topic never makes wiring fail.
 _TAP_QOS = QoS(Reliability.BEST_EFFORT, depth=1)
 
@@ -420,6 +423,9 @@ class LiveView(Actor):
         with self._early_lock:
             loop = self._loop
             if loop is None:  # the stack is starting: applied by on_start
+                if len(self._early_changes) >= _EARLY_CHANGES:
+                    reply([], "parameters: too many changes while the stack starts")
+                    return
                 self._early_changes.append((changes, reply))
                 return
         if loop.is_closed():

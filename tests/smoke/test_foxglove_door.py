@@ -169,6 +169,7 @@ async def test_malformed_frames_are_answered_and_the_connection_goes_on(tmp_path
         '{"op": "getParameters", "id": 1e999, "parameterNames": 5}',
         "[" * 200_000 + "]" * 200_000,
         '{"op": ' * 50_000,
+        json.dumps({"op": "setParameters", "parameters": [{"name": "a", "value": 1}] * 65}),
         "[1, 2]",
         "not json",
         b"",
