@@ -29,10 +29,9 @@ control messages, then the client is disconnected (close code 1008, with the rea
 one subscription per channel (a second id for it is refused, as foxglove-sdk's servers
 do), so each message is one frame per client whatever a client asks, and one status
 answers a whole subscribe request; at most :data:`MAX_ADVERTISED` client channels and
-:data:`MAX_CHANGES` parameters per ``setParameters``. A
-malformed frame (ids that are not uint32, a non-object, deep JSON, a binary frame under
-5 bytes) is answered by a status and reported to ``on_refused``; none ends the
-connection.
+:data:`MAX_CHANGES` parameters per ``setParameters``. A malformed frame (ids that are not
+uint32, a non-object, deep JSON, a binary frame under 5 bytes) is answered by a status and
+reported to ``on_refused``; none ends the connection.
 """
 
 from __future__ import annotations
