@@ -2,9 +2,11 @@
 
 A message a Foxglove client publishes or a DDS participant writes is checked here, after
 it decoded as its topic's type and before any actor sees it, with the bounds the config
-uses: every number finite (the config's ``allow_inf_nan=False``), and a pose within the
+uses: every number finite (the config's ``allow_inf_nan=False``), a pose within the
 world a scenario can describe (:func:`otonav.nav.goal_problem`, the bound of a scenario's
-goal). A refused message is counted and logged on /rosout with its source by
+goal), a velocity command within the fastest base the config allows (``base.max_v`` <=
+10 m/s, ``base.max_omega`` <= 50 rad/s; slower commands are clamped by the base as
+ROS 2's controllers clamp them). A refused message is counted and logged on /rosout with its source by
 :class:`Refusals`; the bridge that took it answers where its protocol can (a Foxglove
 status). Live parameter sets pass the same bounds (:mod:`otonav.stack.live_parameters`).
 """
@@ -15,7 +17,8 @@ import math
 from collections.abc import Callable
 from typing import Any
 
-from otonav.msgs import Message, PoseStamped
+from otonav.limits import MAX_BASE_OMEGA, MAX_BASE_V
+from otonav.msgs import Message, PoseStamped, Twist, Vector3
 from otonav.nav import goal_problem
 
 __all__ = ("LOGGED_PER_SOURCE", "Refusals", "refusal")
@@ -31,7 +34,21 @@ def refusal(message: Message) -> str | None:
     if problem is None and isinstance(message, PoseStamped):
         position = message.pose.position
         problem = goal_problem(position.x, position.y)
+    if problem is None and isinstance(message, Twist):
+        problem = _beyond(message.linear, "linear", MAX_BASE_V, "m/s") or _beyond(
+            message.angular, "angular", MAX_BASE_OMEGA, "rad/s"
+        )
     return problem
+
+
+def _beyond(vector: Vector3, name: str, bound: float, unit: str) -> str | None:
+    """A velocity command beyond what any base may be configured to (``base.max_v``,
+    ``base.max_omega``): 1e308 m/s on /cmd_vel_nav overflowed the safety layer."""
+    for axis in "xyz":
+        value = getattr(vector, axis)
+        if abs(value) > bound:
+            return f"{name}.{axis} = {value!r}: beyond the fastest base ({bound:g} {unit})"
+    return None
 
 
 class Refusals:

@@ -1,10 +1,11 @@
-"""A DDS participant in a process of its own that writes raw CDR payloads on rt/goal
-(reliable, volatile: ``ros2 topic pub``'s offer), one per hex line read from stdin, so a
+"""A DDS participant in a process of its own that writes raw CDR payloads on rt/goal, or
+on rt/cmd_vel_nav (reliable, volatile: ``ros2 topic pub``'s offer), one per hex line read
+from stdin, so a
 test can send what no well-behaved node would. Prints ``matched`` once the bridge's goal
 reader matched, then ``N written`` after each payload (``N refused``: Cyclone's writer
 would not take it: it checks a payload's size against the type's).
 
-    python dds_fuzz_peer.py DOMAIN
+    python dds_fuzz_peer.py DOMAIN [goal | cmd_vel_nav]
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from __future__ import annotations
 import os
 import sys
 
-from otonav.msgs import PoseStamped
+from otonav.msgs import PoseStamped, Twist
 from otonav.ros2.dds import Participant
 from otonav.ros2.naming import dds_qos, discovery
 from otonav.runtime import QoS
@@ -23,9 +24,11 @@ HANG = 30.0
 
 def main() -> None:
     participant = Participant(int(sys.argv[1]), discovery(os.environ).config)
-    writer = participant.writer("rt/goal", PoseStamped, dds_qos(QoS(depth=1), PoseStamped))
+    topic = sys.argv[2] if len(sys.argv) > 2 else "goal"
+    kind = {"goal": PoseStamped, "cmd_vel_nav": Twist}[topic]
+    writer = participant.writer(f"rt/{topic}", kind, dds_qos(QoS(depth=1), kind))
     if not participant.wait(lambda: writer.matched.count > 0, HANG):
-        sys.exit("the bridge's goal reader never matched")
+        sys.exit(f"the bridge's {topic} reader never matched")
     print("matched", flush=True)
     for n, line in enumerate(sys.stdin, 1):
         written = writer.write(bytes.fromhex(line.strip()))

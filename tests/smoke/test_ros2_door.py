@@ -16,6 +16,8 @@ import pytest
 from dds_domain import exclusive_domain
 
 from otonav.actors import topics
+from otonav.msgs import Twist, Vector3
+from otonav.record.cdr import encode
 from otonav.record.reader import read_messages
 from otonav.ros2 import Ros2Bridge, Ros2Options
 from otonav.runtime import Actor, run_blocking
@@ -25,6 +27,7 @@ from otonav.stack import StackConfig
 pytestmark = pytest.mark.smoke
 
 PEER = Path(__file__).with_name("ros2_peer.py")
+FUZZ_PEER = Path(__file__).with_name("dds_fuzz_peer.py")
 HANG = 30.0
 """Wall seconds a wait on DDS may take: a hang, never a timing assertion."""
 BAD_X = ("nan", "inf", "1e308")
@@ -90,3 +93,73 @@ def test_goals_off_the_world_from_other_processes_are_refused_and_the_run_goes_o
     assert len(refused) == len(BAD_X), lines
     for x in ("nan", "inf", "1e+308"):
         assert any(f"goal x = {x}" in line or f"is {x}" in line for line in refused), refused
+
+
+class Commands(Actor):
+    """At 0.5 s of sim time, has a peer process write each of ``payloads`` on
+    rt/cmd_vel_nav, holding sim time until each arrived and the bridge took it."""
+
+    def __init__(self, bridge: Ros2Bridge, domain: int, payloads: list[bytes]) -> None:
+        super().__init__("commands")
+        self.bridge, self.domain, self.payloads = bridge, domain, payloads
+        self.process: subprocess.Popen[str] | None = None
+
+    def _start(self) -> subprocess.Popen[str]:
+        env = {k: v for k, v in os.environ.items() if not k.startswith(("ROS_", "CYCLONEDDS"))}
+        command = [sys.executable, str(FUZZ_PEER), str(self.domain), "cmd_vel_nav"]
+        return subprocess.Popen(
+            command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=env
+        )
+
+    async def run(self) -> None:
+        await self.clock.sleep_until(0.5)
+        self.process = peer = await run_blocking(self._start)
+        assert peer.stdin is not None
+        assert peer.stdout is not None
+        assert await run_blocking(peer.stdout.readline) == "matched\n"
+        (entry,) = [e for e in self.bridge._inputs if e.name == topics.CMD_VEL_NAV]
+        reader = entry.reader
+        assert reader is not None
+        for n, payload in enumerate(self.payloads, 1):
+            peer.stdin.write(payload.hex() + "\n")
+            peer.stdin.flush()
+            assert await run_blocking(peer.stdout.readline) == f"{n} written\n"
+            assert await run_blocking(
+                self.bridge.participant.wait, lambda n=n: reader.arrivals >= n, HANG
+            )
+            await self.clock.sleep(0.05)
+
+    def close(self) -> None:
+        if self.process is not None:
+            self.process.kill()
+            self.process.wait(HANG)
+            for stream in (self.process.stdin, self.process.stdout):
+                if stream is not None:
+                    stream.close()
+
+
+@pytest.mark.timeout(120)
+def test_velocity_commands_beyond_any_base_are_refused_at_the_door(tmp_path: Path) -> None:
+    # 1e308 m/s on /cmd_vel_nav, near an obstacle, is an OverflowError in the safety
+    # layer's stopping path (safe_command): a planner node of your own may send it.
+    bad = [Twist(linear=Vector3(x=1e308)), Twist(angular=Vector3(z=-1e3))]
+    with exclusive_domain() as domain:
+        env = {k: v for k, v in os.environ.items() if not k.startswith(("ROS_", "CYCLONEDDS"))}
+        bridge = Ros2Bridge(Ros2Options(domain_id=domain, inputs=(topics.CMD_VEL_NAV,)), env=env)
+        commands = Commands(bridge, domain, [encode(twist) for twist in bad])
+        try:
+            verdict = run_scenario(
+                ScenarioConfig(),
+                StackConfig(),
+                out_dir=tmp_path,
+                plot=False,
+                extra_actors=(bridge, commands),
+            )
+        finally:
+            commands.close()
+    assert verdict.passed, verdict.reason
+    assert (bridge.received, bridge.refusals.count) == (0, len(bad))
+    lines = [m.msg for _t, _s, m in read_messages(tmp_path / "recording.mcap", [topics.ROSOUT])]
+    refused = [line for line in lines if line.startswith("refused from ROS 2 (rt/cmd_vel_nav)")]
+    assert len(refused) == len(bad), lines
+    assert "beyond the fastest base (10 m/s)" in refused[0]
