@@ -6,9 +6,10 @@ uses: every number finite (the config's ``allow_inf_nan=False``), a pose within 
 world a scenario can describe (:func:`otonav.nav.goal_problem`, the bound of a scenario's
 goal), a velocity command within the fastest base the config allows (``base.max_v`` <=
 10 m/s, ``base.max_omega`` <= 50 rad/s; slower commands are clamped by the base as
-ROS 2's controllers clamp them). A refused message is counted and logged on /rosout with its source by
-:class:`Refusals`; the bridge that took it answers where its protocol can (a Foxglove
-status). Live parameter sets pass the same bounds (:mod:`otonav.stack.live_parameters`).
+ROS 2's controllers clamp them). A refused message is counted and logged on /rosout
+with its source by :class:`Refusals`; the bridge that took it answers where its protocol
+can (a Foxglove status). Live parameter sets pass the same bounds
+(:mod:`otonav.stack.live_parameters`).
 """
 
 from __future__ import annotations
