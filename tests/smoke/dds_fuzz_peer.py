@@ -13,7 +13,7 @@ from __future__ import annotations
 import os
 import sys
 
-from otonav.msgs import PoseStamped, Twist
+from otonav.msgs import Message, PoseStamped, Twist
 from otonav.ros2.dds import Participant
 from otonav.ros2.naming import dds_qos, discovery
 from otonav.runtime import QoS
@@ -25,7 +25,8 @@ HANG = 30.0
 def main() -> None:
     participant = Participant(int(sys.argv[1]), discovery(os.environ).config)
     topic = sys.argv[2] if len(sys.argv) > 2 else "goal"
-    kind = {"goal": PoseStamped, "cmd_vel_nav": Twist}[topic]
+    kinds: dict[str, type[Message]] = {"goal": PoseStamped, "cmd_vel_nav": Twist}
+    kind = kinds[topic]
     writer = participant.writer(f"rt/{topic}", kind, dds_qos(QoS(depth=1), kind))
     if not participant.wait(lambda: writer.matched.count > 0, HANG):
         sys.exit(f"the bridge's {topic} reader never matched")
