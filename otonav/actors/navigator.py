@@ -82,7 +82,8 @@ class GoalNavigator(Actor):
             self._take_goal((x, y))
             return
         self.refused_goals += 1
-        _log.warning("%s: refused a goal on %s: %s", self.name, topics.GOAL, problem)
+        if self.refused_goals == 1:  # once: later ones are counted (refused_goals)
+            _log.warning("%s: refused a goal on %s: %s", self.name, topics.GOAL, problem)
 
     def _take_odometry(self) -> None:
         raise NotImplementedError
