@@ -393,7 +393,7 @@ class LiveView(Actor):
         """Count and log a refusal (on the loop's thread once it runs; any thread)."""
         loop = self._loop
         if loop is None:
-            self.refusals.refuse(source, text)  # nothing runs yet: no race, no /rosout
+            self.refusals.refuse(source, text, log=False)  # nothing runs yet: no /rosout
             return
         with contextlib.suppress(RuntimeError):  # the loop has closed: the run is over
             loop.call_soon_threadsafe(self.refusals.refuse, source, text)

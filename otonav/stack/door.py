@@ -65,10 +65,12 @@ class Refusals:
         """Messages refused in all."""
         return sum(self.by_source.values())
 
-    def refuse(self, source: str, text: str) -> None:
+    def refuse(self, source: str, text: str, *, log: bool = True) -> None:
         """Count a refusal from ``source`` (e.g. ``foxglove client 3``); ``text`` says what
-        and why, in one line."""
+        and why, in one line (``log=False``: counted only, e.g. before /rosout is up)."""
         seen = self.by_source[source] = self.by_source.get(source, 0) + 1
+        if not log:
+            return
         if seen <= LOGGED_PER_SOURCE:
             self._log(f"refused from {source}: {text}")
         if seen == LOGGED_PER_SOURCE:
