@@ -22,6 +22,7 @@ Called on the loop's thread only (the live view hands requests over from the ser
 from __future__ import annotations
 
 import dataclasses
+import functools
 from collections.abc import Iterable
 from typing import Annotated, Any
 
@@ -137,6 +138,7 @@ class ActorParameters:
         return old, new
 
 
+@functools.cache  # built once per key: a set runs on the stack's thread
 def _validator(key: str) -> TypeAdapter[Any]:
     """What validates config key ``key`` (``section.field``): its type and bounds, strict
     and finite, as the config's models validate it."""
