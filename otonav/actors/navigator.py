@@ -3,6 +3,7 @@ guard. /odom + /scan + /goal -> /cmd_vel (+ /nav/state)."""
 
 from __future__ import annotations
 
+import logging
 import math
 
 import numpy as np
@@ -21,8 +22,10 @@ from otonav.msgs import (
     Twist,
     Vector3,
 )
-from otonav.nav import GoToGoalParams, GuardParams, go_to_goal, guard_blocked
+from otonav.nav import GoToGoalParams, GuardParams, go_to_goal, goal_problem, guard_blocked
 from otonav.runtime import Actor, Input, Output
+
+_log = logging.getLogger(__name__)
 
 STOP = Twist.fast(
     linear=Vector3.fast(x=0.0, y=0.0, z=0.0), angular=Vector3.fast(x=0.0, y=0.0, z=0.0)
@@ -52,6 +55,9 @@ class GoalNavigator(Actor):
         self.rate_hz = rate_hz
         self.scan_timeout = scan_timeout
         self._hardware_fault = False
+        self.refused_goals = 0
+        """Goals on /goal it would not drive to (:func:`~otonav.nav.goal_problem`); the
+        door refuses them first (``otonav.stack.door``): this is defence in depth."""
 
     async def run(self) -> None:
         rate = self.clock.rate(self.rate_hz)
@@ -60,7 +66,7 @@ class GoalNavigator(Actor):
             self._take_odometry()
             goal_msg = self.goal_in.take_latest()
             if goal_msg is not None:
-                self._take_goal((goal_msg.pose.position.x, goal_msg.pose.position.y))
+                self._check_goal(goal_msg.pose.position.x, goal_msg.pose.position.y)
             status = self.hardware.take_latest()
             if status is not None:
                 self._hardware_fault = status.faulted
@@ -68,6 +74,16 @@ class GoalNavigator(Actor):
             if scan is not None:
                 self._take_scan(scan)
             await self._step()
+
+    def _check_goal(self, x: float, y: float) -> None:
+        """Take the goal at (x, y), or refuse it and keep the one it had."""
+        problem = goal_problem(x, y)
+        if problem is None:
+            self._take_goal((x, y))
+            return
+        self.refused_goals += 1
+        if self.refused_goals == 1:  # once: later ones are counted (refused_goals)
+            _log.warning("%s: refused a goal on %s: %s", self.name, topics.GOAL, problem)
 
     def _take_odometry(self) -> None:
         raise NotImplementedError

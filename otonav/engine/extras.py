@@ -17,9 +17,9 @@ from otonav.runtime import Actor, System
 from otonav.stack import StackConfig
 
 if TYPE_CHECKING:
-    from otonav.actors.live_parameters import ActorParameters
     from otonav.foxglove import FoxgloveServer, LiveView
     from otonav.ros2 import Ros2Bridge
+    from otonav.stack.live_parameters import ActorParameters
 
 __all__ = ("Extras", "ExtrasError", "open_extras")
 

@@ -23,11 +23,21 @@ runs an asyncio loop with one writer task per client that sends what is queued. 
 client that does not read stops its writer (the socket's buffer is full); its queue
 then keeps the newest ``backlog`` data frames, dropping (and counting) the oldest.
 Control messages (serverInfo, advertisements, status) are never dropped.
+
+Bounded per client (issue 41, docs/adr/0074): at most :data:`CONTROL_BACKLOG` unread
+control messages, then the client is disconnected (close code 1008, with the reason);
+one subscription per channel (a second id for it is refused, as foxglove-sdk's servers
+do), so each message is one frame per client whatever a client asks, and one status
+answers a whole subscribe request; at most :data:`MAX_ADVERTISED` client channels and
+:data:`MAX_CHANGES` parameters per ``setParameters``. A malformed frame (ids that are not
+uint32, a non-object, deep JSON, a binary frame under 5 bytes) is answered by a status and
+reported to ``on_refused``; none ends the connection.
 """
 
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import json
 import struct
 import threading
@@ -46,6 +56,21 @@ SUBPROTOCOLS = (Subprotocol("foxglove.sdk.v1"), Subprotocol("foxglove.websocket.
 _MESSAGE_DATA = struct.Struct("<BIQ")  # opcode 0x01, subscription id, log time ns
 _TIME = struct.Struct("<BQ")  # opcode 0x02, time ns
 _CLIENT_DATA = struct.Struct("<BI")  # opcode 0x01, client channel id; then the payload
+
+CONTROL_BACKLOG = 1024
+"""Replies (status, parameter values, advertisements) queued for a client that does not
+read them before it is disconnected: a client sending bad requests and never reading
+the answers grew the queue without bound (issue 41: 146 -> 425 MB and rising)."""
+MAX_ADVERTISED = 64
+"""Channels one client may advertise (clientPublish): a few topics are ever taken."""
+MAX_CHANGES = 64
+"""Parameters one ``setParameters`` may change: each is validated and applied on the
+stack's thread, which must not do work that grows with what a client asks."""
+MAX_STATUS_CHARS = 500
+"""A status message quotes at most this much of what the client sent."""
+_UINT32 = 1 << 32
+_CLOSE_TIMEOUT = 2.0
+"""Wall seconds a disconnected client has to answer the close before its socket is cut."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -87,10 +112,12 @@ class _Client:
     """subscription id -> channel id."""
     advertised: dict[int, ClientChannel] = field(default_factory=dict)
     """client channel id -> what the client said it publishes there."""
-    by_channel: dict[int, list[int]] = field(default_factory=dict)
-    """channel id -> subscription ids."""
+    by_channel: dict[int, int] = field(default_factory=dict)
+    """channel id -> its subscription id (one per channel: a second is refused)."""
     dropped: int = 0
     waking: bool = False
+    closing: str | None = None
+    """Why the server is disconnecting this client (it went over a bound)."""
 
 
 class Channel:
@@ -144,8 +171,11 @@ class ProtocolServer:
         on_unsubscribe: Callable[[int, int], None] = lambda client, channel: None,
         on_client_message: Callable[[ClientChannel, bytes], str | None] | None = None,
         parameters: Parameters | None = None,
+        on_refused: Callable[[int, str], None] = lambda client, text: None,
     ) -> None:
         self.name = name
+        self._on_refused = on_refused
+        """``(client, text)``: a frame refused as malformed, or a client disconnected."""
         self._on_client_message = on_client_message
         """``(channel, payload) -> None`` taken, or one line why not (sent as a status)."""
         self._parameters = parameters
@@ -166,6 +196,8 @@ class ProtocolServer:
         self._next_channel = 1
         self.dropped = 0
         """Data frames dropped for clients that did not keep up (all clients so far)."""
+        self.disconnected = 0
+        """Clients the server disconnected for going over a bound (all so far)."""
         self._loop = asyncio.new_event_loop()
         self._server: Server | None = None
         self._ready = threading.Event()
@@ -205,7 +237,8 @@ class ProtocolServer:
             if channel_id not in self._subscribed_channels:
                 return
             for client in self._clients.values():
-                for subscription in client.by_channel.get(channel_id, ()):
+                subscription = client.by_channel.get(channel_id)
+                if subscription is not None:
                     self._queue_data(
                         client, _MESSAGE_DATA.pack(0x01, subscription, log_time) + data
                     )
@@ -214,12 +247,13 @@ class ProtocolServer:
         """Queue one message for one client only (a latched topic's last message)."""
         with self._lock:
             client = self._clients.get(client_id)
-            if client is None:
-                return
-            for subscription in client.by_channel.get(channel_id, ()):
+            subscription = None if client is None else client.by_channel.get(channel_id)
+            if client is not None and subscription is not None:
                 self._queue_data(client, _MESSAGE_DATA.pack(0x01, subscription, log_time) + data)
 
     def _queue_data(self, client: _Client, frame: bytes) -> None:  # under the lock
+        if client.closing is not None:
+            return
         if len(client.data) >= self.backlog:
             client.data.popleft()
             client.dropped += 1
@@ -228,8 +262,38 @@ class ProtocolServer:
         self._wake(client)
 
     def _queue_control(self, client: _Client, message: str) -> None:  # under the lock
+        if client.closing is not None:
+            return
+        if len(client.control) >= CONTROL_BACKLOG:
+            self._disconnect(
+                client,
+                f"{CONTROL_BACKLOG} replies unread (status, parameter values): read them",
+            )
+            return
         client.control.append(message)
         self._wake(client)
+
+    def _disconnect(self, client: _Client, reason: str) -> None:  # under the lock
+        """Close ``client``'s connection with ``reason`` (code 1008, policy violation);
+        it gets nothing more queued."""
+        client.closing = reason
+        client.control.clear()
+        client.data.clear()
+        self.disconnected += 1
+
+        with contextlib.suppress(RuntimeError):  # the server has stopped: it is gone
+            self._loop.call_soon_threadsafe(self._close_client, client, reason)
+
+    def _close_client(self, client: _Client, reason: str) -> None:  # the server's thread
+        self._on_refused(client.id, f"disconnected: {reason}")
+
+        async def close() -> None:
+            try:  # a client that does not read may never answer the close: abort it then
+                await asyncio.wait_for(client.connection.close(1008, reason), _CLOSE_TIMEOUT)
+            except (TimeoutError, ConnectionClosed):
+                client.connection.transport.abort()
+
+        self._loop.create_task(close())
 
     def _wake(self, client: _Client) -> None:  # under the lock
         if not client.waking:
@@ -338,44 +402,57 @@ class ProtocolServer:
             pass
 
     def _handle(self, client: _Client, raw: str | bytes) -> None:
+        """One frame from a client; anything malformed is answered by a status (an
+        error escaping here would end the client's connection with a traceback)."""
         try:
             if isinstance(raw, bytes):
                 self._client_data(client, raw)
                 return
             message = json.loads(raw)
+            if not isinstance(message, dict):
+                raise TypeError(f"expected a JSON object, not {type(message).__name__}")
             op = message["op"]
             if op in ("advertise", "unadvertise") and self._on_client_message is not None:
                 self._client_advertise(client, op, message)
             elif op in ("getParameters", "setParameters") and self._parameters is not None:
                 self._parameter_op(client, op, message)
             elif op == "subscribe":
-                for sub in message["subscriptions"]:
-                    self._subscribe(client, int(sub["id"]), int(sub["channelId"]))
+                self._subscribe_all(client, _list(message, "subscriptions"))
             elif op == "unsubscribe":
-                for sub_id in message["subscriptionIds"]:
-                    self._unsubscribe(client, int(sub_id))
+                for sub_id in _list(message, "subscriptionIds"):
+                    self._unsubscribe(client, _uint32(sub_id, "subscription id"))
             else:
                 self._status(client, 1, f"unsupported operation {op!r}: this server only serves")
-        except (ValueError, KeyError, TypeError) as exc:
-            self._status(client, 2, f"bad message ({exc!r})")
+        except (ValueError, KeyError, TypeError, AttributeError, RecursionError) as exc:
+            text = f"bad message ({type(exc).__name__}: {exc})"
+            self._status(client, 2, text)
+            self._on_refused(client.id, text[:MAX_STATUS_CHARS])
 
     def _client_advertise(self, client: _Client, op: str, message: dict[str, Any]) -> None:
         if op == "unadvertise":
-            for channel_id in message["channelIds"]:
-                client.advertised.pop(int(channel_id), None)
+            for channel_id in _list(message, "channelIds"):
+                client.advertised.pop(_uint32(channel_id, "channel id"), None)
             return
-        for c in message["channels"]:
-            encoding = str(c["encoding"])
+        for c in _list(message, "channels"):
+            channel_id, topic = _uint32(c["id"], "channel id"), _text(c["topic"], "topic")
+            encoding = _text(c["encoding"], "encoding")
             if encoding not in ("cdr", "json"):
-                self._status(
-                    client, 2, f"channel {c['topic']}: encoding {encoding!r}: use cdr or json"
-                )
+                self._status(client, 2, f"channel {topic}: encoding {encoding!r}: use cdr or json")
                 continue
-            client.advertised[int(c["id"])] = ClientChannel(
-                client.id, int(c["id"]), str(c["topic"]), encoding, str(c.get("schemaName", ""))
+            if channel_id not in client.advertised and len(client.advertised) >= MAX_ADVERTISED:
+                self._status(client, 2, f"channel {topic}: at most {MAX_ADVERTISED} advertised")
+                continue
+            schema = _text(c.get("schemaName", ""), "schemaName")
+            client.advertised[channel_id] = ClientChannel(
+                client.id, channel_id, topic, encoding, schema
             )
 
     def _client_data(self, client: _Client, raw: bytes) -> None:
+        if len(raw) < _CLIENT_DATA.size:
+            raise ValueError(
+                f"a binary message of {len(raw)} bytes: expected opcode 0x01, a channel id "
+                "(uint32) and the payload"
+            )
         opcode, channel_id = _CLIENT_DATA.unpack_from(raw)
         channel = client.advertised.get(channel_id)
         if opcode != 0x01 or channel is None or self._on_client_message is None:
@@ -400,31 +477,58 @@ class ProtocolServer:
                     self._queue_control(client, json.dumps(answer))
 
         if op == "getParameters":
-            reply(self._parameters.get([str(n) for n in message["parameterNames"]]), None)
+            names = [_text(n, "parameter name") for n in _list(message, "parameterNames")]
+            reply(self._parameters.get(names), None)
         else:
-            changes = [(str(p["name"]), p.get("value")) for p in message["parameters"]]
+            asked = _list(message, "parameters")
+            if len(asked) > MAX_CHANGES:  # each is applied on the stack's thread
+                raise ValueError(f"{len(asked)} parameters in one request: at most {MAX_CHANGES}")
+            changes = [(_text(p["name"], "parameter name"), p.get("value")) for p in asked]
             self._parameters.set(changes, reply)
 
-    def _subscribe(self, client: _Client, sub_id: int, channel_id: int) -> None:
+    def _subscribe_all(self, client: _Client, subscriptions: list[Any]) -> None:
+        """Subscribe to each ``{"id", "channelId"}``: one subscription per channel (as
+        foxglove-sdk's servers do), so a message is one frame per client whatever a
+        client asks; what is refused is answered by one status for the whole request."""
+        asked = [
+            (_uint32(sub["id"], "subscription id"), _uint32(sub["channelId"], "channel id"))
+            for sub in subscriptions
+        ]  # all checked before any is taken
+        problems: list[str] = []
+        taken: list[int] = []
         with self._lock:
-            if sub_id in client.subscriptions or channel_id not in self._channels:
-                problem = "already used" if sub_id in client.subscriptions else "unknown channel"
-                self._queue_control(client, _status(2, f"subscription {sub_id}: {problem}"))
-                return
-            client.subscriptions[sub_id] = channel_id
-            client.by_channel.setdefault(channel_id, []).append(sub_id)
-            self._subscribed_channels[channel_id] = self._subscribed_channels.get(channel_id, 0) + 1
-        self._on_subscribe(client.id, channel_id)
+            for sub_id, channel_id in asked:
+                problem = (
+                    "the id is in use"
+                    if sub_id in client.subscriptions
+                    else "no such channel"
+                    if channel_id not in self._channels
+                    else f"already subscribed as {client.by_channel[channel_id]}"
+                    if channel_id in client.by_channel
+                    else None
+                )
+                if problem is not None:
+                    problems.append(f"{sub_id} (channel {channel_id}): {problem}")
+                    continue
+                client.subscriptions[sub_id] = channel_id
+                client.by_channel[channel_id] = sub_id
+                self._subscribed_channels[channel_id] = (
+                    self._subscribed_channels.get(channel_id, 0) + 1
+                )
+                taken.append(channel_id)
+            if problems:
+                more = f" and {len(problems) - 3} more" if len(problems) > 3 else ""
+                text = f"subscriptions refused: {'; '.join(problems[:3])}{more}"
+                self._queue_control(client, _status(2, text))
+        for channel_id in taken:
+            self._on_subscribe(client.id, channel_id)
 
     def _unsubscribe(self, client: _Client, sub_id: int) -> None:
         with self._lock:
             channel_id = client.subscriptions.pop(sub_id, None)
             if channel_id is None:
                 return
-            subs = client.by_channel[channel_id]
-            subs.remove(sub_id)
-            if not subs:
-                del client.by_channel[channel_id]
+            del client.by_channel[channel_id]
             self._unsubscribed(channel_id)
         self._on_unsubscribe(client.id, channel_id)
 
@@ -441,4 +545,26 @@ class ProtocolServer:
 
 
 def _status(level: int, text: str) -> str:
+    if len(text) > MAX_STATUS_CHARS:
+        text = text[: MAX_STATUS_CHARS - 1] + "…"
     return json.dumps({"op": "status", "level": level, "message": text})
+
+
+def _list(message: dict[str, Any], key: str) -> list[Any]:
+    value = message[key]
+    if not isinstance(value, list):
+        raise TypeError(f"{key}: expected a list, not {type(value).__name__}")
+    return value
+
+
+def _uint32(value: Any, what: str) -> int:
+    """``value`` as the protocol's ids are: an integer in [0, 2**32)."""
+    if isinstance(value, bool) or not isinstance(value, int) or not 0 <= value < _UINT32:
+        raise ValueError(f"{what} {str(value)[:40]}: expected an integer in [0, 2**32)")
+    return value
+
+
+def _text(value: Any, what: str) -> str:
+    if not isinstance(value, str):
+        raise TypeError(f"{what}: expected a string, not {type(value).__name__}")
+    return value

@@ -22,7 +22,7 @@ It also acts (docs/adr/0044): clients may publish (``clientPublish``) on the top
 3D panel sends a goal), in CDR or JSON, each message decoded and checked against the
 topic's type on the server's thread and published from the loop's; and, once
 :meth:`LiveView.serve_parameters` is given the system's actors, read and set
-parameters (``parameters``, :mod:`otonav.actors.live_parameters`). Every change, and
+parameters (``parameters``, :mod:`otonav.stack.live_parameters`). Every change, and
 every refusal, is logged on /rosout, so the recording shows it.
 """
 
@@ -42,12 +42,13 @@ import anyio
 from pydantic import ValidationError
 
 from otonav.actors import topics
-from otonav.actors.live_parameters import ActorParameters, ParameterError
 from otonav.msgs import Log, Message, Time
 from otonav.record.cdr import decode, encode
 from otonav.record.schemas import schema_for
 from otonav.runtime import Actor, Bus, Durability, Output, QoS, Reliability, run_blocking
 from otonav.runtime.mailbox import Endpoint, Publisher, Subscription, Topic
+from otonav.stack.door import Refusals, refusal
+from otonav.stack.live_parameters import ActorParameters, ParameterError
 
 DEFAULT_HOST = "127.0.0.1"
 DEFAULT_PORT = 8765
@@ -116,6 +117,8 @@ class FoxgloveServer:
         """Where client messages go (the live view sets it once wired)."""
         self.parameter_sink: Any = None
         """Who answers parameter requests (the live view, once given the actors)."""
+        self.refusal_sink: Callable[[str, str], None] = lambda source, text: None
+        """Told of malformed frames and disconnected clients (the live view counts them)."""
         outer = self
 
         class _Parameters(Parameters):
@@ -140,6 +143,9 @@ class FoxgloveServer:
                 on_unsubscribe=self._unsubscribed,
                 on_client_message=self._client_message if options.client_publish else None,
                 parameters=_Parameters(),
+                on_refused=lambda client, text: self.refusal_sink(
+                    f"foxglove client {client}", text
+                ),
             )
         except OSError as exc:
             raise LiveViewError(
@@ -162,6 +168,11 @@ class FoxgloveServer:
     def dropped(self) -> int:
         """Messages dropped for clients that did not keep up (their backlog was full)."""
         return self._server.dropped
+
+    @property
+    def disconnected(self) -> int:
+        """Clients disconnected for going over a bound (unread replies)."""
+        return self._server.disconnected
 
     def channel(self, topic: str, msg_type: type[Message]) -> Any:
         """The channel of ``topic`` (advertised to clients when first made)."""
@@ -216,6 +227,9 @@ class FoxgloveServer:
         self.closed = True
         self._server.close()
 
+
+_EARLY_CHANGES = 64
+"""``setParameters`` requests kept while the stack starts (applied as it does)."""
 
 # Matches every publisher (ROS 2 rules): tapping a topic never makes wiring fail.
 _TAP_QOS = QoS(Reliability.BEST_EFFORT, depth=1)
@@ -306,6 +320,10 @@ class LiveView(Actor):
         self._early_lock = threading.Lock()
         self.client_messages = 0
         """Messages clients published that were taken."""
+        self.refusals = Refusals(lambda text: self._log(Log.WARN, text))
+        """What clients sent that the door refused (``otonav.stack.door``), malformed
+        frames, and clients disconnected for going over a bound, by client."""
+        server.refusal_sink = self._refuse
 
     def on_wired(self, bus: Bus) -> None:
         for topic in list(bus.topics.values()):
@@ -335,6 +353,13 @@ class LiveView(Actor):
     # -- acting: client messages and parameters (called on the server's thread) ---------
 
     def _take_client_message(self, channel: Any, payload: bytes) -> str | None:
+        """Publish a client's message once it passed the door; else why not (a status)."""
+        problem = self._client_message_problem(channel, payload)
+        if problem is not None:
+            self._refuse(f"foxglove client {channel.client}", problem)
+        return problem
+
+    def _client_message_problem(self, channel: Any, payload: bytes) -> str | None:
         publisher = self._client_publishers.get(channel.topic)
         loop = self._loop
         if publisher is None:
@@ -352,20 +377,32 @@ class LiveView(Actor):
                 if channel.encoding == "json"
                 else decode(kind, payload)
             )
-        except (ValidationError, ValueError, IndexError) as exc:
-            first = str(exc).splitlines()[0]
+        except (ValidationError, ValueError, IndexError, OverflowError, RecursionError) as exc:
+            first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             return f"{channel.topic}: not a {kind.ros_type} in {channel.encoding} ({first})"
+        problem = refusal(message)
+        if problem is not None:
+            return f"{channel.topic}: {problem}"
         if loop is None or loop.is_closed():
             return f"{channel.topic}: not taken (the stack is not running)"
-        loop.call_soon_threadsafe(self._publish_client, publisher, message)
+        loop.call_soon_threadsafe(self._publish_client, publisher, message, channel.client)
         return None
 
-    def _publish_client(self, publisher: Publisher[Any], message: Message) -> None:
+    def _refuse(self, source: str, text: str) -> None:
+        """Count and log a refusal (on the loop's thread once it runs; any thread)."""
+        loop = self._loop
+        if loop is None:
+            self.refusals.refuse(source, text, log=False)  # nothing runs yet: no /rosout
+            return
+        with contextlib.suppress(RuntimeError):  # the loop has closed: the run is over
+            loop.call_soon_threadsafe(self.refusals.refuse, source, text)
+
+    def _publish_client(self, publisher: Publisher[Any], message: Message, client: int) -> None:
         try:
             publisher.publish_nowait(message)
             self.client_messages += 1
-        except anyio.WouldBlock:
-            self._log(Log.WARN, f"{publisher.topic}: a client's message dropped (full)")
+        except anyio.WouldBlock:  # counted and logged as refusals are: a flood stays bounded
+            self.refusals.refuse(f"foxglove client {client}", f"{publisher.topic}: full, dropped")
 
     def serve_parameters(self, actors: Iterable[Actor]) -> ActorParameters:
         """Serve the parameters of ``actors`` (the system's) to clients; the table served.
@@ -385,6 +422,9 @@ class LiveView(Actor):
         with self._early_lock:
             loop = self._loop
             if loop is None:  # the stack is starting: applied by on_start
+                if len(self._early_changes) >= _EARLY_CHANGES:
+                    reply([], "parameters: too many changes while the stack starts")
+                    return
                 self._early_changes.append((changes, reply))
                 return
         if loop.is_closed():
@@ -401,7 +441,7 @@ class LiveView(Actor):
                 old, new = table.set(name, value)
             except ParameterError as exc:
                 errors.append(str(exc))
-                self._log(Log.WARN, f"refused a client's change: {exc}")
+                self.refusals.refuse("a foxglove client's parameters", str(exc))
                 continue
             self._log(Log.INFO, f"parameter {name}: {old!r} -> {new!r} (set by a client)")
         reply(self.get_parameters([name for name, _ in changes]), "; ".join(errors) or None)

@@ -4,7 +4,7 @@ with a costmap, a global path and recovery (:class:`Navigation`)."""
 
 from otonav.nav.dwa import DwaParams, DwaResult, dwa_step
 from otonav.nav.footprint import centre_clearance
-from otonav.nav.geometry import wrap_angle
+from otonav.nav.geometry import goal_problem, wrap_angle
 from otonav.nav.go_to_goal import GoalCommand, GoToGoalParams, go_to_goal
 from otonav.nav.guard import GuardParams, guard_blocked
 from otonav.nav.navigation import Navigation, NavigationParams, NavOutput
@@ -24,6 +24,7 @@ __all__ = (
     "centre_clearance",
     "dwa_step",
     "go_to_goal",
+    "goal_problem",
     "guard_blocked",
     "safe_command",
     "wrap_angle",

@@ -66,6 +66,7 @@ from otonav.ros2.naming import (
 from otonav.ros2.parameters import rclpy_available
 from otonav.runtime import Actor, Bus, Durability, Output, QoS, Reliability, run_blocking
 from otonav.runtime.mailbox import Endpoint, Publisher, Subscription, Topic
+from otonav.stack.door import Refusals, refusal
 
 if TYPE_CHECKING:
     from otonav.ros2.dds import GraphWriter, Participant, RawReader, RawWriter
@@ -143,7 +144,8 @@ class Ros2Statistics(NamedTuple):
     received: int
     """Messages taken from DDS and published on the bus."""
     rejected: int
-    """Messages from DDS that did not decode as the topic's type, or found it full."""
+    """Messages from DDS refused at the door (not the topic's type, a NaN, a goal beyond
+    the world: ``otonav.stack.door``) or dropped because the topic was full."""
 
 
 _DISCOVERY_QUIET = 0.5
@@ -256,7 +258,10 @@ class Ros2Bridge(Actor):
         self._bus: Bus | None = None
         self._started = False
         self.received = 0
-        self.rejected = 0
+        self.refusals = Refusals(lambda text: self._log(Log.WARN, text))
+        """Messages from DDS the door refused (not the topic's type, a NaN, a goal
+        beyond the world: ``otonav.stack.door``) or dropped (the topic was full), by
+        source."""
         self._clock_mirror: _Mirror | None = None
         self._armed: asyncio.Event | None = None
         """Set by the idle watcher once a lockstep instant settled and /clock was written."""
@@ -461,6 +466,7 @@ class Ros2Bridge(Actor):
                 loop=asyncio.get_running_loop(),
                 node_name=_node_name,
                 on_change=self._parameter_changed,
+                on_refused=lambda text: self.refusals.refuse("ROS 2 parameters", text),
             )
             # rclpy's nodes put their own events on DDS: otonav's go to the recording only.
             events = self._mirrors.get(topics.PARAMETER_EVENTS)
@@ -597,27 +603,25 @@ class Ros2Bridge(Actor):
             reader = entry.reader
             if reader is None:
                 continue
+            source = f"ROS 2 ({dds_topic(entry.name)})"
             for data in reader.take():
                 try:
                     message = decode(entry.wire_type, data)
-                except (ValueError, IndexError, TypeError) as exc:
-                    self.rejected += 1
+                except (ValueError, IndexError, TypeError, OverflowError) as exc:
                     first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-                    self._log(Log.WARN, f"{entry.name}: not a {entry.wire_type.ros_type} ({first})")
+                    self.refusals.refuse(source, f"not a {entry.wire_type.ros_type} ({first})")
                     continue
                 if isinstance(message, TwistStamped):
                     message = message.twist
-                problem = _not_finite(message)
+                problem = refusal(message)
                 if problem is not None:  # outside data, checked at the door (issue 41)
-                    self.rejected += 1
-                    self._log(Log.WARN, f"{entry.name}: refused from ROS 2: {problem}")
+                    self.refusals.refuse(source, f"{entry.name}: {problem}")
                     continue
                 try:
                     entry.publisher.publish_nowait(message)
                     self.received += 1
-                except anyio.WouldBlock:
-                    self.rejected += 1
-                    self._log(Log.WARN, f"{entry.name}: a ROS 2 message dropped (full)")
+                except anyio.WouldBlock:  # counted as refusals are: a flood stays bounded
+                    self.refusals.refuse(source, f"{entry.name}: full, dropped")
 
     async def on_stop(self) -> None:
         if self._remove_watcher is not None:
@@ -648,27 +652,8 @@ class Ros2Bridge(Actor):
             unread=sum(m.unread for m in mirrors),
             refused=sum(m.refused for m in mirrors),
             received=self.received,
-            rejected=self.rejected,
+            rejected=self.refusals.count,
         )
-
-
-def _not_finite(message: Any, path: str = "") -> str | None:
-    """The first field of ``message`` that is a NaN or an infinity (a goal at x = NaN
-    crashed the navigator), or None."""
-    if isinstance(message, float):
-        return None if math.isfinite(message) else f"{path or 'value'} is {message}"
-    if isinstance(message, tuple | list):
-        for i, item in enumerate(message):
-            problem = _not_finite(item, f"{path}[{i}]")
-            if problem is not None:
-                return problem
-        return None
-    if isinstance(message, Message):
-        for name in type(message).model_fields:
-            problem = _not_finite(getattr(message, name), f"{path}.{name}" if path else name)
-            if problem is not None:
-                return problem
-    return None
 
 
 def _node_name(actor: str) -> str:

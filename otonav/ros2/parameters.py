@@ -6,7 +6,7 @@ client (ROS 2's default rmw) matches a reply to its request by an identity that 
 in the RTPS inline QoS, which a plain Cyclone participant can neither read nor write. So
 the services are served by rclpy itself, in this process, when it is importable (a
 sourced ROS 2, or its wheels from PyPI): one rclpy node per actor, named as the actor,
-with the actor's parameters declared as :class:`~otonav.actors.live_parameters.
+with the actor's parameters declared as :class:`~otonav.stack.live_parameters.
 ActorParameters` lists them (``params.dwa.max_v`` on ``/nav``). The runtime-safe ones are
 settable; the others are declared read-only. A set is validated and applied on the run's
 loop (as the Foxglove panel's are): a refused value is an unsuccessful
@@ -24,8 +24,8 @@ import threading
 from collections.abc import Callable, Iterable
 from typing import Any
 
-from otonav.actors.live_parameters import ActorParameters, ParameterError
 from otonav.runtime import Actor
+from otonav.stack.live_parameters import ActorParameters, ParameterError
 
 __all__ = ("ParameterNodes", "rclpy_available")
 
@@ -50,6 +50,7 @@ class ParameterNodes:
         loop: asyncio.AbstractEventLoop,
         node_name: Any,
         on_change: Callable[[str, str, Any], None] | None = None,
+        on_refused: Callable[[str], None] | None = None,
     ) -> None:
         import rclpy
         from rcl_interfaces.msg import ParameterDescriptor
@@ -60,6 +61,8 @@ class ParameterNodes:
         self._loop = loop
         self._on_change = on_change
         """Called on the loop with (actor, key, new value) after each set it took."""
+        self._on_refused = on_refused
+        """Called on the loop with why, after each set it refused."""
         self._table = ActorParameters(actors)
         self._context = Context()
         rclpy.init(context=self._context, domain_id=domain_id)
@@ -115,6 +118,8 @@ class ParameterNodes:
             try:
                 _old, new = self._table.set(name, value)
             except ParameterError as exc:
+                if self._on_refused is not None:
+                    self._on_refused(str(exc))
                 return str(exc)
             if self._on_change is not None:
                 actor, _, key = name.partition(".")

@@ -154,7 +154,7 @@ async def test_otonav_run_foxglove_serves_and_sets_the_actors_parameters(
     recording = out / "recording.mcap"
     lines = [(t, m.msg) for _tp, t, m in read_messages(recording, [topics.ROSOUT])]
     assert [t for t, text in lines if CHANGED in text] == [0.0]
-    assert any("refused a client's change" in text for _t, text in lines)
+    assert any("refused from a foxglove client's parameters" in text for _t, text in lines)
     speeds = [m.twist.twist.linear.x for _tp, _t, m in read_messages(recording, [topics.ODOM])]
     assert max(speeds) > 0.1  # it drove
     assert max(speeds) <= SLOW * 1.05  # never faster than the client's limit

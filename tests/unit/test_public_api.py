@@ -166,6 +166,7 @@ PINNED: dict[str, tuple[str, ...]] = {
         "centre_clearance",
         "dwa_step",
         "go_to_goal",
+        "goal_problem",
         "guard_blocked",
         "safe_command",
         "wrap_angle",

@@ -12,11 +12,11 @@ from typing import Any
 import anyio
 import pytest
 
-from otonav.actors import BaseController, Bridge, Navigator, topics
+from otonav.actors import AvoidingNavigator, BaseController, Bridge, Navigator, topics
 from otonav.control import DiffDriveGeometry
 from otonav.hal import BoxObstacle, FakeHardware
 from otonav.msgs import NavState, Point, Pose, PoseStamped, Twist
-from otonav.nav import GuardParams
+from otonav.nav import GuardParams, NavigationParams, goal_problem
 from otonav.runtime import (
     Actor,
     Bus,
@@ -59,7 +59,7 @@ def _goal(x: float, y: float) -> PoseStamped:
     return PoseStamped(pose=Pose(position=Point(x=x, y=y)))
 
 
-def _stack(hal: FakeHardware, nav: Navigator, *, base: bool = True) -> list[Actor]:
+def _stack(hal: FakeHardware, nav: Actor, *, base: bool = True) -> list[Actor]:
     geometry = DiffDriveGeometry(hal.geometry.wheel_radius, hal.geometry.wheel_separation)
     return [Bridge(hal), *([BaseController(geometry)] if base else []), nav]
 
@@ -277,3 +277,42 @@ def test_a_scan_that_stops_arriving_makes_it_wait_after_scan_timeout() -> None:
     assert waiting_after
     assert min(waiting_after) > 0.9 + 0.5 - 1e-9
     assert all(s == "waiting" for t, s in states if t > 0.9 + 0.5 + NAV_PERIOD)
+
+
+# -- goals it refuses (defence in depth behind the door, issue 41) ---------------------
+
+
+@pytest.mark.parametrize("kind", ["stop", "dwa"])
+def test_a_goal_off_the_world_on_goal_is_refused_and_the_old_goal_kept(kind: str) -> None:
+    # Published on the bus directly (no door in front): NaN, inf and 1e308 crashed the
+    # avoiding navigator's map lookup (_coarse_cell), 1e308 the go-to-goal's arithmetic.
+    bad = (math.nan, math.inf, -math.inf, 1e308, 1000.5)
+    hal = FakeHardware()
+    nav: Navigator | AvoidingNavigator = (
+        Navigator() if kind == "stop" else AvoidingNavigator(NavigationParams(), laser_offset_x=0.0)
+    )
+
+    async def publish_goals(system: System) -> None:
+        goal = system.publisher(topics.GOAL, PoseStamped, topics.LATCHED, name="ui")
+        await goal.publish(_goal(1.0, 0.0))
+        for x in bad:
+            await anyio.sleep(0.1)
+            await goal.publish(_goal(x, 0.0) if x != 1000.5 else _goal(0.0, -x))
+
+    trace = _fly(hal, _stack(hal, nav), duration=6.0, during=publish_goals)
+    assert nav.refused_goals == len(bad)
+    assert trace.collapsed()[-1] == "reached"
+    assert math.hypot(hal.ground_truth().x - 1.0, hal.ground_truth().y) < 0.15
+
+
+@pytest.mark.parametrize(
+    ("x", "y", "ok"),
+    [(0.0, 0.0, True), (-1000.0, 1000.0, True), (math.nan, 0.0, False), (0.0, math.inf, False),
+     (1e308, 0.0, False), (0.0, -1000.001, False)],
+)  # fmt: skip
+def test_goal_problem_bounds_a_goal_as_a_scenario_bounds_it(x: float, y: float, ok: bool) -> None:
+    problem = goal_problem(x, y)
+    assert (problem is None) is ok
+    if not ok:
+        assert problem is not None
+        assert "[-1000, 1000]" in problem
