@@ -64,7 +64,8 @@ def test_the_config_reference_lists_every_key_with_its_default() -> None:
     assert rows["hal.can.left.sign"].default == "`-1`"  # the section's default, not the class's
     assert rows["world.timestep"].bounds == "[0.0001, 0.01]"
     assert rows["hal.can.encoder_period"].bounds == "[0.001, 1]"  # an AfterValidator's range
-    assert rows["actors[].class"].default == "required"
+    assert rows["actors[].name"].default == "required"
+    assert rows["actors[].class"].default != "required"  # none: the built-in of that name
 
 
 def test_every_physical_quantity_in_the_config_has_a_unit() -> None:
