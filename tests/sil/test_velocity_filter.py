@@ -4,6 +4,7 @@ the filter takes a ROS 2 parameter file, and the acceptance scenario still passe
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import pytest
@@ -29,5 +30,5 @@ def test_a_velocity_filter_between_navigator_and_safety_passes_acceptance(
     assert len(nav) == len(raw)  # one filtered command per raw one
     assert max(v for _t, v in raw) > 0.35  # the navigator wanted more ...
     assert max(v for _t, v in nav) == pytest.approx(0.3)  # ... the inline max_v capped it
-    steps = [(b - a) / (tb - ta) for (ta, a), (tb, b) in zip(nav, nav[1:], strict=False) if tb > ta]
+    steps = [(b - a) / (tb - ta) for (ta, a), (tb, b) in itertools.pairwise(nav) if tb > ta]
     assert max(steps) <= 0.8 + 1e-9  # max_accel from the parameter file
