@@ -32,8 +32,8 @@ def box_outlines(boxes: tuple[BoxObstacle, ...]) -> NDArray[np.float64]:
 
 def _boxes_path(boxes: tuple[BoxObstacle, ...]) -> MplPath:
     """All boxes as one compound path: one artist to draw, and one vertex array for the
-    legend's "best" placement to test (a patch per box made it test each one: 3000
-    boxes drew in 1.7 s, issue 30). The outlines all turn the same way, so where boxes
+    renderer to draw (a patch per box made the legend's "best" placement test each one:
+    3000 boxes drew in 1.7 s, issue 30). The outlines all turn the same way, so where boxes
     overlap the non-zero fill rule fills them once."""
     from matplotlib.path import Path as MplPath
 
@@ -65,7 +65,8 @@ def draw_trajectory(
     from matplotlib.figure import Figure
     from matplotlib.patches import Circle, PathPatch
 
-    fig = Figure(figsize=(6.4, 4.8), dpi=100)
+    # Constrained layout: the title and the legend beside the map are never clipped.
+    fig = Figure(figsize=(8.0, 4.8), dpi=100, layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     unknown = []
@@ -108,7 +109,8 @@ def draw_trajectory(
             fontsize=8,
             color="#c0392b",
         )
-    ax.legend(loc="best", fontsize=8)
+    # Beside the map, not on it: "best" still hid the goal or the path (issue 39).
+    fig.legend(loc="outside right upper", fontsize=8)
     return fig
 
 
