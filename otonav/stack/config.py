@@ -558,7 +558,7 @@ class ActorConfig(_Section):
     """One node of the launch: a class (``package.module:Class`` on ``sys.path``, in the
     current directory or the config file's, or ``path/to/file.py:Class`` relative to the
     config file) with its parameters and topic remaps. An entry named like a built-in
-    actor (``nav``, ``safety``, ``base_controller``) replaces it, or with no ``class``
+    actor (``nav``, ``safety``, ``base``) replaces it, or with no ``class``
     only remaps its topics (ADR 0071)."""
 
     name: _Name

@@ -5,7 +5,7 @@ current directory or the config file's, or ``path/to/file.py:Class``; a relative
 is resolved against the config file when it is loaded), its parameters (inline, and a
 ROS 2 ``params_file``) and its remaps, as a ROS 2 launch file names a node's
 executable, ``parameters`` and ``remappings``. An entry whose name is a built-in actor's
-(``nav``, ``safety``, ``base_controller``, ``bridge``) replaces it in place, or, with no
+(``nav``, ``safety``, ``base``, ``bridge``) replaces it in place, or, with no
 ``class``, remaps the built-in's topics; any other is added (ADR 0071).
 
 A launchable actor declares its parameters as a pydantic model in a class attribute
