@@ -172,3 +172,21 @@ def test_every_included_file_is_exercised_by_a_test() -> None:
                 continue
             assert included.is_file(), f"{path.name} includes a missing file {included}"
             assert included.name in tests, f"no test names {included}"
+
+
+def test_the_docs_remap_examples_remap_and_say_what_is_live() -> None:
+    """Issue 39 item 8: concepts/launch.md's only remap example was a no-op
+    (``{/cmd_vel_nav: /cmd_vel_nav}``), and the tutorial mapped ``ros2 param set`` (live)
+    to ``--set`` (launch time)."""
+    remaps = []
+    for path, body in docs_hooks.code_blocks("yaml"):
+        included = docs_hooks.included_file(body)
+        data = yaml.safe_load(included.read_text() if included else body)
+        for entry in data.get("actors", []) if isinstance(data, dict) else []:
+            remaps += [(path.name, a, b) for a, b in entry.get("remap", {}).items()]
+    assert {name for name, _a, _b in remaps} >= {"launch.md", "own-node.md"}
+    assert [r for r in remaps if r[1] == r[2]] == []
+    tutorial = (ROOT / "docs" / "getting-started" / "tutorial.md").read_text()
+    (row,) = [ln for ln in tutorial.splitlines() if ln.startswith("|") and "ros2 param set" in ln]
+    assert "--set" not in row
+    assert "launch-time" in tutorial
