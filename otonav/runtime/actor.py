@@ -163,9 +163,9 @@ class Actor:
         params: Any = None,
     ) -> None:
         """``name`` (default: the class's, in snake_case), ``remap`` (topic renames, from
-        -> to) and ``params``: kept as ``self.params``; when not given, a class with a
-        ``Params`` model gets its defaults (``Params()``). A node with parameters needs
-        no ``__init__`` of its own unless it has state to set up (ADR 0070)."""
+        -> to) and ``params``, kept as ``self.params``; when none are given, a ``Params``
+        model whose fields all have defaults gives ``Params()``. A node with parameters
+        needs no ``__init__`` of its own unless it has state to set up (ADR 0071)."""
         self.name = name or _snake(type(self).__name__)
         self._otonav_remap: dict[str, str] = dict(remap or {})
         self._otonav_ports: dict[str, Any] = {}
@@ -173,7 +173,12 @@ class Actor:
         self._otonav_params: Mapping[str, Any] = {}
         self._otonav_log = NodeLogger(self)
         model = getattr(type(self), "Params", None)
-        if params is None and isinstance(model, type) and issubclass(model, BaseModel):
+        if (
+            params is None
+            and isinstance(model, type)
+            and issubclass(model, BaseModel)
+            and not any(field.is_required() for field in model.model_fields.values())
+        ):
             params = model()
         if params is not None:
             # Not declared on Actor: a subclass's own ``self.params: NavParams`` keeps

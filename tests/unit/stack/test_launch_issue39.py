@@ -138,3 +138,21 @@ def test_an_actor_spec_without_a_module_is_one_line() -> None:
 def _line_of(text: str) -> int:
     lines = PROBES.read_text().splitlines()
     return next(i for i, line in enumerate(lines, 1) if text in line)
+
+
+def test_a_node_whose_params_have_required_fields_keeps_its_own_init() -> None:
+    """Today's signature keeps working: ``super().__init__(name, remap=remap)`` before the
+    node sets ``self.params`` itself, with a model that has no defaults to make."""
+    from pydantic import BaseModel
+
+    from otonav.runtime import Actor
+
+    class Strict(Actor):
+        class Params(BaseModel):
+            speed: float
+
+        def __init__(self, params: Params, *, name: str | None = None) -> None:
+            super().__init__(name)
+            self.params = params
+
+    assert Strict(Strict.Params(speed=2.0)).params.speed == 2.0
