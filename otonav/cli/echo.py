@@ -68,6 +68,8 @@ def main(args: argparse.Namespace) -> int:
     from otonav.record.reader import read_messages, summarize
 
     topics = [t.topic for t in summarize(args.recording).topics]
+    if args.topic not in topics and f"/{args.topic}" in topics:  # ROS 2 resolves it so
+        args.topic = f"/{args.topic}"
     if args.topic not in topics:
         raise UsageError(
             f"{args.recording}: no topic {args.topic!r} (topics: {', '.join(sorted(topics))})"

@@ -152,7 +152,7 @@ def quick_spec(args: argparse.Namespace) -> SweepSpec:
     }
     return SweepSpec(
         name="quick",
-        config=str(Path(args.config).resolve()) if args.config else None,
+        config=str(Path(args.config).resolve()) if getattr(args, "config", None) else None,
         scenarios=tuple(scenarios),
         overrides=grid,
         seeds=SeedRange(count=args.seeds) if args.seeds else None,
