@@ -93,8 +93,16 @@ def draw_trajectory(
         ax.plot(*closest, "x", color="#c0392b", markersize=10, label="closest approach")
     span_x = [*xs, *(goal[:1] if goal else ())] or [0.0]
     span_y = [*ys, *(goal[1:] if goal else ())] or [0.0]
-    ax.set_xlim(min(span_x) - 1.0, max(span_x) + 1.0)
-    ax.set_ylim(min(span_y) - 1.0, max(span_y) + 1.0)
+    x0, x1, y0, y1 = min(span_x) - 1.0, max(span_x) + 1.0, min(span_y) - 1.0, max(span_y) + 1.0
+    if obstacles:  # a box the window cuts is drawn whole, up to 1 m more (walls stay cut)
+        corners = box_outlines(obstacles)
+        lo, hi = corners.min(axis=1), corners.max(axis=1)
+        cut = (lo[:, 0] < x1) & (hi[:, 0] > x0) & (lo[:, 1] < y1) & (hi[:, 1] > y0)
+        if cut.any():
+            x0, y0 = np.maximum(np.minimum((x0, y0), lo[cut].min(axis=0)), (x0 - 1.0, y0 - 1.0))
+            x1, y1 = np.minimum(np.maximum((x1, y1), hi[cut].max(axis=0)), (x1 + 1.0, y1 + 1.0))
+    ax.set_xlim(float(x0), float(x1))
+    ax.set_ylim(float(y0), float(y1))
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
