@@ -137,7 +137,10 @@ def module_spec(spec: str, folder: Path) -> str:
     top = where.partition(".")[0]
     if not sep or where.endswith(".py") or "/" in where or not top.isidentifier():
         return spec
-    if not ((folder / f"{top}.py").is_file() or (folder / top).is_dir()):
+    try:
+        if not ((folder / f"{top}.py").is_file() or (folder / top).is_dir()):
+            return spec
+    except OSError:  # a name no file system takes: not there
         return spec
     if importlib.util.find_spec(top) is not None:
         return spec
@@ -275,8 +278,10 @@ def add_actors(stack: StackConfig, specs: Sequence[str], *, source: str = "--act
             )
         if where.endswith(".py"):  # a file: found from any worker's directory
             spec = f"{Path(where).resolve()}:{attr}"
-        spec = module_spec(spec, Path.cwd())
-        entries.append(ActorConfig(name=name, class_=spec))
+        try:
+            entries.append(ActorConfig(name=name, class_=module_spec(spec, Path.cwd())))
+        except ValidationError as exc:  # a name or path too long, ...: one line
+            raise ConfigFileError(f"{source} {shown(spec)}: {exc.errors()[0]['msg']}") from None
     return stack.model_copy(update={"actors": tuple(entries)})
 
 

@@ -133,6 +133,8 @@ def test_a_constructor_that_raises_is_one_line_with_where(tmp_path: Path) -> Non
 def test_an_actor_spec_without_a_module_is_one_line() -> None:
     with pytest.raises(ConfigFileError, match=r"^--actor ':X': expected module:Class"):
         load_stack(None, [], [":X"])
+    with pytest.raises(ConfigFileError, match=r"^--actor 'aaaa.*characters\): String should"):
+        load_stack(None, [], ["a" * 5000 + ":Node"])
 
 
 def _line_of(text: str) -> int:
