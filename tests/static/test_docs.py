@@ -190,3 +190,26 @@ def test_the_docs_remap_examples_remap_and_say_what_is_live() -> None:
     (row,) = [ln for ln in tutorial.splitlines() if ln.startswith("|") and "ros2 param set" in ln]
     assert "--set" not in row
     assert "launch-time" in tutorial
+
+
+def test_the_api_reference_turns_sphinx_roles_into_links() -> None:
+    """Issue 39 item 7: 112 raw roles showed as text. The griffe extension the docs build
+    loads makes each an autorefs link, resolved in the docstring's scope, and a ``::``
+    marker a colon (``make test-docs`` then searches the built site for any left)."""
+    import griffe
+    import griffe_sphinx_roles
+
+    runtime = griffe.load("otonav.runtime", search_paths=[str(ROOT)])
+    clock = runtime["clock"]
+    text = (
+        "The :class:`~otonav.runtime.system.System` and :class:`Clock`; see :func:`now()`."
+        "\n\nLike this::\n\n    code\n"
+    )
+    converted = griffe_sphinx_roles.convert(text, clock)
+    assert ":class:" not in converted
+    assert ":func:" not in converted
+    link = '<autoref identifier="otonav.runtime.{}" optional><code>{}</code></autoref>'
+    assert link.format("system.System", "System") in converted
+    assert link.format("clock.Clock", "Clock") in converted
+    assert "Like this:\n" in converted
+    assert "::" not in converted
