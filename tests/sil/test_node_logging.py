@@ -83,3 +83,16 @@ def test_echo_refuses_an_unknown_topic_in_one_line(
     cli_fails(["echo", "/nope", str(tmp_path / "recording.mcap")], "no topic '/nope'", "/rosout")
     cli_fails(["echo", "/rosout", str(tmp_path / "recording.mcap"), "--field", "level.x"],
               "--field level.x: no field 'x'")  # fmt: skip
+
+
+@pytest.mark.timeout(300)
+def test_a_sweeps_workers_keep_node_lines_off_its_console(
+    capfd: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """In a worker process Python's last-resort handler printed each run's warnings bare
+    ("battery low: 12 %", no run, no node): they stay on /rosout of the kept runs."""
+    argv = ["sweep", "--scenario", "acceptance", "--workers", "1", "--out", str(tmp_path)]
+    assert main([*argv, "--actor", f"{NODES}:Talker", "--keep", "none"]) == 0
+    err = capfd.readouterr().err
+    assert "battery low" not in err
+    assert "lost the drive" not in err
