@@ -422,7 +422,21 @@ def _sample_outputs() -> dict[str, str]:
                 )
             body = "\n".join(line.rstrip() for line in done.stdout.splitlines())
             outputs[name] = f"```text\n$ otonav {' '.join(args)}\n{mask(body)}\n```\n"
+        refresh_picture(Path(tmp) / "out" / "trajectory.png")
     return outputs
+
+
+PICTURE = DOCS / "images" / "trajectory.png"
+"""The README's and the front page's picture: the default run's plot, as it is drawn now."""
+
+
+def refresh_picture(drawn: Path) -> bool:
+    """Put the plot the build's own default run drew in place of :data:`PICTURE` when it
+    differs (the README showed an older drawing, issue 39); True if it changed."""
+    if PICTURE.exists() and PICTURE.read_bytes() == drawn.read_bytes():
+        return False
+    PICTURE.write_bytes(drawn.read_bytes())
+    return True
 
 
 def sample(name: str) -> str:

@@ -29,7 +29,16 @@ typed), :func:`build_parser` (the docs' CLI reference is generated from it), and
 loaders a host uses to take configs as ``otonav run`` does (imported on first use, like
 every command's dependencies)."""
 
-COMMANDS: tuple[str, ...] = ("run", "info", "inspect", "bench", "sweep", "replay", "play")
+COMMANDS: tuple[str, ...] = (
+    "run",
+    "info",
+    "echo",
+    "inspect",
+    "bench",
+    "sweep",
+    "replay",
+    "play",
+)
 """Modules under ``otonav.cli`` whose ``add_parser`` registers a command, in help order."""
 
 USAGE_ERROR = 2
@@ -102,7 +111,7 @@ def main(argv: Sequence[str] | None = None, *, owns_process: bool = False) -> in
     args.owns_process = owns_process
     from otonav.cli import logs
 
-    logs.install()
+    logs.install(verbose=getattr(args, "verbose", False))
     try:
         code: int = args.handler(args)
         return code

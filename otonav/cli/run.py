@@ -71,6 +71,13 @@ def add_parser(commands: Any) -> None:
     )
     p.add_argument("--no-record", action="store_true", help="do not write recording.mcap")
     p.add_argument(
+        "-v",
+        "--verbose",
+        action="store_true",
+        help="print every log line (nodes' info and debug, lifecycle events); by default "
+        "only warnings and errors",
+    )
+    p.add_argument(
         "--bag",
         action="store_true",
         help="also make OUT/bag a rosbag2 bag directory (metadata.yaml + the recording) "

@@ -31,6 +31,7 @@ QUICK_FLAGS = {
     "--seeds": "seeds",
     "--set": "overrides",
     "--keep": "keep",
+    "--config": "config",
 }
 """The quick form's flags (and their dests): with a sweep file they are refused, not
 ignored."""
@@ -71,6 +72,12 @@ def add_parser(commands: Any) -> None:
         "--scenario", action="append", default=[], help="built-in scenario or file (repeatable)"
     )
     quick.add_argument("--seeds", type=int, metavar="N", help="seeds 0..N-1 for every scenario")
+    quick.add_argument(
+        "--config",
+        metavar="STACK.yaml",
+        help="the stack config every run starts from (your robot, your nodes), as "
+        "otonav run --config; default: the built-in one",
+    )
     quick.add_argument(
         "--set",
         dest="overrides",
@@ -145,6 +152,7 @@ def quick_spec(args: argparse.Namespace) -> SweepSpec:
     }
     return SweepSpec(
         name="quick",
+        config=str(Path(args.config).resolve()) if getattr(args, "config", None) else None,
         scenarios=tuple(scenarios),
         overrides=grid,
         seeds=SeedRange(count=args.seeds) if args.seeds else None,
@@ -288,7 +296,7 @@ def _invocation(args: argparse.Namespace) -> dict[str, Any]:
     for flag, dest in _PLAN_FLAGS.items():
         key = "sweep" if flag == "sweep" else dest
         value = getattr(args, key)
-        if key == "sweep" and value is not None:
+        if key in ("sweep", "config") and value is not None:
             value = str(Path(value).resolve())
         stored[key] = value
     return stored

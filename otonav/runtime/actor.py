@@ -28,9 +28,12 @@ import re
 from collections.abc import Mapping
 from typing import Any, Final, Generic, TypeVar, overload
 
+from pydantic import BaseModel
+
 from otonav.runtime.clock import Clock
 from otonav.runtime.errors import ActorDefinitionError
 from otonav.runtime.mailbox import Bus, Publisher, Subscription
+from otonav.runtime.nodelog import NodeLogger
 from otonav.runtime.qos import DEFAULT_QOS, QoS
 
 M = TypeVar("M")
@@ -105,6 +108,7 @@ FRAMEWORK_ATTRIBUTES: Final[Mapping[str, str]] = {
     "ports": "the declared ports, read by the wiring",
     "topic_of": "a port's topic after remapping, read by the wiring",
     "parameters": "the parameters the actor was launched with",
+    "log": "the actor's logger (self.log.info(...), to /rosout and the console)",
 }
 
 
@@ -151,12 +155,35 @@ class Actor:
                     f"{', '.join(sorted(_HOOKS))})"
                 )
 
-    def __init__(self, name: str | None = None, *, remap: Mapping[str, str] | None = None) -> None:
+    def __init__(
+        self,
+        name: str | None = None,
+        *,
+        remap: Mapping[str, str] | None = None,
+        params: Any = None,
+    ) -> None:
+        """``name`` (default: the class's, in snake_case), ``remap`` (topic renames, from
+        -> to) and ``params``, kept as ``self.params``; when none are given, a ``Params``
+        model whose fields all have defaults gives ``Params()``. A node with parameters
+        needs no ``__init__`` of its own unless it has state to set up (ADR 0071)."""
         self.name = name or _snake(type(self).__name__)
         self._otonav_remap: dict[str, str] = dict(remap or {})
         self._otonav_ports: dict[str, Any] = {}
         self._otonav_clock: Clock | None = None
         self._otonav_params: Mapping[str, Any] = {}
+        self._otonav_log = NodeLogger(self)
+        model = getattr(type(self), "Params", None)
+        if (
+            params is None
+            and isinstance(model, type)
+            and issubclass(model, BaseModel)
+            and not any(field.is_required() for field in model.model_fields.values())
+        ):
+            params = model()
+        if params is not None:
+            # Not declared on Actor: a subclass's own ``self.params: NavParams`` keeps
+            # its type; a user's node annotates ``params: Params`` for mypy.
+            setattr(self, "params", params)  # noqa: B010
 
     @classmethod
     def ports(cls) -> list[_Port[Any]]:
@@ -177,6 +204,12 @@ class Actor:
     def topic_of(self, port: _Port[Any]) -> str:
         """The topic ``port`` is bound to for this instance (after remapping)."""
         return self._otonav_remap.get(port.topic, port.topic)
+
+    @property
+    def log(self) -> NodeLogger:
+        """The actor's logger, as rclpy's ``get_logger()``: ``self.log.info("...")``
+        publishes ``/rosout`` in sim time and reaches the console (ADR 0070)."""
+        return self._otonav_log
 
     @property
     def clock(self) -> Clock:

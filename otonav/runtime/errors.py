@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
-from otonav.errors import OtonavError
+from otonav.errors import OtonavError, UsageError
 
 
 class OtonavRuntimeError(OtonavError):
     """Base class of every error the runtime raises on purpose."""
 
 
-class WiringError(OtonavRuntimeError):
-    """Ports, topics or QoS that cannot be connected; raised at wiring time, never later."""
+class WiringError(OtonavRuntimeError, UsageError):
+    """Ports, topics or QoS that cannot be connected; raised at wiring time, never later.
+    A user's mistake in the graph they launched, so a :class:`~otonav.errors.UsageError`:
+    the CLI prints its one line and exits 2 (issue 39)."""
 
 
 class ActorDefinitionError(WiringError, TypeError):

@@ -9,6 +9,7 @@ and the last observed value.
 from __future__ import annotations
 
 import asyncio
+import inspect
 from collections.abc import Callable
 from typing import TypeVar
 
@@ -83,7 +84,7 @@ async def until(
             return
         if not check():
             raise SimTimeoutError(
-                what or str(getattr(predicate, "__name__", "condition")),
+                what or _named(predicate),
                 clock.now(),
                 budget,
                 last,
@@ -120,3 +121,23 @@ async def next_message(
     raise SimTimeoutError(
         what or f"a matching message on '{subscription.topic}'", clock.now(), within, last
     )
+
+
+def _named(predicate: Callable[[], object]) -> str:
+    """What a timeout names: a function's name, or a lambda's own expression
+    (``lambda: odom.x > 1.0`` is "odom.x > 1.0")."""
+    name = str(getattr(predicate, "__name__", "condition"))
+    if name != "<lambda>":
+        return name
+    try:
+        source = inspect.getsource(predicate)
+    except (OSError, TypeError):
+        return name
+    body = source.partition("lambda")[2].partition(":")[2].strip()
+    depth, end = 0, len(body)
+    for i, char in enumerate(body):  # up to the bracket or comma that ends the lambda
+        depth += (char in "([{") - (char in ")]}")
+        if depth < 0 or (depth == 0 and char == ","):
+            end = i
+            break
+    return " ".join(body[:end].split()) or name

@@ -32,8 +32,8 @@ def box_outlines(boxes: tuple[BoxObstacle, ...]) -> NDArray[np.float64]:
 
 def _boxes_path(boxes: tuple[BoxObstacle, ...]) -> MplPath:
     """All boxes as one compound path: one artist to draw, and one vertex array for the
-    legend's "best" placement to test (a patch per box made it test each one: 3000
-    boxes drew in 1.7 s, issue 30). The outlines all turn the same way, so where boxes
+    renderer to draw (a patch per box made the legend's "best" placement test each one:
+    3000 boxes drew in 1.7 s, issue 30). The outlines all turn the same way, so where boxes
     overlap the non-zero fill rule fills them once."""
     from matplotlib.path import Path as MplPath
 
@@ -65,7 +65,8 @@ def draw_trajectory(
     from matplotlib.figure import Figure
     from matplotlib.patches import Circle, PathPatch
 
-    fig = Figure(figsize=(6.4, 4.8), dpi=100)
+    # Constrained layout: the title and the legend beside the map are never clipped.
+    fig = Figure(figsize=(8.0, 4.8), dpi=100, layout="constrained")
     FigureCanvasAgg(fig)
     ax = fig.add_subplot()
     unknown = []
@@ -92,8 +93,16 @@ def draw_trajectory(
         ax.plot(*closest, "x", color="#c0392b", markersize=10, label="closest approach")
     span_x = [*xs, *(goal[:1] if goal else ())] or [0.0]
     span_y = [*ys, *(goal[1:] if goal else ())] or [0.0]
-    ax.set_xlim(min(span_x) - 1.0, max(span_x) + 1.0)
-    ax.set_ylim(min(span_y) - 1.0, max(span_y) + 1.0)
+    x0, x1, y0, y1 = min(span_x) - 1.0, max(span_x) + 1.0, min(span_y) - 1.0, max(span_y) + 1.0
+    if obstacles:  # a box the window cuts is drawn whole, up to 1 m more (walls stay cut)
+        corners = box_outlines(obstacles)
+        lo, hi = corners.min(axis=1), corners.max(axis=1)
+        cut = (lo[:, 0] < x1) & (hi[:, 0] > x0) & (lo[:, 1] < y1) & (hi[:, 1] > y0)
+        if cut.any():
+            x0, y0 = np.maximum(np.minimum((x0, y0), lo[cut].min(axis=0)), (x0 - 1.0, y0 - 1.0))
+            x1, y1 = np.minimum(np.maximum((x1, y1), hi[cut].max(axis=0)), (x1 + 1.0, y1 + 1.0))
+    ax.set_xlim(float(x0), float(x1))
+    ax.set_ylim(float(y0), float(y1))
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
@@ -109,7 +118,8 @@ def draw_trajectory(
             color="#c0392b",
         )
     if ax.get_legend_handles_labels()[1]:  # nothing drawn (every chunk damaged): no legend
-        ax.legend(loc="best", fontsize=8)
+        # Beside the map, not on it: "best" still hid the goal or the path (issue 39).
+        fig.legend(loc="outside right upper", fontsize=8)
     return fig
 
 

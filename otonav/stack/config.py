@@ -555,15 +555,21 @@ class RobotConfig(_Section):
 
 
 class ActorConfig(_Section):
-    """One node of the launch: a class (``package.module:Class`` on ``sys.path``, or
-    ``path/to/file.py:Class`` relative to the config file) with its parameters and
-    topic remaps. An entry named like a built-in actor (``nav``, ``safety``, ``base``)
-    replaces it."""
+    """One node of the launch: a class (``package.module:Class`` on ``sys.path``, in the
+    current directory or the config file's, or ``path/to/file.py:Class`` relative to the
+    config file) with its parameters and topic remaps. An entry named like a built-in
+    actor (``nav``, ``safety``, ``base``) replaces it, or with no ``class``
+    only remaps its topics (ADR 0071)."""
 
     name: _Name
-    class_: str = Field(alias="class", min_length=3, max_length=limits.MAX_PATH_CHARS)
+    class_: str | None = Field(None, alias="class", min_length=3, max_length=limits.MAX_PATH_CHARS)
+    """The node's class; none: the built-in actor of this name, remapped."""
     params: dict[str, Any] = Field(default_factory=dict)
-    """Validated at start-up against the class's ``Params`` model."""
+    """Validated at start-up against the class's ``Params`` model; they win over
+    ``params_file``'s."""
+    params_file: str | None = Field(None, min_length=1, max_length=limits.MAX_PATH_CHARS)
+    """A ROS 2 parameter file (``NAME: {ros__parameters: {...}}``, or ``/**:``),
+    relative to the config file (ADR 0071)."""
     remap: dict[str, str] = Field(default_factory=dict)
     """Topic renames, from -> to (as ROS 2 remappings)."""
 

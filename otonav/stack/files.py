@@ -86,8 +86,9 @@ def parse_yaml(text: str | bytes, source: str) -> object:
         raise ConfigFileError(f"{source}: invalid YAML{where}: {problem}") from None
 
 
-def load_model(path: Path, model: type[_M]) -> _M:
-    """Load ``path`` (YAML) as ``model``; raise :class:`ConfigFileError` on any problem."""
+def read_yaml(path: Path) -> object:
+    """The YAML document in ``path``, read within the limits; :class:`ConfigFileError`
+    naming the file otherwise."""
     try:
         with path.open("rb") as f:
             raw = f.read(safe_yaml.MAX_BYTES + 1)  # bounded, even for /dev/zero
@@ -95,7 +96,12 @@ def load_model(path: Path, model: type[_M]) -> _M:
         raise ConfigFileError(f"{path}: no such file") from None
     except OSError as exc:
         raise ConfigFileError(f"{path}: cannot read ({exc.strerror})") from None
-    data = parse_yaml(raw, str(path))
+    return parse_yaml(raw, str(path))
+
+
+def load_model(path: Path, model: type[_M]) -> _M:
+    """Load ``path`` (YAML) as ``model``; raise :class:`ConfigFileError` on any problem."""
+    data = read_yaml(path)
     if data is None or data == {}:  # it silently ran the defaults (issue 27)
         raise ConfigFileError(
             f"{path}: empty (no keys); give at least one key (the README lists them), "

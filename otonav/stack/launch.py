@@ -1,13 +1,15 @@
 """Launch as data: the stack config's ``actors`` list made into actors.
 
-Each entry names a class (``package.module:Class`` importable from ``sys.path``, or
-``path/to/file.py:Class``; a relative file is resolved against the config file when it
-is loaded), its parameters and its remaps, as a ROS 2 launch file names a node's
+Each entry names a class (``package.module:Class`` importable from ``sys.path``, the
+current directory or the config file's, or ``path/to/file.py:Class``; a relative file
+is resolved against the config file when it is loaded), its parameters (inline, and a
+ROS 2 ``params_file``) and its remaps, as a ROS 2 launch file names a node's
 executable, ``parameters`` and ``remappings``. An entry whose name is a built-in actor's
-(``nav``, ``safety``, ``base``, ``bridge``) replaces it in place; any other is added.
+(``nav``, ``safety``, ``base``, ``bridge``) replaces it in place, or, with no
+``class``, remaps the built-in's topics; any other is added (ADR 0071).
 
 A launchable actor declares its parameters as a pydantic model in a class attribute
-``Params`` and takes them as ``params``::
+``Params``; ``Actor.__init__`` takes them and keeps them as ``self.params``::
 
     class Wander(Actor):
         class Params(BaseModel):
@@ -15,12 +17,12 @@ A launchable actor declares its parameters as a pydantic model in a class attrib
 
         cmd = Output("/cmd_vel_nav", Twist)
 
-        def __init__(self, params: Params, *, name=None, remap=None) -> None:
-            super().__init__(name, remap=remap)
-            self.params = params
+        async def run(self) -> None:
+            ...  # self.params.speed
 
-An actor with no ``Params`` is built as ``Class(name=..., remap=...)`` and takes no
-parameters. Bad parameters are one line naming ``actors.NAME.KEY``.
+An actor with an ``__init__`` of its own takes ``params``, ``name`` and ``remap`` as
+keywords and passes them on. Bad parameters are one line naming ``actors.NAME.KEY`` (or
+the parameter file's key path).
 """
 
 from __future__ import annotations
@@ -31,6 +33,7 @@ import importlib.util
 import inspect
 import re
 import sys
+import traceback
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -39,7 +42,7 @@ from pydantic import BaseModel, ValidationError
 
 from otonav.runtime import Actor
 from otonav.stack.config import ActorConfig, StackConfig
-from otonav.stack.files import ConfigFileError, shown
+from otonav.stack.files import ConfigFileError, read_yaml, shown
 
 __all__ = [
     "actor_class",
@@ -48,7 +51,9 @@ __all__ = [
     "check_actors",
     "launch",
     "make_actor",
+    "module_spec",
     "params_model",
+    "remap_builtin",
 ]
 
 
@@ -88,6 +93,9 @@ def actor_class(spec: str, key: str) -> type[Actor]:
     if where.endswith(".py"):
         module = _import_file(Path(where), key)
     else:
+        folder, slash, where = where.rpartition("/")
+        if slash and folder not in sys.path:  # a module found in that folder (ADR 0071)
+            sys.path.append(folder)
         try:
             module = importlib.import_module(where)
         except ImportError as exc:
@@ -121,20 +129,76 @@ def params_model(cls: type[Actor]) -> type[BaseModel] | None:
     return None
 
 
-def actor_params(cls: type[Actor], params: Mapping[str, Any], key: str) -> BaseModel | None:
-    """``params`` validated against ``cls.Params`` (one line naming ``key.FIELD``)."""
+def module_spec(spec: str, folder: Path) -> str:
+    """``spec`` (``module:Class``) as ``FOLDER/module:Class`` when its module is not
+    importable from ``sys.path`` but lives in ``folder``, as ``python`` finds a module
+    next to the script it runs; any other spec unchanged."""
+    where, sep, attr = spec.rpartition(":")
+    top = where.partition(".")[0]
+    if not sep or where.endswith(".py") or "/" in where or not top.isidentifier():
+        return spec
+    try:
+        if not ((folder / f"{top}.py").is_file() or (folder / top).is_dir()):
+            return spec
+    except OSError:  # a name no file system takes: not there
+        return spec
+    if importlib.util.find_spec(top) is not None:
+        return spec
+    return f"{folder.resolve()}/{where}:{attr}"
+
+
+def _file_params(entry: ActorConfig, key: str) -> tuple[dict[str, Any], str]:
+    """The parameters ``entry.params_file`` holds for ``entry.name`` (ROS 2's layout:
+    ``NAME: {ros__parameters: {...}}``, ``/**`` for every node), and the key path prefix
+    its errors name."""
+    if entry.params_file is None:
+        return {}, key
+    path = Path(entry.params_file)
+    data = read_yaml(path)
+    if not isinstance(data, dict):
+        raise ConfigFileError(f"{path}: expected NODE_NAME: {{ros__parameters: {{...}}}}")
+    merged: dict[str, Any] = {}
+    prefix = ""
+    for node in ("/**", entry.name, f"/{entry.name}"):
+        section = data.get(node)
+        if section is None:
+            continue
+        if not isinstance(section, dict) or not isinstance(section.get("ros__parameters"), dict):
+            raise ConfigFileError(
+                f"{path}: {node}: expected a mapping with ros__parameters (ROS 2's layout: "
+                f"{entry.name}: {{ros__parameters: {{KEY: VALUE}}}})"
+            )
+        merged.update(section["ros__parameters"])
+        prefix = f"{node}.ros__parameters"
+    if not prefix:
+        raise ConfigFileError(
+            f"{path}: no section for node {entry.name!r} (its sections: "
+            f"{', '.join(map(str, data)) or 'none'}); name the node, or /** for every node"
+        )
+    return merged, f"{path}: {prefix}"
+
+
+def actor_params(
+    cls: type[Actor], params: Mapping[str, Any], key: str, *, entry: ActorConfig | None = None
+) -> BaseModel | None:
+    """``params`` validated against ``cls.Params`` (one line naming ``key.FIELD``); with
+    ``entry``, its ``params_file``'s under them (an error there names the file's key)."""
+    from_file, file_key = _file_params(entry, key) if entry is not None else ({}, key)
     model = params_model(cls)
     if model is None:
-        if params:
+        if params or from_file:
             raise ConfigFileError(
                 f"{key}.params: {cls.__name__} declares no parameters (no Params model) "
-                f"but was given {', '.join(sorted(params))}"
+                f"but was given {', '.join(sorted({**from_file, **params}))}"
             )
         return None
     try:
-        return model.model_validate(dict(params))
+        return model.model_validate({**from_file, **params})
     except ValidationError as exc:
         first = exc.errors()[0]
+        top = str(first["loc"][0]) if first["loc"] else ""
+        if top in from_file and top not in params:
+            key = file_key
         where = ".".join([key, *(str(part) for part in first["loc"])])
         message = first["msg"]
         if first["type"] == "extra_forbidden":
@@ -150,8 +214,10 @@ def actor_params(cls: type[Actor], params: Mapping[str, Any], key: str) -> BaseM
 def make_actor(entry: ActorConfig) -> Actor:
     """The actor of one ``actors`` entry, its parameters validated."""
     key = f"actors.{entry.name}"
+    if entry.class_ is None:
+        raise ConfigFileError(f"{key}: no class, and no built-in actor of that name to remap")
     cls = actor_class(entry.class_, f"{key}.class")
-    params = actor_params(cls, entry.params, key)
+    params = actor_params(cls, entry.params, key, entry=entry)
     kwargs: dict[str, Any] = {"name": entry.name, "remap": dict(entry.remap)}
     if params is not None:
         kwargs["params"] = params
@@ -162,10 +228,36 @@ def make_actor(entry: ActorConfig) -> Actor:
         raise ConfigFileError(
             f"{key}.class: {cls.__name__} must accept {how} as keywords ({exc})"
         ) from None
-    actor = cls(**kwargs)
+    try:
+        actor = cls(**kwargs)
+    except Exception as exc:  # the user's __init__: one line, where it raised (issue 41)
+        frame = traceback.extract_tb(exc.__traceback__)[-1]
+        raise ConfigFileError(
+            f"{key}: {cls.__name__}(...) raised {type(exc).__name__}: {exc} "
+            f"({Path(frame.filename).name}:{frame.lineno})"
+        ) from None
     if params is not None:
         actor._otonav_params = params.model_dump(mode="json")
     return actor
+
+
+def remap_builtin(actor: Actor, entry: ActorConfig) -> None:
+    """Rename ``actor``'s topics as ``entry.remap`` says, from the names it has now
+    (``otonav graph``'s) to new ones; a class-less entry may do nothing else."""
+    key = f"actors.{entry.name}"
+    if entry.params or entry.params_file:
+        raise ConfigFileError(
+            f"{key}.params: a built-in actor takes its parameters from the config's sections "
+            "(nav.*, safety.*, base.*); give a class to replace it with your own"
+        )
+    now = {port.topic: actor.topic_of(port) for port in actor.ports()}
+    unknown = sorted(set(entry.remap) - set(now.values()))
+    if unknown:
+        raise ConfigFileError(
+            f"{key}.remap: {entry.name} has no topic {', '.join(unknown)} (its topics: "
+            f"{', '.join(sorted(set(now.values())))})"
+        )
+    actor._otonav_remap = {port: entry.remap.get(topic, topic) for port, topic in now.items()}
 
 
 def add_actors(stack: StackConfig, specs: Sequence[str], *, source: str = "--actor") -> StackConfig:
@@ -173,8 +265,8 @@ def add_actors(stack: StackConfig, specs: Sequence[str], *, source: str = "--act
     in snake_case: ``my_nodes:Wander`` is ``wander``)."""
     entries = list(stack.actors)
     for spec in specs:
-        attr = spec.rpartition(":")[2]
-        if not attr.isidentifier():
+        where, _sep, attr = spec.rpartition(":")
+        if not where or not attr.isidentifier():
             raise ConfigFileError(
                 f"{source} {spec!r}: expected module:Class (e.g. my_pkg.nodes:Wander)"
             )
@@ -184,10 +276,12 @@ def add_actors(stack: StackConfig, specs: Sequence[str], *, source: str = "--act
                 f"{source} {spec}: an actor named {name!r} is already launched; name it in "
                 "the config's actors list instead"
             )
-        where = spec.rpartition(":")[0]
         if where.endswith(".py"):  # a file: found from any worker's directory
             spec = f"{Path(where).resolve()}:{attr}"
-        entries.append(ActorConfig(name=name, class_=spec))
+        try:
+            entries.append(ActorConfig(name=name, class_=module_spec(spec, Path.cwd())))
+        except ValidationError as exc:  # a name or path too long, ...: one line
+            raise ConfigFileError(f"{source} {shown(spec)}: {exc.errors()[0]['msg']}") from None
     return stack.model_copy(update={"actors": tuple(entries)})
 
 
@@ -196,7 +290,8 @@ def check_actors(entries: Sequence[ActorConfig]) -> None:
     would refuse), before anything runs."""
     for entry in entries:
         key = f"actors.{entry.name}"
-        actor_params(actor_class(entry.class_, f"{key}.class"), entry.params, key)
+        if entry.class_ is not None:
+            actor_params(actor_class(entry.class_, f"{key}.class"), entry.params, key, entry=entry)
 
 
 def launch(builtin: Sequence[Actor], entries: Sequence[ActorConfig]) -> list[Actor]:
@@ -205,6 +300,9 @@ def launch(builtin: Sequence[Actor], entries: Sequence[ActorConfig]) -> list[Act
     actors = list(builtin)
     index = {actor.name: i for i, actor in enumerate(actors)}
     for entry in entries:
+        if entry.class_ is None and entry.name in index:
+            remap_builtin(actors[index[entry.name]], entry)
+            continue
         actor = make_actor(entry)
         if entry.name in index:
             actors[index[entry.name]] = actor

@@ -1,6 +1,7 @@
 """A stack config file as a launch file: loaded, validated, and its relative paths
-(``robot.model``, an actor's ``path/file.py:Class``) taken from the file's folder, as a
-ROS 2 launch file finds what it names relative to its package."""
+(``robot.model``, an actor's ``path/file.py:Class``, ``module:Class`` next to the file,
+``params_file``) taken from the file's folder, as a ROS 2 launch file finds what it
+names relative to its package."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ from pathlib import Path
 from otonav.hal.description import BUILTIN_ROBOTS
 from otonav.stack.config import StackConfig
 from otonav.stack.files import load_model
+from otonav.stack.launch import module_spec
 
 __all__ = ["load_stack_file", "resolve_paths"]
 
@@ -29,9 +31,15 @@ def resolve_paths(stack: StackConfig, folder: Path) -> StackConfig:
         updates["robot"] = stack.robot.model_copy(update={"model": str(folder / model)})
     actors = []
     for entry in stack.actors:
-        where, sep, name = entry.class_.rpartition(":")
-        if sep and where.endswith(".py") and not Path(where).is_absolute():
-            entry = entry.model_copy(update={"class_": f"{folder / where}:{name}"})
+        if entry.params_file is not None and not Path(entry.params_file).is_absolute():
+            entry = entry.model_copy(update={"params_file": str(folder / entry.params_file)})
+        spec = entry.class_
+        if spec is not None:
+            where, sep, name = spec.rpartition(":")
+            if sep and where.endswith(".py") and not Path(where).is_absolute():
+                entry = entry.model_copy(update={"class_": f"{folder / where}:{name}"})
+            else:
+                entry = entry.model_copy(update={"class_": module_spec(spec, folder)})
         actors.append(entry)
     if tuple(actors) != stack.actors:
         updates["actors"] = tuple(actors)

@@ -1,5 +1,6 @@
-"""/rosout: the system's lifecycle events (started, crashed, restarted, stopped) as
-``rcl_interfaces/msg/Log`` lines, so a recording carries them next to the data."""
+"""/rosout: the system's lifecycle events (started, crashed, restarted, stopped) and
+every actor's ``self.log`` lines as ``rcl_interfaces/msg/Log``, so a recording carries
+them next to the data (ADR 0070)."""
 
 from __future__ import annotations
 
@@ -18,8 +19,27 @@ _LEVELS = {EventKind.CRASHED: Log.ERROR, EventKind.RESTARTED: Log.WARN}
 
 
 def attach_rosout(system: System) -> None:
-    """Publish every event of ``system`` on /rosout (dropped, not blocking, when full)."""
+    """Publish every event of ``system`` and every line its actors log on /rosout
+    (dropped, not blocking, when full)."""
     publisher = system.publisher(topics.ROSOUT, Log, ROSOUT_QOS, name="rosout")
+
+    def log_line(
+        now: float, level: int, name: str, text: str, file: str, function: str, line: int
+    ) -> None:
+        message = Log.fast(
+            stamp=Time.from_seconds(now),
+            level=level,
+            name=name,
+            msg=text,
+            file=file,
+            function=function,
+            line=line,
+        )
+        with contextlib.suppress(anyio.WouldBlock):
+            publisher.publish_nowait(message)
+
+    for node in system.graph().actors:
+        system.actor(node.name).log.sink = log_line
 
     def publish(event: SystemEvent) -> None:
         text = str(event.kind) if not event.detail else f"{event.kind}: {event.detail}"

@@ -229,7 +229,7 @@ def _iter_runs(spec: SweepSpec, base: Path, where: str, actors: Sequence[str]) -
     configured = len(stack.actors)
     if actors:
         stack = add_actors(stack, actors)
-    launched = tuple(entry.class_ for entry in stack.actors[configured:])
+    launched = tuple(entry.class_ or "" for entry in stack.actors[configured:])
     scenarios = _resolve_scenarios(spec, base, where)
     combos = override_combinations(spec)
     overridden = [

@@ -1,6 +1,7 @@
 """Every scenario of a sweep checked before the first run starts: a goal inside a box
 or outside the arena, a scene that does not load, a run too costly for its budget
-would otherwise surface as "error" runs after the others had run."""
+would otherwise surface as "error" runs after the others had run. So would the user's
+nodes that cannot be built or wired (issue 41: one line, exit 2, as ``otonav run``)."""
 
 from __future__ import annotations
 
@@ -8,10 +9,11 @@ from collections.abc import Sequence
 
 from otonav.hal import BoxObstacle
 from otonav.hal.mujoco import SceneError
+from otonav.runtime import System
 from otonav.scenario import ScenarioConfig
 from otonav.scenario.run import effective_stack
 from otonav.scenario.validate import check_cost, check_goal
-from otonav.stack import StackConfig, build_world
+from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.files import ConfigFileError
 from otonav.sweep.plan import RunTask
 
@@ -26,7 +28,11 @@ def check_tasks(tasks: Sequence[RunTask]) -> list[str]:
     valid by construction and not checked again."""
     problems: dict[str, str] = {}
     scenes: dict[str, _Scene | str] = {}
+    launches: set[str] = set()
     for task in tasks:
+        if task.stack_json not in launches:  # the user's nodes built and wired once
+            launches.add(task.stack_json)
+            _check_launch(StackConfig.model_validate_json(task.stack_json))
         where = task.source or task.scenario
         if not task.scenario_json or where in problems:
             continue
@@ -56,5 +62,18 @@ def _load_scene(stack: StackConfig) -> _Scene | str:
         return str(exc)
     try:
         return world.obstacles(), world.walls()
+    finally:
+        world.close()
+
+
+def _check_launch(stack: StackConfig) -> None:
+    """Raise what ``otonav run`` would if the stack's own nodes cannot start (an
+    ``__init__`` that raises, a port whose type or QoS does not match its topic): a
+    :class:`~otonav.errors.UsageError`, one line, before anything runs."""
+    if not stack.actors:
+        return
+    world = build_world(stack)
+    try:
+        System(build_actors(stack, world))
     finally:
         world.close()

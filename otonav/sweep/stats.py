@@ -108,9 +108,11 @@ _NUMBER = re.compile(r"-?\d+(\.\d+)?(e-?\d+)?")
 
 
 def reason_class(reason: str) -> str:
-    """A failure reason with details and numbers masked: the group it belongs to."""
-    masked = _NUMBER.sub("#", _PARENS.sub("", reason))
-    return "; ".join(part.strip() for part in masked.split(";"))
+    """A failure reason with details and numbers masked, and without the recoveries the
+    run tried (their list differs from run to run: three failures made three groups,
+    issue 39): the group it belongs to."""
+    masked = _NUMBER.sub("#", _PARENS.sub("", reason.partition("recoveries:")[0]))
+    return "; ".join(part.strip() for part in masked.split(";") if part.strip())
 
 
 def failures_by_reason(records: Sequence[dict[str, Any]]) -> dict[str, list[dict[str, Any]]]:

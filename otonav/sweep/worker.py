@@ -19,6 +19,7 @@ from __future__ import annotations
 import contextlib
 import gc
 import hashlib
+import logging
 import os
 import signal
 import socket
@@ -29,6 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
+from otonav.runtime.nodelog import LOGGER_NAME
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.scenario.run import finite_figures
 from otonav.stack import StackConfig
@@ -100,6 +102,7 @@ class WarmWorker:
     def __init__(self, scratch: Path) -> None:
         self.scratch = scratch
         self.runs = 0
+        _quiet_nodes()  # a process of its own: no console handler but Python's last resort
         gc.collect()
         gc.freeze()
 
@@ -110,6 +113,15 @@ class WarmWorker:
         if self.runs == 1:
             gc.freeze()
         return outcome
+
+
+def _quiet_nodes() -> None:
+    """A node's ``self.log`` lines stay on /rosout in the kept recordings: on a sweep's
+    console they would be many runs' lines, none saying which run (ADR 0070)."""
+    nodes = logging.getLogger(LOGGER_NAME)
+    if not nodes.handlers:
+        nodes.addHandler(logging.NullHandler())
+        nodes.propagate = False
 
 
 def execute(task: RunTask, scratch: Path) -> RunOutcome:

@@ -22,6 +22,8 @@ from pathlib import Path
 
 import pytest
 
+from otonav.errors import UsageError
+from otonav.runtime.errors import SimTimeoutError
 from otonav.runtime.loop import virtual_loop_factory
 
 DEFAULT_WALL_CEILING = 60.0
@@ -96,6 +98,10 @@ def pytest_runtest_makereport(
 ) -> Generator[None, pytest.TestReport, None]:
     outcome = yield
     report: pytest.TestReport = outcome.get_result()
+    if report.failed and call.excinfo is not None:
+        short = _short_failure(item, call.excinfo)
+        if short is not None:
+            report.longrepr = short
     path = item.stash.get(_DIR_KEY, None)
     if path is None or report.when != "call":
         return
@@ -116,3 +122,17 @@ def pytest_runtest_makereport(
         report.sections.append(("otonav artifacts", "\n".join(lines) or f"(none in {path})"))
     else:
         shutil.rmtree(path, ignore_errors=True)
+
+
+def _short_failure(item: pytest.Item, excinfo: pytest.ExceptionInfo[BaseException]) -> str | None:
+    """A user's wiring or config mistake, or a sim-time wait that ran out, as the line
+    that says it and where in the test it came from, not the library's source (issue
+    39); None for any other failure (pytest's own report)."""
+    if not excinfo.errisinstance((UsageError, SimTimeoutError)):
+        return None
+    where = ""
+    for entry in reversed(excinfo.traceback):
+        if Path(str(entry.path)) == Path(str(item.path)):
+            where = f"{entry.path}:{entry.lineno + 1}: "
+            break
+    return f"{where}{excinfo.typename}: {excinfo.value}"

@@ -35,7 +35,12 @@ def test_a_core_actor_crash_gives_the_verdict_a_summary_and_stops_the_wheels(
     monkeypatch.setattr(AvoidingNavigator, "_step", crashing_step)
     assert main(["run", "--out", str(tmp_path)]) == 1
     out = capsys.readouterr()
-    assert "Traceback" not in out.err + out.out
+    assert "Traceback (most recent call last)" not in out.err + out.out
+    # The fault is injected from this file, outside otonav: the console shows that frame
+    # (issue 39: a user's crash shows its own code), never otonav's or the libraries'.
+    assert "otonav/actors" not in out.err
+    assert "otonav/runtime" not in out.err
+    assert len(out.err.splitlines()) <= 6, out.err
     assert "FAILED" in out.out
     assert "why: run ended early" in out.out
     assert "injected navigator fault" in out.out

@@ -51,7 +51,11 @@ def test_an_actor_crash_ends_every_mode_as_a_failed_run(tmp_path: Path, mode: st
     out = tmp_path / "out"
     done = _run(out, "Crashes", MODES[mode])
     assert done.returncode == 1, done.stderr
-    assert "Traceback" not in done.stderr, done.stderr
+    # One line says it crashed; a crash in the user's own node then shows the user's own
+    # frames (issue 39), never Python's whole traceback or an ExceptionGroup (issue 41).
+    assert "Traceback (most recent call last)" not in done.stderr, done.stderr
+    assert "ExceptionGroup" not in done.stderr, done.stderr
+    assert "ending_actors.py" in done.stderr, done.stderr
     said = [line for line in done.stderr.splitlines() if "crashed" in line]
     assert len(said) == 1, done.stderr
     assert "crashes crashed: RuntimeError: boom at half a second" in said[0], said

@@ -64,7 +64,8 @@ def test_the_config_reference_lists_every_key_with_its_default() -> None:
     assert rows["hal.can.left.sign"].default == "`-1`"  # the section's default, not the class's
     assert rows["world.timestep"].bounds == "[0.0001, 0.01]"
     assert rows["hal.can.encoder_period"].bounds == "[0.001, 1]"  # an AfterValidator's range
-    assert rows["actors[].class"].default == "required"
+    assert rows["actors[].name"].default == "required"
+    assert rows["actors[].class"].default != "required"  # none: the built-in of that name
 
 
 def test_every_physical_quantity_in_the_config_has_a_unit() -> None:
@@ -171,3 +172,44 @@ def test_every_included_file_is_exercised_by_a_test() -> None:
                 continue
             assert included.is_file(), f"{path.name} includes a missing file {included}"
             assert included.name in tests, f"no test names {included}"
+
+
+def test_the_docs_remap_examples_remap_and_say_what_is_live() -> None:
+    """Issue 39 item 8: concepts/launch.md's only remap example was a no-op
+    (``{/cmd_vel_nav: /cmd_vel_nav}``), and the tutorial mapped ``ros2 param set`` (live)
+    to ``--set`` (launch time)."""
+    remaps = []
+    for path, body in docs_hooks.code_blocks("yaml"):
+        included = docs_hooks.included_file(body)
+        data = yaml.safe_load(included.read_text() if included else body)
+        for entry in data.get("actors", []) if isinstance(data, dict) else []:
+            remaps += [(path.name, a, b) for a, b in entry.get("remap", {}).items()]
+    assert {name for name, _a, _b in remaps} >= {"launch.md", "own-node.md"}
+    assert [r for r in remaps if r[1] == r[2]] == []
+    tutorial = (ROOT / "docs" / "getting-started" / "tutorial.md").read_text()
+    (row,) = [ln for ln in tutorial.splitlines() if ln.startswith("|") and "ros2 param set" in ln]
+    assert "--set" not in row
+    assert "launch-time" in tutorial
+
+
+def test_the_api_reference_turns_sphinx_roles_into_links() -> None:
+    """Issue 39 item 7: 112 raw roles showed as text. The griffe extension the docs build
+    loads makes each an autorefs link, resolved in the docstring's scope, and a ``::``
+    marker a colon (``make test-docs`` then searches the built site for any left)."""
+    import griffe
+    import griffe_sphinx_roles
+
+    runtime = griffe.load("otonav.runtime", search_paths=[str(ROOT)])
+    clock = runtime["clock"]
+    text = (
+        "The :class:`~otonav.runtime.system.System` and :class:`Clock`; see :func:`now()`."
+        "\n\nLike this::\n\n    code\n"
+    )
+    converted = griffe_sphinx_roles.convert(text, clock)
+    assert ":class:" not in converted
+    assert ":func:" not in converted
+    link = '<autoref identifier="otonav.runtime.{}" optional><code>{}</code></autoref>'
+    assert link.format("system.System", "System") in converted
+    assert link.format("clock.Clock", "Clock") in converted
+    assert "Like this:\n" in converted
+    assert "::" not in converted

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from pydantic import BaseModel
+from pydantic import BaseModel, Field
 
-from otonav.msgs import Odometry
-from otonav.runtime import SENSOR_DATA_QOS, Actor, Input
+from otonav.msgs import LaserScan, Odometry, Twist
+from otonav.runtime import SENSOR_DATA_QOS, Actor, Input, QoS, Reliability
 
 
 class OdomCounter(Actor):
@@ -35,3 +35,32 @@ class Stubborn(Actor):
 
 
 NOT_AN_ACTOR = 42
+
+
+class Tuned(Actor):
+    """Parameters and no __init__ of its own: the base class takes them (issue 39)."""
+
+    class Params(BaseModel):
+        model_config = {"extra": "forbid"}
+        gain: float = Field(1.0, gt=0.0)
+        limits: dict[str, float] = {}
+
+
+class RaisesInInit(Actor):
+    """A constructor that raises, as a user's might (issue 41, case 11)."""
+
+    def __init__(self, *, name: str | None = None, remap: Mapping[str, str] | None = None):
+        super().__init__(name, remap=remap)
+        raise RuntimeError("no device /dev/ttyUSB0")
+
+
+class ScanAsTwist(Actor):
+    """/scan typed as Twist: a wiring mistake (issue 39 item 3)."""
+
+    scan = Input("/scan", Twist)
+
+
+class ReliableScan(Actor):
+    """A reliable subscriber on the best-effort /scan: a QoS mismatch."""
+
+    scan = Input("/scan", LaserScan, QoS(reliability=Reliability.RELIABLE))

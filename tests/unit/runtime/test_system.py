@@ -242,16 +242,16 @@ class _Slow(Actor):
 
     def __init__(self, name: str, log: list[tuple[str, str, float]], stop_takes: float) -> None:
         super().__init__(name)
-        self.log = log
+        self.events = log
         self.stop_takes = stop_takes
 
     async def run(self) -> None:
         await anyio.sleep_forever()
 
     async def on_stop(self) -> None:
-        self.log.append((self.name, "on_stop begins", self.clock.now()))
+        self.events.append((self.name, "on_stop begins", self.clock.now()))
         await self.clock.sleep(self.stop_takes)
-        self.log.append((self.name, "on_stop ends", self.clock.now()))
+        self.events.append((self.name, "on_stop ends", self.clock.now()))
 
 
 @pytest.mark.parametrize("how", ["exit", "crash"])

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import pytest
 from matplotlib.path import Path as Path_
@@ -47,8 +48,8 @@ def _recording(path: Path, *, goal: bool = True, world: bool = False, seconds: f
 
 
 def _legend(fig: object) -> list[str]:
-    (ax,) = fig.axes  # type: ignore[attr-defined]
-    return [t.get_text() for t in ax.get_legend().get_texts()]
+    (legend,) = fig.legends  # type: ignore[attr-defined]
+    return [t.get_text() for t in legend.get_texts()]
 
 
 def _notes(fig: object) -> str:
@@ -147,3 +148,33 @@ def test_box_outlines_are_the_boxes_corners() -> None:
             ly = -s * (x - box.x) + c * (y - box.y)
             assert (abs(lx), abs(ly)) == pytest.approx((box.half_x, box.half_y))  # a corner
         assert list(outline[4]) == list(outline[0])
+
+
+def test_the_legend_and_the_title_cover_nothing_and_are_not_clipped(tmp_path: Path) -> None:
+    """Issue 39: the legend placed "best" on the map hid the goal. It sits beside the map
+    now: its box does not overlap the axes', and the title is inside the figure."""
+    fig: Any = _figure(_recording(tmp_path / "r.mcap", world=True))
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    (ax,) = fig.axes
+    (legend,) = fig.legends
+    map_box, legend_box = ax.get_window_extent(renderer), legend.get_window_extent(renderer)
+    assert not map_box.overlaps(legend_box)
+    title = ax.title.get_window_extent(renderer)
+    assert fig.bbox.contains(title.x0, title.y0)
+    assert fig.bbox.contains(title.x1, title.y1)
+    assert fig.bbox.contains(legend_box.x1, legend_box.y0)
+
+
+def test_a_box_the_window_cuts_is_drawn_whole_and_a_wall_stays_cut() -> None:
+    """Issue 39 item 12: the acceptance plot cut the box at y = -1 in half. The window is
+    the path and the goal +- 1 m: here x in [-1, 3], y in [-1, 1.5]."""
+    box = BoxObstacle(1.0, -1.0, 0.2, 0.1, 0.5)  # across the window's lower edge
+    wall = BoxObstacle(0.0, 1.5, 20.0, 0.1, 0.0)  # across its upper edge, 40 m long
+    trajectory = [(0.0, 0.0, 0.0), (1.0, 1.0, 0.5)]
+    fig: Any = draw_trajectory(trajectory, (box, wall), (2.0, 0.5), 0.15, None, "t")
+    (ax,) = fig.axes
+    (bottom, top), (left, right) = ax.get_ylim(), ax.get_xlim()
+    assert bottom == pytest.approx(box_outlines((box,))[0][:, 1].min())  # the whole box
+    assert top == pytest.approx(1.6)  # the wall's whole thickness
+    assert (left, right) == pytest.approx((-2.0, 4.0))  # its length: at most 1 m more

@@ -86,7 +86,7 @@ def test_an_entry_named_like_a_built_in_replaces_it_in_place() -> None:
     [
         ("no_such_module_xyz:Node", {}, r"^actors\.n\.class: cannot import 'no_such_module_xyz'"),
         (f"{PROBES}:Missing", {}, r"^actors\.n\.class: .* has no 'Missing' \(actor classes there: "
-         r"OdomCounter, Stubborn\)$"),
+         r"OdomCounter, RaisesInInit, ReliableScan, ScanAsTwist, Stubborn, Tuned\)$"),
         (f"{PROBES}:NOT_AN_ACTOR", {}, r"^actors\.n\.class: .* is not an otonav\.runtime\.Actor"),
         (f"{PROBES}:OdomCounter", {"x": 1}, r"^actors\.n\.params: OdomCounter declares no "
          r"parameters \(no Params model\) but was given x$"),

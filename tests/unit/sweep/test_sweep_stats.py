@@ -76,6 +76,10 @@ def test_errors_count_as_not_passed_and_reasons_group_without_numbers() -> None:
     ]
     assert len(groups["did not reach the goal within # s"]) == 2
     assert reason_class("a (x); b 2.5e-3 m") == "a; b # m"
+    assert reason_class(
+        "did not reach the goal within 20 s (ended 2.1 m away); "
+        "recoveries: spin at 3.1 s (blocked); backup at 7.5 s (stuck)"
+    ) == "did not reach the goal within # s"  # fmt: skip
     assert override_rates(records)["nav.max_v"]["0.3"].passed == 1
 
 
