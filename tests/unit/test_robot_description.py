@@ -121,8 +121,11 @@ def test_a_urdf_with_package_meshes_and_no_actuators_drives() -> None:
     assert world.ground_truth().vx_world == pytest.approx(3.0 * 0.0762, rel=0.05)
 
 
-def test_the_added_lidar_does_not_see_the_robot_itself() -> None:
-    world = MujocoInterface("empty", robot=pathfinder())
+@pytest.mark.parametrize("lidar", [None, Mount(pos=(0.0, 0.0, 0.05))], ids=["on-top", "inside"])
+def test_the_lidar_does_not_see_the_robot_itself(lidar: Mount | None) -> None:
+    """Inside its housing too (0.05 m up is inside the deck's collision box), as vendor
+    models mount it: every geom of the robot is out of the rays, whichever body's."""
+    world = MujocoInterface("empty", robot=pathfinder(lidar=lidar))
     ranges = world.read_scan().ranges
     finite = ranges[np.isfinite(ranges)]
     assert finite.size > 0  # the arena's walls
@@ -204,9 +207,14 @@ def test_given_values_override_derived_ones() -> None:
             r"^robot\.lidar: no site 'laser' in pathfinder\.xml \(sites: none named\)$",
         ),
         (
-            pathfinder(lidar=Mount(pos=(0.0, 0.0, 0.05))),
-            r"^robot\.lidar: the lidar's origin is inside the robot's collision geom "
-            r"'deck_collision'",
+            pathfinder(left_wheel="right_wheel_hinge", right_wheel="left_wheel_hinge"),
+            r"^robot\.left_wheel: joint 'right_wheel_hinge' is at y = -0\.150 m, not left of "
+            r"'left_wheel_hinge' .*: swap robot\.left_wheel and robot\.right_wheel$",
+        ),
+        (
+            pathfinder(right_wheel="left_wheel_hinge"),
+            r"^robot\.right_wheel: names the same joint as robot\.left_wheel "
+            r"\('left_wheel_hinge'\); name the right wheel's joint$",
         ),
         (
             pathfinder(model=PATHFINDER / "nope.xml"),
@@ -286,3 +294,96 @@ def test_an_old_scene_with_our_robot_in_it_refuses_another_robot(tmp_path: Path)
     with pytest.raises(SceneError, match=r"old\.xml includes otonav's robot \(body 'chassis'\); "
                        r"remove its <include"):  # fmt: skip
         MujocoInterface(scene, robot=builtin_robot("burger"))
+
+
+TB3 = Path(__file__).resolve().parents[2] / "examples" / "robots" / "turtlebot3_burger.xml"
+
+
+def turtlebot3(**changes: object) -> RobotDescription:
+    """ROBOTIS's Burger as vendors write it (examples/robots): base_footprint above
+    base_link, a box caster on its own fixed link, the lidar inside its housing."""
+    values: dict[str, object] = {
+        "model": str(TB3),
+        "label": TB3.name,
+        "base": "base_footprint",
+        "left_wheel": "wheel_left_joint",
+        "right_wheel": "wheel_right_joint",
+        "lidar": Mount(body="base_scan", pos=(0.0, 0.0, 0.0)),
+    }
+    values.update(changes)
+    return RobotDescription(**values)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("base", ["base_footprint", "base_link"])
+def test_a_vendor_model_runs_as_written_whichever_base_frame_is_named(base: str) -> None:
+    world = MujocoInterface("empty", robot=turtlebot3(base=base))
+    sources = world.geometry_sources()
+    assert sources["base"] == "body 'base_footprint', free joint added by otonav"
+    assert sources["casters"] == (
+        "made frictionless by otonav: #3 of body 'caster_back_link' (condim 3, priority 0)"
+    )
+    height = {"base_footprint": 0.0, "base_link": 0.010}[base]
+    assert world.geometry.base_height == pytest.approx(height, abs=1e-3)
+    assert world.geometry.laser_offset_z == pytest.approx(0.182 - height, abs=1e-3)
+    ranges = world.read_scan().ranges
+    assert float(ranges[np.isfinite(ranges)].min()) > 4.0  # the housing is not seen
+    drive(world, speed=0.19 / 0.033, seconds=2.0)
+    truth = world.ground_truth()
+    assert truth.x > 0.25  # weak servos: ~0.16 of 0.19 m/s asked, but it rolls
+    assert abs(truth.pitch) < 0.02
+
+
+def test_a_condim_1_caster_without_priority_is_made_frictionless(tmp_path: Path) -> None:
+    assets = Path(MujocoInterface("empty").scene_file).parent
+    text = (assets / "robots" / "burger.xml").read_text()
+    old = 'condim="1" priority="1"'
+    assert old in text
+    path = tmp_path / "burger.xml"
+    path.write_text(text.replace(old, 'condim="1"'))
+    robot = replace(builtin_robot("burger"), model=str(path), label=path.name)
+    world = MujocoInterface("empty", robot=robot)
+    assert world.geometry_sources()["casters"] == (
+        "made frictionless by otonav: 'caster' (condim 1, priority 0)"
+    )
+    drive(world, speed=0.2 / 0.033, seconds=2.0)
+    assert world.ground_truth().x > 0.3
+
+
+def urdf_variant(tmp_path: Path, name: str, old: str, new: str) -> RobotDescription:
+    shutil.copytree(PATHFINDER / "meshes", tmp_path / "meshes", dirs_exist_ok=True)
+    text = (PATHFINDER / "pathfinder.urdf").read_text()
+    assert old in text
+    path = tmp_path / name
+    path.write_text(text.replace(old, new))
+    return urdf(model=str(path), label=name)
+
+
+def test_a_urdf_using_xacro_is_refused_with_the_command_that_expands_it(tmp_path: Path) -> None:
+    """MuJoCo reads a xacro file without its macros (issue 41 case 14: the caster gone)."""
+    robot = urdf_variant(
+        tmp_path,
+        "pathfinder.urdf.xacro",
+        '<robot name="pathfinder">',
+        '<robot name="pathfinder" xmlns:xacro="http://ros.org/wiki/xacro">\n'
+        '  <xacro:include filename="caster.xacro"/>',
+    )
+    with pytest.raises(SceneError) as caught:
+        MujocoInterface("empty", robot=robot)
+    assert str(caught.value) == (
+        "robot.model: pathfinder.urdf.xacro uses xacro (<xacro:include>), which otonav does "
+        "not expand: expand it first (xacro pathfinder.urdf.xacro > pathfinder.urdf) and name "
+        "the result"
+    )
+
+
+def test_a_plain_urdf_that_declares_the_xacro_namespace_is_read(tmp_path: Path) -> None:
+    """ROBOTIS's expanded turtlebot3_burger.urdf declares xmlns:xacro and keeps a
+    commented-out include: no xacro left in it, so it loads."""
+    robot = urdf_variant(
+        tmp_path,
+        "expanded.urdf",
+        '<robot name="pathfinder">',
+        '<robot name="pathfinder" xmlns:xacro="http://ros.org/wiki/xacro">\n'
+        '  <!-- <xacro:include filename="caster.xacro"/> -->',
+    )
+    assert MujocoInterface("empty", robot=robot).geometry.wheel_radius > 0.07

@@ -126,12 +126,13 @@ class MujocoInterface(RobotHardwareInterface):
             prefix = ROBOT_PREFIX
         parts = _RobotSpec(robot_spec, robot, robot_file)
         probe = _probe(parts)
-        parts.casters(probe.floor)
+        parts.casters(probe.resting)
         parts.prepare(probe.mass, probe.wheel_radius)
         lidar_site = parts.mount("lidar", robot.lidar, (0.0, 0.0, probe.top + _MOUNT_ABOVE))
         imu_site = parts.mount("imu", robot.imu, (0.0, 0.0, 0.0))
         parts.imu_sensors(imu_site)
         self._ctrl_scale = (parts.ctrl_scale["left_wheel"], parts.ctrl_scale["right_wheel"])
+        mover = str(parts.base.name)  # the body that moves: robot.base, or above it
         if prefix:
             if abs(probe.bottom) > _REST_TOLERANCE:
                 parts.base.pos[2] -= probe.bottom  # rest on the floor, not in or above it
@@ -152,7 +153,7 @@ class MujocoInterface(RobotHardwareInterface):
                 raise SceneError(f"{robot_file}: {name!r} missing after compiling")
             return found
 
-        self._chassis = ident(obj.mjOBJ_BODY, robot.base)
+        self._chassis = ident(obj.mjOBJ_BODY, mover)
         base_joint = int(m.body_jntadr[self._chassis])
         self._base_qpos = int(m.jnt_qposadr[base_joint])
         self._base_qvel = int(m.jnt_dofadr[base_joint])
@@ -168,7 +169,7 @@ class MujocoInterface(RobotHardwareInterface):
         self._accel = _site_sensor(m, mujoco.mjtSensor.mjSENS_ACCELEROMETER, self._imu_site)
         self._quat = _site_sensor(m, mujoco.mjtSensor.mjSENS_FRAMEQUAT, self._imu_site)
 
-        derived = _Derivation(m, self._chassis, parts)
+        derived = _Derivation(m, ident(obj.mjOBJ_BODY, robot.base), parts)
         self._wheel_sign = (derived.wheel_sign(left_joint), derived.wheel_sign(right_joint))
         self._mirrored = self._wheel_sign != (1.0, 1.0)
         self._ctrl_scale = (
@@ -176,7 +177,7 @@ class MujocoInterface(RobotHardwareInterface):
             self._ctrl_scale[1] * self._wheel_sign[1],
         )
         self._geometry = derived.geometry(
-            (left_joint, right_joint), self._lidar_site, self._imu_site, self._base_qpos
+            (left_joint, right_joint), self._lidar_site, self._imu_site
         )
         self._sources = {**parts.sources, **derived.sources}
         self._obstacles = self._static_boxes("obstacle")
