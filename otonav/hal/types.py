@@ -154,6 +154,30 @@ class RobotGeometry:
 
 
 @dataclass(frozen=True, slots=True)
+class Reach:
+    """What the robot really reaches when asked for ``asked_v`` m/s straight ahead and
+    ``asked_omega`` rad/s in place: its steady speeds ``v`` (m/s) and ``omega`` (rad/s),
+    and the mean accelerations to 90 % of them (m/s^2, rad/s^2). Identified in sim time
+    on a copy of the robot alone on a floor (ADR 0066)."""
+
+    asked_v: float
+    asked_omega: float
+    v: float
+    omega: float
+    accel: float
+    alpha: float
+
+    def line(self) -> str:
+        """One line for ``otonav info`` and the verdict."""
+        v, omega = self.v / self.asked_v, self.omega / self.asked_omega
+        return (
+            f"{self.v:.3g} of {self.asked_v:.3g} m/s asked ({v:.0%}), {self.omega:.3g} of "
+            f"{self.asked_omega:.3g} rad/s ({omega:.0%}), accel {self.accel:.3g} m/s^2, "
+            f"{self.alpha:.3g} rad/s^2"
+        )
+
+
+@dataclass(frozen=True, slots=True)
 class BoxObstacle:
     """An upright box in the world plane: centre (x, y) m, half sizes m, yaw rad."""
 

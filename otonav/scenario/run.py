@@ -21,6 +21,7 @@ from otonav import limits
 from otonav._version import __version__
 from otonav.actors import topics
 from otonav.hal import RobotHardwareInterface
+from otonav.hal.types import Reach
 from otonav.msgs import Header, Point, Pose, PoseStamped, ScenarioVerdict, Time
 from otonav.record.diskfull import DiskFullError, is_disk_full
 from otonav.record.outlock import lock_output
@@ -43,7 +44,7 @@ from otonav.scenario.judge import Judge
 from otonav.scenario.plot import plot_trajectory
 from otonav.scenario.validate import check_cost, check_goal
 from otonav.stack import StackConfig, build_actors, build_world
-from otonav.stack.robot import describe_robot
+from otonav.stack.robot import describe_robot, reached, slower
 from otonav.stack.session import StackSession
 
 VERDICT_TOPIC = "/scenario/verdict"
@@ -120,10 +121,15 @@ under the default ``nav.max_v``). A robot whose description states a lower top s
 its top speed, so the same courses judge it fairly (ADR 0041)."""
 
 
-def for_robot(scenario: ScenarioConfig, stack: StackConfig) -> ScenarioConfig:
+def for_robot(
+    scenario: ScenarioConfig, stack: StackConfig, reach: Reach | None = None
+) -> ScenarioConfig:
     """``scenario`` as run with ``stack``'s robot: its sim budget scaled to the robot's
-    stated top speed when that is below :data:`BUDGET_SPEED`."""
+    stated top speed, or to the one it really reaches (``reach``, ADR 0066), when that is
+    below :data:`BUDGET_SPEED`."""
     top = describe_robot(stack.robot).max_v
+    if reach is not None and slower(reach) < 1.0:
+        top = min(top, reach.v) if top is not None else reach.v
     if top is None or top >= BUDGET_SPEED:
         return scenario
     budget = min(scenario.sim_budget * BUDGET_SPEED / top, limits.MAX_SIM_BUDGET_S)
@@ -138,13 +144,13 @@ def scenario_world(
     pose, checked: a goal or start outside the arena or on an obstacle raises
     ``ConfigFileError`` naming ``source`` (the world is then closed)."""
     stack = effective_stack(scenario, stack)
-    scenario = for_robot(scenario, stack)
     hal = build_world(
         stack,
         extra_obstacles=[b.to_obstacle() for b in scenario.obstacles],
         start=scenario.start.as_tuple(),
     )
     try:
+        scenario = for_robot(scenario, stack, reached(stack, hal))
         check_goal(scenario, stack.world.scene, hal.obstacles(), hal.walls(), source=source)
         check_cost(scenario, stack, len(hal.obstacles() + hal.walls()), source=source)
     except BaseException:
@@ -615,6 +621,7 @@ def robot_summary(stack: StackConfig, hal: RobotHardwareInterface) -> dict[str, 
         "wheel_separation": g.wheel_separation,
         "footprint_radius": g.footprint_radius,
         "laser_offset": [g.laser_offset_x, g.laser_offset_z],
+        "reach": asdict(reach) if (reach := reached(stack, hal)) is not None else None,
         "sources": hal.geometry_sources(),
     }
 

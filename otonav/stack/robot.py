@@ -5,12 +5,15 @@ against the config file it was written in."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Final
 
 from otonav.hal.description import BUILTIN_ROBOTS, Mount, RobotDescription, builtin_robot
+from otonav.hal.interface import RobotHardwareInterface
+from otonav.hal.types import Reach
 from otonav.stack.config import BaseConfig, MountConfig, RobotConfig, StackConfig
 from otonav.stack.files import ConfigFileError
 
-__all__ = ["describe_robot", "robot_base", "top_speed"]
+__all__ = ["describe_robot", "reached", "robot_base", "slower", "top_speed"]
 
 
 def _mount(config: MountConfig | None) -> Mount | None:
@@ -72,3 +75,24 @@ def robot_base(stack: StackConfig) -> BaseConfig:
 def top_speed(stack: StackConfig) -> float:
     """m/s: the fastest the robot may drive (the base's limit, capped by the robot's)."""
     return robot_base(stack).max_v
+
+
+REACHED: Final = 0.95
+"""A robot that reaches this share of the asked speed is taken at the asked figure (the
+identification's few percent are not worth a different navigator; ADR 0066)."""
+
+
+def reached(stack: StackConfig, hal: RobotHardwareInterface) -> Reach | None:
+    """What ``hal``'s robot really reaches when the navigator asks its top speeds (the
+    nav's, capped by the base's and the robot's); None when the HAL cannot tell."""
+    base, nav = robot_base(stack), stack.nav
+    return hal.reach(min(nav.max_v, base.max_v), min(nav.max_omega, base.max_omega))
+
+
+def slower(reach: Reach | None) -> float:
+    """The share of the asked speed the robot reaches: 1.0 when it reaches at least
+    :data:`REACHED` of it (or nobody measured)."""
+    if reach is None:
+        return 1.0
+    share = reach.v / reach.asked_v
+    return share if share < REACHED else 1.0

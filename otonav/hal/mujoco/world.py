@@ -44,6 +44,7 @@ from otonav.hal.description import RobotDescription, builtin_robot
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.mujoco._lib import mujoco, viewer_module
 from otonav.hal.mujoco.derive import _actuator_of, _Derivation, _probe, _site_sensor
+from otonav.hal.mujoco.identify import _Robot, identify
 from otonav.hal.mujoco.prepare import ROBOT_PREFIX, _load_robot, _merge_options, _RobotSpec
 from otonav.hal.mujoco.scene import SceneError, _add_box, _compile, _load_spec
 from otonav.hal.mujoco.static_geoms import ray_caster
@@ -53,6 +54,7 @@ from otonav.hal.types import (
     GroundTruth,
     ImuSample,
     RangeScan,
+    Reach,
     RobotGeometry,
     WheelSetpoint,
     WheelState,
@@ -64,6 +66,7 @@ __all__ = ["MujocoInterface"]
 _RAY_GROUPS: Final = np.array([1, 0, 1, 0, 0, 0], dtype=np.uint8)  # groups 0 and 2
 _SETTLE_TIME: Final = 0.25  # s of physics run at construction, before tick 0
 _MOUNT_ABOVE: Final = 0.02  # m: a default lidar sits this far above the robot's top
+_IDENTIFY_S: Final = 5.5  # s of sim the identification runs (settle, straight, turn)
 _REST_TOLERANCE: Final = 1e-3  # m: a model resting within this of the floor is not moved
 
 
@@ -180,6 +183,16 @@ class MujocoInterface(RobotHardwareInterface):
             (left_joint, right_joint), self._lidar_site, self._imu_site
         )
         self._sources = {**parts.sources, **derived.sources}
+        self._spec = spec
+        self._identity = _Robot(
+            body=prefix + mover,
+            left=prefix + robot.left_wheel,
+            right=prefix + robot.right_wheel,
+            scale=self._ctrl_scale,
+            radius=self._geometry.wheel_radius,
+            separation=self._geometry.wheel_separation,
+        )
+        self._reach: dict[tuple[float, float], Reach] = {}
         self._obstacles = self._static_boxes("obstacle")
         self._walls = self._static_boxes("wall")
         self._is_floor = np.asarray(m.geom_type == mujoco.mjtGeom.mjGEOM_PLANE, dtype=np.bool_)
@@ -492,6 +505,15 @@ class MujocoInterface(RobotHardwareInterface):
     def robot(self) -> RobotDescription:
         """The description this world's robot was built from."""
         return self._robot
+
+    def reach(self, v: float, omega: float) -> Reach:
+        """Identified in sim time on a copy of the world with only the robot in it
+        (ADR 0066): this world's physics is not touched. Recorded in the sources."""
+        if (v, omega) not in self._reach:
+            found = identify(self._spec, self._identity, v, omega)
+            self._reach[(v, omega)] = found
+            self._sources["reach"] = f"identified in {_IDENTIFY_S:g} s of sim: {found.line()}"
+        return self._reach[(v, omega)]
 
     def obstacles(self) -> tuple[BoxObstacle, ...]:
         return self._obstacles
