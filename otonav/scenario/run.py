@@ -682,6 +682,7 @@ def judge_verdict(
             else f"reported unreachable at {judge.unreachable_at:.1f} s, as expected, "
             "with clearance"
         )
+    reasons.extend(judge.slips)
     if judge.recoveries:
         reasons.append(f"recoveries: {'; '.join(judge.recoveries)}")
     return Verdict(
