@@ -404,3 +404,31 @@ def test_the_robot_identified_in_sim_time_reaches_what_its_servos_allow() -> Non
     strong = MujocoInterface("empty", robot=builtin_robot("burger")).reach(0.22, 2.84)
     assert strong.v == pytest.approx(0.22, rel=0.02)
     assert strong.omega == pytest.approx(2.84, rel=0.05)
+
+
+@pytest.mark.parametrize(
+    ("model", "base", "lidar"),
+    [
+        ("skeleton.xml", "base_link", None),
+        ("skeleton.urdf", "base_footprint", Mount(body="laser", pos=(0.0, 0.0, 0.0))),
+    ],
+)
+def test_the_docs_skeletons_drive_as_written(model: str, base: str, lidar: Mount | None) -> None:
+    """docs/how-to/own-robot.md's skeletons: names only, everything else otonav's."""
+    path = TB3.parent / model
+    robot = RobotDescription(
+        model=str(path),
+        label=model,
+        base=base,
+        left_wheel="left_wheel_joint",
+        right_wheel="right_wheel_joint",
+        lidar=lidar,
+    )
+    world = MujocoInterface("empty", robot=robot)
+    assert world.geometry.wheel_radius == pytest.approx(0.05)
+    assert world.geometry.wheel_separation == pytest.approx(0.26)
+    assert "frictionless" in world.geometry_sources()["casters"]
+    drive(world, speed=4.0, seconds=2.0)
+    truth = world.ground_truth()
+    assert truth.x > 0.3
+    assert abs(truth.pitch) < 0.03
