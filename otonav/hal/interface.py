@@ -99,6 +99,10 @@ class RobotHardwareInterface(abc.ABC):
         from the model, or given in the robot description. Empty when not known."""
         return {}
 
+    def tallest_obstacle(self) -> float | None:
+        """m: the top of the tallest obstacle above the floor; None if none or unknown."""
+        return None
+
     def reach(self, v: float, omega: float) -> Reach | None:
         """What the robot really reaches when asked for ``v`` m/s and ``omega`` rad/s
         (:class:`Reach`); None when this interface cannot tell (the stack then trusts

@@ -623,7 +623,20 @@ def robot_summary(stack: StackConfig, hal: RobotHardwareInterface) -> dict[str, 
         "laser_offset": [g.laser_offset_x, g.laser_offset_z],
         "reach": asdict(reach) if (reach := reached(stack, hal)) is not None else None,
         "sources": hal.geometry_sources(),
+        "warnings": lidar_over_obstacles(hal),
     }
+
+
+def lidar_over_obstacles(hal: RobotHardwareInterface) -> list[str]:
+    """A lidar above the tallest obstacle sees none of them (issue 38): a warning."""
+    g, top = hal.geometry, hal.tallest_obstacle()
+    height = g.base_height + g.laser_offset_z
+    if top is None or height < top:
+        return []
+    return [
+        f"warning: the lidar is {height:.2f} m above the floor, over the tallest obstacle "
+        f"({top:.2f} m): it sees none of them; mount it lower (robot.lidar)"
+    ]
 
 
 def judge_verdict(
@@ -683,6 +696,7 @@ def judge_verdict(
             "with clearance"
         )
     reasons.extend(judge.slips)
+    reasons.extend((robot or {}).get("warnings", ()))
     if judge.recoveries:
         reasons.append(f"recoveries: {'; '.join(judge.recoveries)}")
     return Verdict(

@@ -12,9 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from otonav.hal import WheelSetpoint
+from otonav.hal import BoxObstacle, WheelSetpoint
 from otonav.hal.description import Mount, RobotDescription, builtin_robot
 from otonav.hal.mujoco import MujocoInterface, SceneError
+from otonav.scenario.run import lidar_over_obstacles
 
 PATHFINDER = Path(__file__).resolve().parents[2] / "examples" / "my_robot"
 
@@ -432,3 +433,21 @@ def test_the_docs_skeletons_drive_as_written(model: str, base: str, lidar: Mount
     truth = world.ground_truth()
     assert truth.x > 0.3
     assert abs(truth.pitch) < 0.03
+
+
+@pytest.mark.parametrize(("height", "warned"), [(0.3, False), (0.6, True)])
+def test_a_lidar_over_the_tallest_obstacle_is_warned_of(height: float, warned: bool) -> None:
+    """The courses' boxes are 0.5 m tall: a lidar at 0.6 m sees none of them."""
+    world = MujocoInterface(
+        "empty",
+        robot=pathfinder(lidar=Mount(pos=(0.0, 0.0, height))),
+        extra_obstacles=[BoxObstacle(2.0, 0.0, 0.2, 0.2)],
+    )
+    assert world.tallest_obstacle() == pytest.approx(0.5)
+    warnings = lidar_over_obstacles(world)
+    assert bool(warnings) == warned
+    if warned:
+        assert warnings[0].startswith("warning: the lidar is 0.")
+        assert warnings[0].endswith(
+            "over the tallest obstacle (0.50 m): it sees none of them; mount it lower (robot.lidar)"
+        )

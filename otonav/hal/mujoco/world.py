@@ -506,6 +506,16 @@ class MujocoInterface(RobotHardwareInterface):
         """The description this world's robot was built from."""
         return self._robot
 
+    def tallest_obstacle(self) -> float | None:
+        m, tops = self._model, []  # the boxes, not the arena's walls
+        for g in range(m.ngeom):
+            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g) or ""
+            if name.startswith("obstacle") and int(m.geom_bodyid[g]) == 0:
+                tops.append(float(m.geom_pos[g][2] + m.geom_rbound[g]))
+                if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX:  # upright: its half height
+                    tops[-1] = float(m.geom_pos[g][2] + m.geom_size[g][2])
+        return max(tops, default=None)
+
     def reach(self, v: float, omega: float) -> Reach:
         """Identified in sim time on a copy of the world with only the robot in it
         (ADR 0066): this world's physics is not touched. Recorded in the sources."""
