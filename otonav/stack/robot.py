@@ -91,8 +91,8 @@ def reached(stack: StackConfig, hal: RobotHardwareInterface) -> Reach | None:
 
 def slower(reach: Reach | None) -> float:
     """The share of the asked speed the robot reaches: 1.0 when it reaches at least
-    :data:`REACHED` of it (or nobody measured)."""
+    :data:`REACHED` of it, none of it, or nobody measured."""
     if reach is None:
         return 1.0
     share = reach.v / reach.asked_v
-    return share if share < REACHED else 1.0
+    return share if 0.0 < share < REACHED else 1.0  # 0: it never moved; nothing to scale

@@ -451,3 +451,26 @@ def test_a_lidar_over_the_tallest_obstacle_is_warned_of(height: float, warned: b
         assert warnings[0].endswith(
             "over the tallest obstacle (0.50 m): it sees none of them; mount it lower (robot.lidar)"
         )
+
+
+def test_a_wheel_cylinder_turned_in_radians_under_degrees_is_refused(tmp_path: Path) -> None:
+    """MJCF angles are degrees by default: euler="1.5708 0 0" leaves the wheel a flat
+    disk the robot sits on (it never moves): one line naming the key and the fix."""
+    text = (TB3.parent / "skeleton.xml").read_text()
+    assert 'euler="90 0 0"' in text
+    path = tmp_path / "radians.xml"
+    path.write_text(text.replace('euler="90 0 0"', 'euler="1.5708 0 0"'))
+    robot = RobotDescription(
+        model=str(path),
+        label=path.name,
+        base="base_link",
+        left_wheel="left_wheel_joint",
+        right_wheel="right_wheel_joint",
+    )
+    with pytest.raises(SceneError) as caught:
+        MujocoInterface("empty", robot=robot)
+    assert str(caught.value) == (
+        "robot.left_wheel: the wheel's geom of body 'left_wheel' is a cylinder whose axis is "
+        "not the joint's axle, so it cannot roll: turn it (MJCF angles are degrees unless "
+        '<compiler angle="radian"/>)'
+    )

@@ -235,7 +235,14 @@ class _Derivation:
         k = int(np.argmax(np.abs(axis)))
         aligned = abs(float(axis[k])) > 0.999
         round_about_z = kind in (mujoco.mjtGeom.mjGEOM_CYLINDER, mujoco.mjtGeom.mjGEOM_CAPSULE)
-        if kind == mujoco.mjtGeom.mjGEOM_SPHERE or (round_about_z and aligned and k == 2):
+        if round_about_z and not (aligned and k == 2):
+            raise self.parts.fail(
+                "left_wheel",
+                f"the wheel's geom {name} is a {mujoco.mjtGeom(kind).name[7:].lower()} whose "
+                "axis is not the joint's axle, so it cannot roll: turn it (MJCF angles are "
+                'degrees unless <compiler angle="radian"/>)',
+            )
+        if kind == mujoco.mjtGeom.mjGEOM_SPHERE or round_about_z:
             radius = float(size[0])
         elif kind == mujoco.mjtGeom.mjGEOM_ELLIPSOID and aligned:
             radius = float(max(size[i] for i in range(3) if i != k))

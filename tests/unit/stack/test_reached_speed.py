@@ -41,3 +41,10 @@ def test_the_budget_follows_the_speed_really_reached() -> None:
     assert for_robot(box, StackConfig(), reach(0.2)).sim_budget == pytest.approx(
         box.sim_budget * 0.4 / 0.2
     )
+
+
+def test_a_robot_that_never_moved_is_taken_at_the_asked_figures() -> None:
+    config = StackConfig()
+    nominal = navigation_params(config, FakeHardware().geometry)
+    assert navigation_params(config, FakeHardware().geometry, reach(0.0)) == nominal
+    assert for_robot(BUILTIN["box"], config, reach(0.0)).sim_budget == BUILTIN["box"].sim_budget
