@@ -444,6 +444,7 @@ def _ros2_bridge(args: argparse.Namespace, stack: Any) -> Any:
     import sys
 
     from otonav.stack.files import ConfigFileError
+    from otonav.stack.robot import robot_frames
 
     section = stack.ros2
     if not (args.ros2 or section.enabled):
@@ -465,7 +466,7 @@ def _ros2_bridge(args: argparse.Namespace, stack: Any) -> Any:
             section,
             domain_id=args.ros2_domain,
             inputs=args.ros2_inputs or (),
-            base_frame=stack.robot.frames.base,
+            base_frame=robot_frames(stack.robot).base,
         )
     except Ros2Error as exc:
         raise ConfigFileError(str(exc)) from None

@@ -34,6 +34,7 @@ from otonav.runtime import (
     System,
 )
 from otonav.stack import StackConfig, build_actors, build_world
+from otonav.stack.robot import robot_frames
 from otonav.stack.session import StackSession
 
 M = TypeVar("M")
@@ -374,7 +375,7 @@ async def open_live_stack(
             if ros2 or stack.ros2.enabled:
                 from otonav.ros2 import bridge_for
 
-                bridge = bridge_for(stack.ros2, base_frame=stack.robot.frames.base)
+                bridge = bridge_for(stack.ros2, base_frame=robot_frames(stack.robot).base)
                 actors.append(bridge)
         except BaseException:
             hal.close()

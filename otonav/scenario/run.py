@@ -41,7 +41,7 @@ from otonav.runtime._asyncio_compat import preload_anyio_backend
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.crash import RunCrashedError, crash_reason
 from otonav.scenario.judge import Judge
-from otonav.scenario.plot import plot_trajectory
+from otonav.scenario.plot import key_poses, plot_trajectory
 from otonav.scenario.validate import check_cost, check_goal
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.robot import describe_robot, reached, slower
@@ -539,6 +539,8 @@ def save_artifacts(
                 scenario.goal_tolerance,
                 judge.min_clearance_at,
                 verdict_title(verdict.scenario, verdict.passed, verdict.reason),
+                footprint=judge.hal.geometry.footprint,
+                poses=key_poses(judge.trajectory, scenario.start.yaw, judge.min_clearance_at),
             )
         except OSError as exc:
             if not is_disk_full(exc):

@@ -21,7 +21,6 @@ from otonav.actors import (
 from otonav.actors.localized_navigator import LocalizedNavigator
 from otonav.actors.localizer import Localizer, LocalizerParams
 from otonav.actors.odometry_error import OdometryError
-from otonav.actors.topics import Frames
 from otonav.control import DiffDriveGeometry
 from otonav.hal import BoxObstacle, RobotGeometry, RobotHardwareInterface
 from otonav.hal.mujoco import MujocoInterface
@@ -36,7 +35,7 @@ from otonav.runtime import Actor
 from otonav.stack.config import StackConfig
 from otonav.stack.files import ConfigFileError
 from otonav.stack.launch import launch
-from otonav.stack.robot import describe_robot, reached, robot_base, slower
+from otonav.stack.robot import describe_robot, reached, robot_base, robot_frames, slower
 
 if TYPE_CHECKING:
     from otonav.hal.can import CanBusInterface
@@ -173,7 +172,7 @@ def build_actors(
             scan_hz=rates.scan_hz,
             initial_pose=initial_pose,
             odometry_error=odometry_error(config),
-            frames=Frames(**config.robot.frames.model_dump()),
+            frames=robot_frames(config.robot),
         ),
         BaseController(
             DiffDriveGeometry(geometry.wheel_radius, geometry.wheel_separation),

@@ -7,13 +7,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Final
 
+from otonav.actors.topics import FRAMES, Frames
 from otonav.hal.description import BUILTIN_ROBOTS, Mount, RobotDescription, builtin_robot
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.types import Reach
 from otonav.stack.config import BaseConfig, MountConfig, RobotConfig, StackConfig
 from otonav.stack.files import ConfigFileError
 
-__all__ = ["describe_robot", "reached", "robot_base", "slower", "top_speed"]
+__all__ = ["describe_robot", "reached", "robot_base", "robot_frames", "slower", "top_speed"]
 
 
 def _mount(config: MountConfig | None) -> Mount | None:
@@ -56,6 +57,32 @@ def describe_robot(config: RobotConfig) -> RobotDescription:
         footprint=config.footprint,
         max_v=config.max_v if config.max_v is not None else base.max_v,
         max_omega=config.max_omega if config.max_omega is not None else base.max_omega,
+    )
+
+
+def _frame(mount: Mount | None, default: str) -> str:
+    if mount is None:
+        return default
+    return mount.site or mount.body or default
+
+
+def robot_frames(config: RobotConfig) -> Frames:
+    """The frame ids otonav stamps: ``robot.frames`` where set, else the model's names
+    (the base body; the lidar's and the IMU's site or body), else otonav's."""
+    given = config.frames
+    if config.model == "otonav":
+        model = FRAMES
+    else:
+        robot = describe_robot(config)
+        model = Frames(
+            base=robot.base,
+            laser=_frame(robot.lidar, FRAMES.laser),
+            imu=_frame(robot.imu, FRAMES.imu),
+        )
+    return Frames(
+        base=given.base or model.base,
+        laser=given.laser or model.laser,
+        imu=given.imu or model.imu,
     )
 
 

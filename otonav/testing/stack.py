@@ -11,6 +11,7 @@ from otonav.hal import BoxObstacle, RobotHardwareInterface
 from otonav.runtime import Actor, System
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.loading import load_stack_file
+from otonav.stack.robot import robot_frames
 from otonav.stack.session import StackSession
 
 
@@ -65,7 +66,7 @@ async def running_stack(
         if config.ros2.enabled:
             from otonav.ros2 import bridge_for
 
-            bridge = bridge_for(config.ros2, base_frame=config.robot.frames.base)
+            bridge = bridge_for(config.ros2, base_frame=robot_frames(config.robot).base)
             actors.append(bridge)
     except BaseException:
         hal.close()
