@@ -145,6 +145,8 @@ class RobotGeometry:
     every collision geom of the robot, projected on the floor); the default is that
     rectangle for ``otonav/hal/assets/robot.xml`` (chassis box 0.30 x 0.18 m centred
     0.06 m ahead of the axle, wheels reaching y = +-0.1225 m)."""
+    wheel_joints: tuple[str, str] = ("left_wheel", "right_wheel")
+    """The wheel joints' names in the model (/joint_states)."""
 
     @property
     def footprint_radius(self) -> float:

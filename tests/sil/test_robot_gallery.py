@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+from otonav.record.reader import read_messages
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.scenario.builtin import BUILTIN
 from otonav.stack import StackConfig
@@ -41,13 +42,26 @@ def test_each_example_robot_passes_the_courses_it_can_physically_pass(
     assert verdict.passed, verdict.reason
 
 
-def test_robotis_burger_with_its_lidar_inside_the_housing_passes_the_easy_course() -> None:
+def test_robotis_burger_with_its_lidar_inside_the_housing_passes_the_easy_course(
+    tmp_path: Path,
+) -> None:
+    """The model's frames on /tf and its wheel joints on /joint_states, recorded."""
     stack = load_stack_file(ROBOTS / "turtlebot3_burger.yaml")
-    verdict = run_scenario(EASY, stack, record=False, plot=False)
+    verdict = run_scenario(EASY, stack, out_dir=tmp_path, plot=False)
     assert verdict.passed, verdict.reason
     reach = verdict.robot["reach"]
     assert reach["v"] < 0.9 * reach["asked_v"]  # the weak servos, as ROBOTIS wrote them
     assert "made frictionless" in verdict.robot["sources"]["casters"]
+    recording = tmp_path / "recording.mcap"
+    ((_topic, _t, static),) = read_messages(recording, ["/tf_static"])
+    assert {(t.header.frame_id, t.child_frame_id) for t in static.transforms} == {
+        ("base_footprint", "base_scan"),
+        ("base_footprint", "imu_link"),
+    }
+    joints = [m for _topic, _t, m in read_messages(recording, ["/joint_states"])]
+    assert len(joints) >= 10 * verdict.sim_time_s - 1  # 10 Hz
+    assert all(list(m.name) == ["wheel_left_joint", "wheel_right_joint"] for m in joints)
+    assert joints[-1].position[0] > 2.0 / 0.033 * 0.8  # rad rolled over ~2.2 m
 
 
 def test_a_robot_reaching_70_percent_of_the_asked_speed_still_passes(tmp_path: Path) -> None:

@@ -124,6 +124,7 @@ PINNED: dict[str, tuple[str, ...]] = {
         "HardwareStatus",
         "Header",
         "Imu",
+        "JointState",
         "KeyValue",
         "LaserScan",
         "Log",

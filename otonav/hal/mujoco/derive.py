@@ -186,6 +186,7 @@ class _Derivation:
             base_height=float(self.origin[2]),
             imu_offset=(float(imu_pos[0]), float(imu_pos[1]), float(imu_pos[2])),
             footprint=footprint,
+            wheel_joints=(self.robot.left_wheel, self.robot.right_wheel),
         )
 
     def _given(self, key: str, value: object) -> bool:
