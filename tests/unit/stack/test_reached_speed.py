@@ -48,3 +48,12 @@ def test_a_robot_that_never_moved_is_taken_at_the_asked_figures() -> None:
     nominal = navigation_params(config, FakeHardware().geometry)
     assert navigation_params(config, FakeHardware().geometry, reach(0.0)) == nominal
     assert for_robot(BUILTIN["box"], config, reach(0.0)).sim_budget == BUILTIN["box"].sim_budget
+
+
+def test_the_verdict_table_says_what_the_robot_reached() -> None:
+    from otonav.cli.run import reach_row
+
+    assert reach_row({"v": 0.187, "asked_v": 0.22}) == [
+        ("reaches", "0.187 of 0.22 m/s asked (85%)")
+    ]
+    assert reach_row(None) == []
