@@ -168,6 +168,9 @@ class Reach:
     omega: float
     accel: float
     alpha: float
+    deadband: float = 0.0
+    """rad/s of wheel speed a command loses whatever its size (friction against a weak
+    servo): the constant part of the deficit, from a second step at half the speed."""
 
     def line(self) -> str:
         """One line for ``otonav info`` and the verdict."""
@@ -175,7 +178,7 @@ class Reach:
         return (
             f"{self.v:.3g} of {self.asked_v:.3g} m/s asked ({v:.0%}), {self.omega:.3g} of "
             f"{self.asked_omega:.3g} rad/s ({omega:.0%}), accel {self.accel:.3g} m/s^2, "
-            f"{self.alpha:.3g} rad/s^2"
+            f"{self.alpha:.3g} rad/s^2, deadband {self.deadband:.3g} rad/s of wheel speed"
         )
 
 

@@ -35,7 +35,14 @@ from otonav.runtime import Actor
 from otonav.stack.config import StackConfig
 from otonav.stack.files import ConfigFileError
 from otonav.stack.launch import launch
-from otonav.stack.robot import describe_robot, reached, robot_base, robot_frames, slower
+from otonav.stack.robot import (
+    deadband,
+    describe_robot,
+    reached,
+    robot_base,
+    robot_frames,
+    slower,
+)
 
 if TYPE_CHECKING:
     from otonav.hal.can import CanBusInterface
@@ -179,6 +186,7 @@ def build_actors(
             BaseLimits(base.max_v, base.max_omega, base.max_accel, base.max_alpha),
             rate_hz=base.rate_hz,
             cmd_timeout=base.cmd_timeout,
+            deadband=deadband(reached(config, hal)),
         ),
     ]
     if config.hal.kind == "can" and config.hal.can.record_frames:

@@ -14,7 +14,15 @@ from otonav.hal.types import Reach
 from otonav.stack.config import BaseConfig, MountConfig, RobotConfig, StackConfig
 from otonav.stack.files import ConfigFileError
 
-__all__ = ["describe_robot", "reached", "robot_base", "robot_frames", "slower", "top_speed"]
+__all__ = [
+    "deadband",
+    "describe_robot",
+    "reached",
+    "robot_base",
+    "robot_frames",
+    "slower",
+    "top_speed",
+]
 
 
 def _mount(config: MountConfig | None) -> Mount | None:
@@ -123,3 +131,10 @@ def slower(reach: Reach | None) -> float:
         return 1.0
     share = reach.v / reach.asked_v
     return share if 0.0 < share < REACHED else 1.0  # 0: it never moved; nothing to scale
+
+
+def deadband(reach: Reach | None) -> float:
+    """rad/s the base adds to each turning wheel's command (ADR 0066): the robot's
+    identified deadband when it is slower than asked, else 0 (a robot that reaches its
+    speed is driven exactly as before)."""
+    return reach.deadband if reach is not None and slower(reach) < 1.0 else 0.0

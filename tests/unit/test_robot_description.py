@@ -392,19 +392,22 @@ def test_a_plain_urdf_that_declares_the_xacro_namespace_is_read(tmp_path: Path) 
 
 def test_the_robot_identified_in_sim_time_reaches_what_its_servos_allow() -> None:
     """ADR 0066: kv 0.1 servos with 0.1 N m of friction loss fall short of the asked
-    speed by a constant; otonav's own servos reach it. The world is not touched."""
+    speed by a constant, their deadband; otonav's own servos reach it. The world is not
+    touched."""
     weak = MujocoInterface("obstacles", robot=turtlebot3())
     before = weak.ground_truth()
     reach = weak.reach(0.22, 2.84)
     assert 0.15 < reach.v < 0.2  # ~85 % of 0.22
     assert reach.omega < 0.8 * 2.84
     assert reach.accel > 0.5
+    assert reach.deadband == pytest.approx(1.0, abs=0.15)  # frictionloss / kv, rad/s
     assert weak.ground_truth() == before
     assert weak.ticks == 0
-    assert weak.geometry_sources()["reach"].startswith("identified in 5.5 s of sim: 0.187 of")
+    assert weak.geometry_sources()["reach"].startswith("identified in 9 s of sim: 0.187 of")
     strong = MujocoInterface("empty", robot=builtin_robot("burger")).reach(0.22, 2.84)
     assert strong.v == pytest.approx(0.22, rel=0.02)
     assert strong.omega == pytest.approx(2.84, rel=0.05)
+    assert strong.deadband < 0.05
 
 
 @pytest.mark.parametrize(

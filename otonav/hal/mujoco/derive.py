@@ -108,13 +108,20 @@ def _geom_half(model: Any, geom: int) -> tuple[NDArray[np.float64], NDArray[np.f
 
 
 def _geom_corners(model: Any, data: Any, geom: int) -> NDArray[np.float64]:
-    """The 8 corners of ``geom``'s bounding box, world frame."""
-    centre, half = _geom_half(model, geom)
-    local = _SIGNS * half + centre
-    corners: NDArray[np.float64] = (
+    """Points that bound ``geom``, world frame: a mesh's own vertices (its bounding box
+    turns with the mesh's principal axes, arbitrary about a wheel's axle, and reached
+    ~14 mm under a tyre), else the 8 corners of its bounding box."""
+    if int(model.geom_type[geom]) == mujoco.mjtGeom.mjGEOM_MESH:
+        mesh = int(model.geom_dataid[geom])
+        start, count = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
+        local = np.asarray(model.mesh_vert[start : start + count], dtype=np.float64)
+    else:
+        centre, half = _geom_half(model, geom)
+        local = _SIGNS * half + centre
+    points: NDArray[np.float64] = (
         local @ data.geom_xmat[geom].reshape(3, 3).T + data.geom_xpos[geom]
     )
-    return corners
+    return points
 
 
 def _shown_name(model: Any, kind: Any, ident: int) -> str:

@@ -69,9 +69,22 @@ def identify(spec: Any, robot: _Robot, v: float, omega: float) -> Reach:
 
     wheel = v / robot.radius
     speed, accel = run(wheel, wheel, _STRAIGHT, forward)
+    half, _ = run(wheel / 2, wheel / 2, _STRAIGHT, forward)
     turn = omega * robot.separation / 2.0 / robot.radius
     rate, alpha = run(-turn, turn, _TURN, lambda: data.qvel[dof + 5])
-    return Reach(asked_v=v, asked_omega=omega, v=speed, omega=rate, accel=accel, alpha=alpha)
+    # reached = gain x asked - loss, in wheel rad/s: the loss over the gain is what a
+    # command must carry more to get where it asks (a servo's friction, its deadband).
+    gain = (speed - half) / (v / 2)
+    deadband = (gain * wheel - speed / robot.radius) / gain if gain > 0.0 else 0.0
+    return Reach(
+        asked_v=v,
+        asked_omega=omega,
+        v=speed,
+        omega=rate,
+        accel=accel,
+        alpha=alpha,
+        deadband=max(0.0, deadband),
+    )
 
 
 def _alone(spec: Any, body: str) -> tuple[Any, Any]:

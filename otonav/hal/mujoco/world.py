@@ -66,7 +66,7 @@ __all__ = ["MujocoInterface"]
 _RAY_GROUPS: Final = np.array([1, 0, 1, 0, 0, 0], dtype=np.uint8)  # groups 0 and 2
 _SETTLE_TIME: Final = 0.25  # s of physics run at construction, before tick 0
 _MOUNT_ABOVE: Final = 0.02  # m: a default lidar sits this far above the robot's top
-_IDENTIFY_S: Final = 5.5  # s of sim the identification runs (settle, straight, turn)
+_IDENTIFY_S: Final = 9.0  # s of sim the identification runs (settle, 2 straight, turn)
 _REST_TOLERANCE: Final = 1e-3  # m: a model resting within this of the floor is not moved
 
 

@@ -12,12 +12,15 @@ from otonav.scenario.builtin import BUILTIN
 from otonav.scenario.run import for_robot
 from otonav.stack import StackConfig
 from otonav.stack.build import navigation_params
+from otonav.stack.robot import deadband
 
 pytestmark = pytest.mark.unit
 
 
 def reach(v: float, accel: float = 5.0, alpha: float = 50.0) -> Reach:
-    return Reach(asked_v=0.4, asked_omega=1.2, v=v, omega=1.0, accel=accel, alpha=alpha)
+    return Reach(
+        asked_v=0.4, asked_omega=1.2, v=v, omega=1.0, accel=accel, alpha=alpha, deadband=0.8
+    )
 
 
 def test_a_robot_at_70_percent_gets_a_longer_progress_window_and_its_accelerations() -> None:
@@ -57,3 +60,9 @@ def test_the_verdict_table_says_what_the_robot_reached() -> None:
         ("reaches", "0.187 of 0.22 m/s asked (85%)")
     ]
     assert reach_row(None) == []
+
+
+def test_the_base_carries_the_deadband_only_of_a_robot_slower_than_asked() -> None:
+    assert deadband(reach(0.28)) == 0.8
+    assert deadband(reach(0.39)) == 0.0  # reaches its speed: driven as before
+    assert deadband(None) == 0.0
