@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import shutil
+import struct
 from dataclasses import replace
 from pathlib import Path
 
@@ -477,3 +478,61 @@ def test_a_wheel_cylinder_turned_in_radians_under_degrees_is_refused(tmp_path: P
         "not the joint's axle, so it cannot roll: turn it (MJCF angles are degrees unless "
         '<compiler angle="radian"/>)'
     )
+
+
+def _tyre_stl(path: Path, radius_mm: float, width_mm: float, sides: int = 48) -> None:
+    """A binary STL of a round tyre (a prism about z), in millimetres."""
+    ring = [
+        (
+            radius_mm * math.cos(2 * math.pi * k / sides),
+            radius_mm * math.sin(2 * math.pi * k / sides),
+        )
+        for k in range(sides)
+    ]
+    h = width_mm / 2
+    triangles = []
+    for k in range(sides):
+        (x0, y0), (x1, y1) = ring[k], ring[(k + 1) % sides]
+        triangles += [
+            ((0, 0, -h), (x1, y1, -h), (x0, y0, -h)),
+            ((0, 0, h), (x0, y0, h), (x1, y1, h)),
+            ((x0, y0, -h), (x1, y1, -h), (x1, y1, h)),
+            ((x0, y0, -h), (x1, y1, h), (x0, y0, h)),
+        ]
+    with path.open("wb") as f:
+        f.write(b"\0" * 80 + struct.pack("<I", len(triangles)))
+        for triangle in triangles:
+            f.write(struct.pack("<3f", 0.0, 0.0, 0.0))
+            for vertex in triangle:
+                f.write(struct.pack("<3f", *vertex))
+            f.write(b"\0\0")
+
+
+def test_a_mesh_tyre_turned_about_its_axle_rests_on_the_floor_with_its_caster(
+    tmp_path: Path,
+) -> None:
+    """A mesh's bounding box turns with the mesh (ROBOTIS's tyres: their principal
+    axes): its corners reached 14 mm under the floor, lifted the robot and hid the
+    caster. The mesh's own vertices bound it."""
+    _tyre_stl(tmp_path / "tyre.stl", 50.0, 30.0)
+    text = (TB3.parent / "skeleton.xml").read_text()
+    text = text.replace(
+        '<mujoco model="skeleton">',
+        '<mujoco model="skeleton">\n  <asset><mesh name="tyre" file="tyre.stl" '
+        'scale="0.001 0.001 0.001"/></asset>',
+    )
+    old = '<geom type="cylinder" size="0.05 0.015" euler="90 0 0" mass="0.2"/>'
+    assert text.count(old) == 2
+    text = text.replace(old, '<geom type="mesh" mesh="tyre" euler="90 0 45" mass="0.2"/>')
+    (tmp_path / "meshed.xml").write_text(text)
+    robot = RobotDescription(
+        model=str(tmp_path / "meshed.xml"),
+        label="meshed.xml",
+        base="base_link",
+        left_wheel="left_wheel_joint",
+        right_wheel="right_wheel_joint",
+    )
+    world = MujocoInterface("empty", robot=robot)
+    assert world.geometry.wheel_radius == pytest.approx(0.05, abs=1e-4)
+    assert world.geometry.base_height == pytest.approx(0.05, abs=1e-3)  # not lifted
+    assert "frictionless" in world.geometry_sources()["casters"]
