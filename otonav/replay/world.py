@@ -25,6 +25,7 @@ from otonav.hal import (
     WheelSetpoint,
     WheelState,
 )
+from otonav.hal.types import Reach
 from otonav.replay.recording import Recording
 from otonav.stack import StackConfig
 from otonav.stack.worldmeta import WORLD_METADATA, geometry_from_metadata
@@ -72,6 +73,10 @@ class RecordedRobot(RobotHardwareInterface):
     @property
     def geometry(self) -> RobotGeometry:
         return self._geometry
+
+    def reach(self, v: float, omega: float) -> Reach | None:
+        # The base's deadband and the navigator's limits were built from it (ADR 0066).
+        return self.world().reach(v, omega)
 
     @property
     def tick(self) -> float:

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+from otonav.cli import main
 from otonav.record.reader import read_messages
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.scenario.builtin import BUILTIN
@@ -88,3 +89,14 @@ def test_odometry_parting_from_the_truth_is_flagged_in_the_verdict() -> None:
     assert not verdict.passed
     assert "odometry says reached at " in verdict.reason
     assert verdict.reason.endswith(" m away: wheel slip")
+
+
+def test_the_base_of_a_robot_with_a_deadband_replays_byte_identical(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The replayed robot identifies the deadband again (ADR 0066): without it, the
+    replayed base sent other /wheel_cmd than the recorded one."""
+    stack = load_stack_file(ROBOTS / "turtlebot3_burger.yaml")
+    run_scenario(BUILTIN["empty"], stack, out_dir=tmp_path, plot=False)
+    assert main(["replay", str(tmp_path / "recording.mcap"), "--node", "base"]) == 0
+    assert "SAME: every output byte-identical" in capsys.readouterr().out

@@ -404,7 +404,7 @@ def test_the_robot_identified_in_sim_time_reaches_what_its_servos_allow() -> Non
     assert reach.deadband == pytest.approx(1.0, abs=0.15)  # frictionloss / kv, rad/s
     assert weak.ground_truth() == before
     assert weak.ticks == 0
-    assert weak.geometry_sources()["reach"].startswith("identified in 9 s of sim: 0.187 of")
+    assert weak.geometry_sources()["reach"].startswith("identified in 8.75 s of sim: 0.187 of")
     strong = MujocoInterface("empty", robot=builtin_robot("burger")).reach(0.22, 2.84)
     assert strong.v == pytest.approx(0.22, rel=0.02)
     assert strong.omega == pytest.approx(2.84, rel=0.05)

@@ -13,13 +13,15 @@ from otonav.hal.mujoco._lib import mujoco
 from otonav.hal.mujoco.derive import _actuator_of
 from otonav.hal.types import Reach
 
-__all__: list[str] = []
+__all__ = ["SECONDS"]
 
 _SETTLE: Final = 0.25  # s at rest before the step, as the world settles
 _STRAIGHT: Final = 3.0  # s of the straight step
 _TURN: Final = 2.0  # s of the turn in place
 _STEADY: Final = 1.0  # s at the end of each step whose mean speed is the reached one
 _SAMPLE: Final = 0.01  # s between speed samples
+SECONDS: Final = 3 * _SETTLE + 2 * _STRAIGHT + _TURN
+"""s of sim one identification runs (three steps, each from rest)."""
 
 
 @dataclass(frozen=True, slots=True)

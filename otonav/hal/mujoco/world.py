@@ -44,7 +44,7 @@ from otonav.hal.description import RobotDescription, builtin_robot
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.mujoco._lib import mujoco, viewer_module
 from otonav.hal.mujoco.derive import _actuator_of, _Derivation, _probe, _site_sensor
-from otonav.hal.mujoco.identify import _Robot, identify
+from otonav.hal.mujoco.identify import SECONDS, _Robot, identify
 from otonav.hal.mujoco.prepare import ROBOT_PREFIX, _load_robot, _merge_options, _RobotSpec
 from otonav.hal.mujoco.scene import SceneError, _add_box, _compile, _load_spec
 from otonav.hal.mujoco.static_geoms import ray_caster
@@ -66,7 +66,6 @@ __all__ = ["MujocoInterface"]
 _RAY_GROUPS: Final = np.array([1, 0, 1, 0, 0, 0], dtype=np.uint8)  # groups 0 and 2
 _SETTLE_TIME: Final = 0.25  # s of physics run at construction, before tick 0
 _MOUNT_ABOVE: Final = 0.02  # m: a default lidar sits this far above the robot's top
-_IDENTIFY_S: Final = 9.0  # s of sim the identification runs (settle, 2 straight, turn)
 _REST_TOLERANCE: Final = 1e-3  # m: a model resting within this of the floor is not moved
 
 
@@ -522,7 +521,7 @@ class MujocoInterface(RobotHardwareInterface):
         if (v, omega) not in self._reach:
             found = identify(self._spec, self._identity, v, omega)
             self._reach[(v, omega)] = found
-            self._sources["reach"] = f"identified in {_IDENTIFY_S:g} s of sim: {found.line()}"
+            self._sources["reach"] = f"identified in {SECONDS:g} s of sim: {found.line()}"
         return self._reach[(v, omega)]
 
     def obstacles(self) -> tuple[BoxObstacle, ...]:
