@@ -125,11 +125,12 @@ def for_robot(
     scenario: ScenarioConfig, stack: StackConfig, reach: Reach | None = None
 ) -> ScenarioConfig:
     """``scenario`` as run with ``stack``'s robot: its sim budget scaled to the robot's
-    stated top speed, or to the one it really reaches (``reach``, ADR 0066), when that is
-    below :data:`BUDGET_SPEED`."""
+    stated top speed, or to the one it really reaches or its control range allows
+    (``reach``, ADR 0066), when that is below :data:`BUDGET_SPEED`."""
     top = describe_robot(stack.robot).max_v
-    if reach is not None and slower(reach) < 1.0:
-        top = min(top, reach.v) if top is not None else reach.v
+    if reach is not None:  # what it reaches, or may be asked (its control range)
+        real = reach.v if slower(reach) < 1.0 else reach.asked_v
+        top = min(top, real) if top is not None else real
     if top is None or top >= BUDGET_SPEED:
         return scenario
     budget = min(scenario.sim_budget * BUDGET_SPEED / top, limits.MAX_SIM_BUDGET_S)

@@ -282,6 +282,8 @@ def navigation_params(
     nav, base = config.nav, robot_base(config)
     radius = centre_clearance(nav.clearance, geometry.footprint_radius, nav.footprint_padding)
     fastest_v, fastest_omega = min(nav.max_v, base.max_v), min(nav.max_omega, base.max_omega)
+    if reach is not None:  # no faster than the wheels' control range lets it ask
+        fastest_v, fastest_omega = reach.asked_v, reach.asked_omega
     accel, alpha = base.max_accel, base.max_alpha
     if reach is not None:
         accel, alpha = min(accel, reach.accel), min(alpha, reach.alpha)

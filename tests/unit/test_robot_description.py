@@ -536,3 +536,14 @@ def test_a_mesh_tyre_turned_about_its_axle_rests_on_the_floor_with_its_caster(
     assert world.geometry.wheel_radius == pytest.approx(0.05, abs=1e-4)
     assert world.geometry.base_height == pytest.approx(0.05, abs=1e-3)  # not lifted
     assert "frictionless" in world.geometry_sources()["casters"]
+
+
+def test_the_speed_asked_is_capped_by_the_wheels_control_range() -> None:
+    """ROBOTIS's servos take at most 6.67 rad/s: asked 0.4 m/s, the robot is asked
+    0.22, and what it reaches is judged against that (ADR 0066)."""
+    world = MujocoInterface("empty", robot=turtlebot3())
+    reach = world.reach(0.4, 3.0)
+    assert reach.asked_v == pytest.approx(6.67 * 0.033)
+    assert reach.asked_omega == pytest.approx(6.67 * 0.033 / 0.08)
+    assert 0.8 < reach.v / reach.asked_v < 0.9
+    assert world.geometry_sources()["reach"].endswith("(the wheels' control range: 6.67 rad/s)")

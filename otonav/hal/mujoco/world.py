@@ -517,12 +517,29 @@ class MujocoInterface(RobotHardwareInterface):
 
     def reach(self, v: float, omega: float) -> Reach:
         """Identified in sim time on a copy of the world with only the robot in it
-        (ADR 0066): this world's physics is not touched. Recorded in the sources."""
+        (ADR 0066): this world's physics is not touched. Recorded in the sources. The
+        speeds asked are capped at what the wheels' control range allows (ROBOTIS's
+        +-6.67 rad/s: 0.22 m/s), and the result says so in ``asked_v``/``asked_omega``."""
         if (v, omega) not in self._reach:
-            found = identify(self._spec, self._identity, v, omega)
+            wheel = self._wheel_top()
+            radius, half_track = self._geometry.wheel_radius, self._geometry.wheel_separation / 2
+            asked = (min(v, wheel * radius), min(omega, wheel * radius / half_track))
+            found = identify(self._spec, self._identity, *asked)
             self._reach[(v, omega)] = found
-            self._sources["reach"] = f"identified in {SECONDS:g} s of sim: {found.line()}"
+            capped = (
+                f" (the wheels' control range: {wheel:.3g} rad/s)" if asked != (v, omega) else ""
+            )
+            self._sources["reach"] = f"identified in {SECONDS:g} s of sim: {found.line()}{capped}"
         return self._reach[(v, omega)]
+
+    def _wheel_top(self) -> float:
+        """rad/s: the fastest wheel speed the actuators' control ranges can ask."""
+        m, top = self._model, math.inf
+        for act, scale in zip((self._left_act, self._right_act), self._ctrl_scale, strict=True):
+            if bool(m.actuator_ctrllimited[act]):
+                lo, hi = (float(c) for c in m.actuator_ctrlrange[act])
+                top = min(top, min(abs(lo), abs(hi)) / abs(scale))
+        return top
 
     def obstacles(self) -> tuple[BoxObstacle, ...]:
         return self._obstacles
