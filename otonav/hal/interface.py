@@ -103,6 +103,10 @@ class RobotHardwareInterface(abc.ABC):
         """m: the top of the tallest obstacle above the floor; None if none or unknown."""
         return None
 
+    def identified(self) -> tuple[tuple[float, float], Reach] | None:
+        """The last :meth:`reach` measured: the (v, omega) asked and the result."""
+        return None
+
     def reach(self, v: float, omega: float) -> Reach | None:
         """What the robot really reaches when asked for ``v`` m/s and ``omega`` rad/s
         (:class:`Reach`); None when this interface cannot tell (the stack then trusts

@@ -24,10 +24,14 @@ from collections.abc import Sequence
 
 from otonav.hal import RobotGeometry, RobotHardwareInterface
 from otonav.hal.mujoco import SceneError
+from otonav.hal.types import Reach
 from otonav.replay.recording import ReplayInputError
 from otonav.replay.world import RecordedRobot
 from otonav.runtime import Actor
 from otonav.stack import StackConfig, build_actors, build_world
+
+RecordedReach = tuple[tuple[float, float], Reach] | None
+"""What a recording says its robot was identified to reach (ADR 0066), if it says."""
 
 NOT_REPLAYABLE: dict[str, str] = {
     "bridge": "it owns the hardware: its inputs are physics, not topics",
@@ -41,8 +45,10 @@ def stack_actor_names(stack: StackConfig, geometry: RobotGeometry | None = None)
     return [a.name for a in _stack_actors(stack, geometry) if a.name not in NOT_REPLAYABLE]
 
 
-def _stack_actors(stack: StackConfig, geometry: RobotGeometry | None) -> list[Actor]:
-    hal = _robot(stack, geometry)
+def _stack_actors(
+    stack: StackConfig, geometry: RobotGeometry | None, reach: RecordedReach = None
+) -> list[Actor]:
+    hal = _robot(stack, geometry, reach)
     try:
         return build_actors(stack, hal)
     except ImportError as exc:  # a CAN stack's modules without the extra
@@ -54,11 +60,13 @@ def _stack_actors(stack: StackConfig, geometry: RobotGeometry | None) -> list[Ac
         hal.close()
 
 
-def _robot(stack: StackConfig, geometry: RobotGeometry | None) -> RobotHardwareInterface:
+def _robot(
+    stack: StackConfig, geometry: RobotGeometry | None, reach: RecordedReach = None
+) -> RobotHardwareInterface:
     """The recorded robot (its world built on demand), or the world for ``stack``."""
     if geometry is None:
         return _world(stack)
-    return RecordedRobot(geometry, lambda: _world(stack))
+    return RecordedRobot(geometry, lambda: _world(stack), reach)
 
 
 def _world(stack: StackConfig) -> RobotHardwareInterface:
@@ -81,13 +89,16 @@ def _valid_names(stack_names: Sequence[str]) -> str:
 
 
 def build_nodes(
-    specs: Sequence[str], stack: StackConfig, geometry: RobotGeometry | None = None
+    specs: Sequence[str],
+    stack: StackConfig,
+    geometry: RobotGeometry | None = None,
+    reach: RecordedReach = None,
 ) -> list[Actor]:
     """The actors named by ``specs`` (stack names or import paths), built from ``stack``
     for a robot of ``geometry`` (None: the one ``stack``'s world compiles to)."""
     if not specs:
         raise ReplayInputError("--node: name at least one node to replay")
-    stack_actors = {a.name: a for a in _stack_actors(stack, geometry)}
+    stack_actors = {a.name: a for a in _stack_actors(stack, geometry, reach)}
     replayable = [name for name in stack_actors if name not in NOT_REPLAYABLE]
     actors: list[Actor] = []
     for spec in specs:

@@ -49,8 +49,7 @@ class _RobotSpec:
         self.ctrl_scale: dict[str, float] = {}
         self.lidar_site = ""
         self.imu_site = ""
-        self.named = self._body(robot.base, "base")
-        self.base = self._mover(self.named)
+        self.base = self._mover(self._body(robot.base, "base"))
         self.joints = {
             "left_wheel": self._wheel(robot.left_wheel, "left_wheel"),
             "right_wheel": self._wheel(robot.right_wheel, "right_wheel"),

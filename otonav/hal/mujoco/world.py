@@ -532,6 +532,9 @@ class MujocoInterface(RobotHardwareInterface):
             self._sources["reach"] = f"identified in {SECONDS:g} s of sim: {found.line()}{capped}"
         return self._reach[(v, omega)]
 
+    def identified(self) -> tuple[tuple[float, float], Reach] | None:
+        return next(reversed(self._reach.items()), None)
+
     def _wheel_top(self) -> float:
         """rad/s: the fastest wheel speed the actuators' control ranges can ask."""
         m, top = self._model, math.inf
