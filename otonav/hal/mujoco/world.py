@@ -69,6 +69,15 @@ _MOUNT_ABOVE: Final = 0.02  # m: a default lidar sits this far above the robot's
 _REST_TOLERANCE: Final = 1e-3  # m: a model resting within this of the floor is not moved
 
 
+_IDENTIFIED: dict[object, Reach] = {}
+"""Identifications by robot, model file version, scene, timestep and speeds asked: a
+sweep's runs of one robot identify it once per process (~0.1 s each otherwise)."""
+
+
+def _mtime(path: str) -> int:
+    return os.stat(path).st_mtime_ns
+
+
 def _yaw_of_quat(w: float, x: float, y: float, z: float) -> float:
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
@@ -524,7 +533,10 @@ class MujocoInterface(RobotHardwareInterface):
             wheel = self._wheel_top()
             radius, half_track = self._geometry.wheel_radius, self._geometry.wheel_separation / 2
             asked = (min(v, wheel * radius), min(omega, wheel * radius / half_track))
-            found = identify(self._spec, self._identity, *asked)
+            robot, scene = self._robot, self._label  # the scene: its floor's friction
+            key = (repr(robot), _mtime(robot.model), scene, self.tick, self._identity, asked)
+            found = _IDENTIFIED.get(key) or identify(self._spec, self._identity, *asked)
+            _IDENTIFIED[key] = found
             self._reach[(v, omega)] = found
             capped = (
                 f" (the wheels' control range: {wheel:.3g} rad/s)" if asked != (v, omega) else ""
