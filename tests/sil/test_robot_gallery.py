@@ -12,6 +12,7 @@ from otonav.cli import main
 from otonav.record.reader import read_messages
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.scenario.builtin import BUILTIN
+from otonav.scenario.replay import recorded_plot
 from otonav.stack import StackConfig
 from otonav.stack.loading import load_stack_file
 from otonav.stack.overrides import apply_overrides
@@ -63,6 +64,9 @@ def test_robotis_burger_with_its_lidar_inside_the_housing_passes_the_easy_course
     assert len(joints) >= 10 * verdict.sim_time_s - 1  # 10 Hz
     assert all(list(m.name) == ["wheel_left_joint", "wheel_right_joint"] for m in joints)
     assert joints[-1].position[0] > 2.0 / 0.033 * 0.8  # rad rolled over ~2.2 m
+    plot = recorded_plot(recording)  # otonav plot: the footprint from the recording
+    assert len(plot.footprint) == 4
+    assert max(y for _, y in plot.footprint) == pytest.approx(0.089, abs=1e-3)
 
 
 def test_a_robot_reaching_70_percent_of_the_asked_speed_still_passes(tmp_path: Path) -> None:
