@@ -65,6 +65,7 @@ class BaseController(Actor):
         *,
         rate_hz: float = 50.0,
         cmd_timeout: float = 0.5,
+        deadband: float = 0.0,
         name: str = "base",
     ) -> None:
         super().__init__(name)
@@ -76,6 +77,10 @@ class BaseController(Actor):
         self.limits = limits
         self.rate_hz = rate_hz
         self.cmd_timeout = cmd_timeout
+        self.deadband = deadband
+        """rad/s added to a turning wheel's command, in its direction: what the wheel's
+        servo loses to friction whatever the speed (identified, ADR 0066), so a small
+        command still turns the wheel; 0: none."""
         self.watchdog_trips = 0
         self.rejected_commands = 0
         self._logged_at = -math.inf
@@ -130,6 +135,9 @@ class BaseController(Actor):
                 max_alpha=limits.max_alpha,
             )
             left, right = twist_to_wheels(v, omega, self.geometry)
+            if self.deadband:
+                left += math.copysign(self.deadband, left) if left else 0.0
+                right += math.copysign(self.deadband, right) if right else 0.0
             sec, nanosec = split_seconds(now)
             command = WHEEL_COMMAND(sec, nanosec, left, right)
             try:

@@ -25,6 +25,7 @@ from otonav.msgs import (
     HardwareStatus,
     Header,
     Imu,
+    JointState,
     KeyValue,
     LaserScan,
     Log,
@@ -192,6 +193,7 @@ class Bridge(Actor):
     odom = Output(topics.ODOM, Odometry, topics.ODOM_QOS)
     imu = Output(topics.IMU, Imu, topics.SENSOR_QOS)
     scan = Output(topics.SCAN, LaserScan, topics.SENSOR_QOS)
+    joint_states = Output(topics.JOINT_STATES, JointState, topics.SENSOR_QOS)
     tf = Output(topics.TF, TFMessage, topics.TF_QOS)
     tf_static = Output(topics.TF_STATIC, TFMessage, topics.LATCHED)
     wheel_cmd = Input(topics.WHEEL_CMD, WheelCommand, topics.COMMAND_QOS)
@@ -208,6 +210,7 @@ class Bridge(Actor):
         imu_hz: float = 100.0,
         scan_hz: float = 10.0,
         diagnostics_hz: float = 1.0,
+        joint_states_hz: float = 10.0,
         initial_pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
         odometry_error: OdometryError | None = None,
         frames: Frames = FRAMES,
@@ -223,6 +226,7 @@ class Bridge(Actor):
             ("imu_hz", imu_hz),
             ("scan_hz", scan_hz),
             ("diagnostics_hz", diagnostics_hz),
+            ("joint_states_hz", joint_states_hz),
         ):
             if not hz > 0:
                 raise ValueError(f"bridge.{field} must be > 0 Hz, got {hz}")
@@ -233,6 +237,7 @@ class Bridge(Actor):
             "imu": 1.0 / imu_hz,
             "scan": 1.0 / scan_hz,
             "diagnostics": 1.0 / diagnostics_hz,
+            "joint_states": 1.0 / joint_states_hz,
         }
         self._health: HardwareHealth | None = None
         self._odometry = OdometryEstimate(Pose2D(*initial_pose), 0.0, 0.0, 0.0, 0.0)
@@ -295,6 +300,7 @@ class Bridge(Actor):
             (self._periods["imu"], self._publish_imu, None),
             (self._periods["scan"], None, self._publish_scan),
             (self._periods["diagnostics"], None, self._publish_diagnostics),
+            (self._periods["joint_states"], self._publish_joints, None),
         )
         counts = [1] * len(publishers)
         due = [start + period for period, _, _ in publishers]
@@ -369,6 +375,21 @@ class Bridge(Actor):
         qz, qw = math.sin(pose.yaw / 2), math.cos(pose.yaw / 2)  # Quaternion.from_yaw's
         self._send(self.odom, self._odom_layout(sec, nanosec, pose.x, pose.y, qz, qw, v, gyro_z))
         self._send(self.tf, self._tf_layout(sec, nanosec, pose.x, pose.y, qz, qw))
+
+    def _publish_joints(self, sec: int, nanosec: int, _now: float) -> None:
+        """/joint_states: the wheel joints by the model's names, as the HAL reads them
+        (positive rolls the robot forward), after every other stream of the instant."""
+        left, right, left_v, right_v = self.hal.wheel_values()
+        self._send(
+            self.joint_states,
+            JointState.fast(
+                header=Header.fast(stamp=Time.fast(sec=sec, nanosec=nanosec), frame_id=""),
+                name=self.hal.geometry.wheel_joints,
+                position=(left, right),
+                velocity=(left_v, right_v),
+                effort=(),
+            ),
+        )
 
     def _imu_at(self, now: float) -> ImuSample:
         """One IMU read per instant, shared by odometry and /imu (it was read twice)."""

@@ -10,6 +10,7 @@ CLOCK = "/clock"
 ODOM = "/odom"
 IMU = "/imu"
 SCAN = "/scan"
+JOINT_STATES = "/joint_states"
 TF = "/tf"
 TF_STATIC = "/tf_static"
 #: The localizer's map (nav_msgs/OccupancyGrid, latched).

@@ -184,8 +184,17 @@ def robot_rows(verdict: Verdict) -> list[tuple[str, str]]:
     return [
         ("robot", f"{robot['model']}{top}"),
         ("wheels", f"r {robot['wheel_radius']:.4f} m, {robot['wheel_separation']:.3f} m apart"),
+        *reach_row(robot.get("reach")),
         ("sim budget", f"{verdict.sim_budget_s:g} s"),
     ]
+
+
+def reach_row(reach: dict[str, float] | None) -> list[tuple[str, str]]:
+    """What the robot really reached against what it was asked (ADR 0066)."""
+    if not reach:
+        return []
+    v, asked = reach["v"], reach["asked_v"]
+    return [("reaches", f"{v:.3g} of {asked:.3g} m/s asked ({v / asked:.0%})")]
 
 
 def print_verdict(verdict: Verdict, console: Console) -> None:

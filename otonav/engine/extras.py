@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 from otonav.errors import UsageError
 from otonav.runtime import Actor, System
 from otonav.stack import StackConfig
+from otonav.stack.robot import robot_frames
 
 if TYPE_CHECKING:
     from otonav.foxglove import FoxgloveServer, LiveView
@@ -84,7 +85,8 @@ def open_extras(config: StackConfig) -> Extras:
             from otonav.ros2 import Ros2Error, bridge_for
 
             try:
-                extras.ros2 = bridge_for(config.ros2, base_frame=config.robot.frames.base)
+                base = robot_frames(config.robot).base
+                extras.ros2 = bridge_for(config.ros2, base_frame=base)
             except Ros2Error as exc:
                 raise ExtrasError(str(exc)) from None
     except BaseException:

@@ -18,6 +18,7 @@ from otonav.hal.types import (
     GroundTruth,
     ImuSample,
     RangeScan,
+    Reach,
     RobotGeometry,
     WheelSetpoint,
     WheelState,
@@ -97,6 +98,20 @@ class RobotHardwareInterface(abc.ABC):
         """Where each value of :attr:`geometry` (and each robot part) came from: derived
         from the model, or given in the robot description. Empty when not known."""
         return {}
+
+    def tallest_obstacle(self) -> float | None:
+        """m: the top of the tallest obstacle above the floor; None if none or unknown."""
+        return None
+
+    def identified(self) -> tuple[tuple[float, float], Reach] | None:
+        """The last :meth:`reach` measured: the (v, omega) asked and the result."""
+        return None
+
+    def reach(self, v: float, omega: float) -> Reach | None:
+        """What the robot really reaches when asked for ``v`` m/s and ``omega`` rad/s
+        (:class:`Reach`); None when this interface cannot tell (the stack then trusts
+        the asked figures)."""
+        return None
 
     @abc.abstractmethod
     def obstacles(self) -> tuple[BoxObstacle, ...]:

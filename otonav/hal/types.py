@@ -139,12 +139,41 @@ class RobotGeometry:
     every collision geom of the robot, projected on the floor); the default is that
     rectangle for ``otonav/hal/assets/robot.xml`` (chassis box 0.30 x 0.18 m centred
     0.06 m ahead of the axle, wheels reaching y = +-0.1225 m)."""
+    wheel_joints: tuple[str, str] = ("left_wheel", "right_wheel")
+    """The wheel joints' names in the model (/joint_states)."""
 
     @property
     def footprint_radius(self) -> float:
         """Radius of the smallest circle about base_link (the judged point, the wheel
         axle's midpoint) that holds the footprint, m: what a spin in place sweeps."""
         return max((math.hypot(x, y) for x, y in self.footprint), default=0.0)
+
+
+@dataclass(frozen=True, slots=True)
+class Reach:
+    """What the robot really reaches when asked for ``asked_v`` m/s straight ahead and
+    ``asked_omega`` rad/s in place: its steady speeds ``v`` (m/s) and ``omega`` (rad/s),
+    and the mean accelerations to 90 % of them (m/s^2, rad/s^2). Identified in sim time
+    on a copy of the robot alone on a floor (ADR 0066)."""
+
+    asked_v: float
+    asked_omega: float
+    v: float
+    omega: float
+    accel: float
+    alpha: float
+    deadband: float = 0.0
+    """rad/s of wheel speed a command loses whatever its size (friction against a weak
+    servo): the constant part of the deficit, from a second step at half the speed."""
+
+    def line(self) -> str:
+        """One line for ``otonav info`` and the verdict."""
+        v, omega = self.v / self.asked_v, self.omega / self.asked_omega
+        return (
+            f"{self.v:.3g} of {self.asked_v:.3g} m/s asked ({v:.0%}), {self.omega:.3g} of "
+            f"{self.asked_omega:.3g} rad/s ({omega:.0%}), accel {self.accel:.3g} m/s^2, "
+            f"{self.alpha:.3g} rad/s^2, deadband {self.deadband:.3g} rad/s of wheel speed"
+        )
 
 
 @dataclass(frozen=True, slots=True)

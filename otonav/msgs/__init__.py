@@ -30,6 +30,7 @@ from otonav.msgs.otonav_msgs import (
 )
 from otonav.msgs.sensors import (
     Imu,
+    JointState,
     LaserScan,
     MapMetaData,
     OccupancyGrid,
@@ -54,6 +55,7 @@ __all__ = (
     "HardwareStatus",
     "Header",
     "Imu",
+    "JointState",
     "KeyValue",
     "LaserScan",
     "Log",

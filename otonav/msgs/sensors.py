@@ -43,6 +43,18 @@ class Imu(Message):
     linear_acceleration_covariance: tuple[float, ...] = _ZERO9
 
 
+class JointState(Message):
+    """sensor_msgs/msg/JointState: each joint's position (rad), velocity (rad/s) and
+    effort (N m), by name (empty: not measured)."""
+
+    ros_type: ClassVar[str] = "sensor_msgs/msg/JointState"
+    header: Header = Header()
+    name: tuple[str, ...] = ()
+    position: tuple[float, ...] = ()
+    velocity: tuple[float, ...] = ()
+    effort: tuple[float, ...] = ()
+
+
 class LaserScan(Message):
     """sensor_msgs/msg/LaserScan: beam i at ``angle_min + i * angle_increment``
     (counter-clockwise from the laser's +x); +inf where nothing was hit (REP 117)."""

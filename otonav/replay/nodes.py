@@ -24,10 +24,14 @@ from collections.abc import Sequence
 
 from otonav.hal import RobotGeometry, RobotHardwareInterface
 from otonav.hal.mujoco import SceneError
+from otonav.hal.types import Reach
 from otonav.replay.recording import ReplayInputError
 from otonav.replay.world import RecordedRobot
 from otonav.runtime import Actor
 from otonav.stack import StackConfig, build_actors, build_world
+
+RecordedReach = tuple[tuple[float, float], Reach] | None
+"""What a recording says its robot was identified to reach (ADR 0066), if it says."""
 
 NOT_REPLAYABLE: dict[str, str] = {
     "bridge": "it owns the hardware: its inputs are physics, not topics",
@@ -45,8 +49,9 @@ def _stack_actors(
     stack: StackConfig,
     geometry: RobotGeometry | None,
     start: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    reach: RecordedReach = None,
 ) -> list[Actor]:
-    hal = _robot(stack, geometry)
+    hal = _robot(stack, geometry, reach)
     try:
         return build_actors(stack, hal, initial_pose=start)
     except ImportError as exc:  # a CAN stack's modules without the extra
@@ -58,11 +63,13 @@ def _stack_actors(
         hal.close()
 
 
-def _robot(stack: StackConfig, geometry: RobotGeometry | None) -> RobotHardwareInterface:
+def _robot(
+    stack: StackConfig, geometry: RobotGeometry | None, reach: RecordedReach = None
+) -> RobotHardwareInterface:
     """The recorded robot (its world built on demand), or the world for ``stack``."""
     if geometry is None:
         return _world(stack)
-    return RecordedRobot(geometry, lambda: _world(stack))
+    return RecordedRobot(geometry, lambda: _world(stack), reach)
 
 
 def _world(stack: StackConfig) -> RobotHardwareInterface:
@@ -89,13 +96,14 @@ def build_nodes(
     stack: StackConfig,
     geometry: RobotGeometry | None = None,
     start: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    reach: RecordedReach = None,
 ) -> list[Actor]:
     """The actors named by ``specs`` (stack names or import paths), built from ``stack``
     for a robot of ``geometry`` (None: the one ``stack``'s world compiles to) that
     started at ``start`` (x, y, yaw: the run's, as the run built them)."""
     if not specs:
         raise ReplayInputError("--node: name at least one node to replay")
-    stack_actors = {a.name: a for a in _stack_actors(stack, geometry, start)}
+    stack_actors = {a.name: a for a in _stack_actors(stack, geometry, start, reach)}
     replayable = [name for name in stack_actors if name not in NOT_REPLAYABLE]
     actors: list[Actor] = []
     for spec in specs:

@@ -24,7 +24,7 @@ from otonav.replay.recording import (
     load_recording,
     read_topics,
 )
-from otonav.replay.world import recorded_geometry
+from otonav.replay.world import recorded_geometry, recorded_reach
 from otonav.runtime import (
     Actor,
     ActorCrashedError,
@@ -224,7 +224,8 @@ def _replay(
         config = apply_overrides(config, overrides)
     names = [n for n in nodes if isinstance(n, str)]
     geometry = recorded_geometry(meta, config)
-    built = iter(build_nodes(names, config, geometry, meta.start)) if names else iter(())
+    reach = recorded_reach(meta, geometry)
+    built = iter(build_nodes(names, config, geometry, meta.start, reach)) if names else iter(())
     actors: list[Actor] = [next(built) if isinstance(n, str) else n for n in nodes]
     if not actors:
         raise ReplayInputError("--node: name at least one node to replay")

@@ -25,11 +25,12 @@ from otonav.hal import (
     WheelSetpoint,
     WheelState,
 )
+from otonav.hal.types import Reach
 from otonav.replay.recording import Recording
 from otonav.stack import StackConfig
-from otonav.stack.worldmeta import WORLD_METADATA, geometry_from_metadata
+from otonav.stack.worldmeta import WORLD_METADATA, geometry_from_metadata, reach_from_metadata
 
-__all__ = ("RecordedRobot", "recorded_geometry")
+__all__ = ("RecordedRobot", "recorded_geometry", "recorded_reach")
 
 
 def recorded_geometry(recording: Recording, stack: StackConfig) -> RobotGeometry | None:
@@ -48,15 +49,29 @@ def recorded_geometry(recording: Recording, stack: StackConfig) -> RobotGeometry
     return geometry_from_metadata(recording.metadata.get(WORLD_METADATA, {}))
 
 
+def recorded_reach(
+    recording: Recording, geometry: RobotGeometry | None
+) -> tuple[tuple[float, float], Reach] | None:
+    """What the recorded robot was identified to reach, with the recorded geometry (a
+    world built anew identifies its own)."""
+    if geometry is None:
+        return None
+    return reach_from_metadata(recording.metadata.get(WORLD_METADATA, {}))
+
+
 class RecordedRobot(RobotHardwareInterface):
     """A hardware interface whose ``geometry`` is the recorded one; every other call
     builds the world (``build()``, once) and goes to it."""
 
     def __init__(
-        self, geometry: RobotGeometry, build: Callable[[], RobotHardwareInterface]
+        self,
+        geometry: RobotGeometry,
+        build: Callable[[], RobotHardwareInterface],
+        reach: tuple[tuple[float, float], Reach] | None = None,
     ) -> None:
         self._geometry = geometry
         self._build = build
+        self._reach = reach
         self._world: RobotHardwareInterface | None = None
 
     @property
@@ -72,6 +87,16 @@ class RecordedRobot(RobotHardwareInterface):
     @property
     def geometry(self) -> RobotGeometry:
         return self._geometry
+
+    def reach(self, v: float, omega: float) -> Reach | None:
+        # The base's deadband and the navigator's limits were built from it (ADR 0066):
+        # none recorded (a CAN robot's, an older file's) was none in the run; the
+        # recorded one when asked the same; else the world identifies it again.
+        if self._reach is None:
+            return None
+        if self._reach[0] == (v, omega):
+            return self._reach[1]
+        return self.world().reach(v, omega)
 
     @property
     def tick(self) -> float:

@@ -76,6 +76,9 @@ class Judge(Actor):
         1/3, under 0.3 m of progress along the path in 3.5 s)`` (/nav/diagnostics'
         stage and reason; issue 24: the verdict says which rung ran and why)."""
         self._stage = ""
+        self.slips: list[str] = []
+        """Each time the navigator said ``reached`` while the true pose was farther than
+        the tolerance from the goal: its odometry and the truth had parted (wheel slip)."""
         self.hal = hal
         self.goal = goal
         self.tolerance = tolerance
@@ -154,6 +157,8 @@ class Judge(Actor):
 
     def _follow_nav_state(self, now: float) -> None:
         while (state := self.nav_state_in.try_recv()) is not None:
+            if state.state == "reached" and self.nav_state != "reached":
+                self._check_slip(now)
             self.nav_state = state.state
             if self.unreachable_at is None and state.state == "unreachable":
                 self.unreachable_at = now
@@ -164,6 +169,16 @@ class Judge(Actor):
                 why = diag.reason.removeprefix(f"{diag.stage}: ")
                 self.recoveries.append(f"{diag.stage} at {now:.1f} s ({why})")
             self._stage = diag.stage
+
+    def _check_slip(self, now: float) -> None:
+        """The navigator says ``reached`` from its odometry: the truth must agree."""
+        x, y, _, _ = self.hal.planar_truth()
+        truth = math.hypot(self.goal[0] - x, self.goal[1] - y)
+        if truth > self.tolerance:
+            self.slips.append(
+                f"odometry says reached at {now:.1f} s; ground truth is {truth:.2f} m away: "
+                "wheel slip"
+            )
 
     def sample(self, now: float) -> None:
         x, y, vx, vy = self.hal.planar_truth()

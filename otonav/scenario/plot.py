@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -45,6 +46,37 @@ def _boxes_path(boxes: tuple[BoxObstacle, ...]) -> MplPath:
     return MplPath(outlines.reshape(-1, 2), codes)
 
 
+def key_poses(
+    trajectory: Sequence[tuple[float, float, float]],
+    start_yaw: float,
+    closest: tuple[float, float] | None,
+) -> list[tuple[float, float, float]]:
+    """(x, y, yaw) at the start, at the sample nearest ``closest`` and at the end of a
+    (t, x, y) trajectory; the heading along the path there (a diff-drive robot drives
+    where it faces), the start's as given."""
+    if not trajectory:
+        return []
+
+    def heading(i: int) -> float:
+        x, y = trajectory[i][1:]
+        for j in (*range(i - 1, -1, -1), *range(i + 1, len(trajectory))):
+            px, py = trajectory[j][1:]
+            if math.hypot(x - px, y - py) > 0.02:  # a step that says where it went
+                return math.atan2(y - py, x - px) if j < i else math.atan2(py - y, px - x)
+        return start_yaw
+
+    poses = [(trajectory[0][1], trajectory[0][2], start_yaw)]
+    if closest is not None and not math.isnan(closest[0]):
+        near = min(
+            range(len(trajectory)),
+            key=lambda i: math.hypot(trajectory[i][1] - closest[0], trajectory[i][2] - closest[1]),
+        )
+        poses.append((trajectory[near][1], trajectory[near][2], heading(near)))
+    last = len(trajectory) - 1
+    poses.append((trajectory[last][1], trajectory[last][2], heading(last)))
+    return poses
+
+
 def draw_trajectory(
     trajectory: list[tuple[float, float, float]],
     obstacles: tuple[BoxObstacle, ...] | None,
@@ -54,16 +86,19 @@ def draw_trajectory(
     title: str,
     *,
     path_label: str = "path (ground truth)",
+    footprint: Sequence[tuple[float, float]] = (),
+    poses: Sequence[tuple[float, float, float]] = (),
 ) -> Figure:
     """The figure of a run: ``trajectory`` as (t, x, y), the obstacle boxes (``None``:
     not known, and the figure says so), the goal and its tolerance circle (``None``:
-    not known, said likewise), the closest approach."""
+    not known, said likewise), the closest approach; the robot's ``footprint`` (base
+    frame) drawn at each of ``poses`` (x, y, yaw), e.g. start, closest approach, end."""
     # Imported here: matplotlib costs ~0.3 s, and only a drawn plot needs it. A Figure
     # on an Agg canvas, not pyplot: no global figure registry (runs plot from worker
     # threads at once) and no backend forced on a host process.
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
-    from matplotlib.patches import Circle, PathPatch
+    from matplotlib.patches import Circle, PathPatch, Polygon
 
     # Constrained layout: the title and the legend beside the map are never clipped.
     fig = Figure(figsize=(8.0, 4.8), dpi=100, layout="constrained")
@@ -91,6 +126,12 @@ def draw_trajectory(
         unknown.append("goal unknown")
     if closest is not None and not math.isnan(closest[0]):
         ax.plot(*closest, "x", color="#c0392b", markersize=10, label="closest approach")
+    for i, (x, y, yaw) in enumerate(poses if footprint else ()):
+        c, s = math.cos(yaw), math.sin(yaw)
+        outline = [(x + c * px - s * py, y + s * px + c * py) for px, py in footprint]
+        ax.add_patch(
+            Polygon(outline, fill=False, color="#555555", linewidth=1, label=None if i else "robot")
+        )
     span_x = [*xs, *(goal[:1] if goal else ())] or [0.0]
     span_y = [*ys, *(goal[1:] if goal else ())] or [0.0]
     x0, x1, y0, y1 = min(span_x) - 1.0, max(span_x) + 1.0, min(span_y) - 1.0, max(span_y) + 1.0
@@ -133,10 +174,20 @@ def plot_trajectory(
     title: str,
     *,
     path_label: str = "path (ground truth)",
+    footprint: Sequence[tuple[float, float]] = (),
+    poses: Sequence[tuple[float, float, float]] = (),
 ) -> Path:
     """Write a PNG of the run (:func:`draw_trajectory`) to ``path`` and return it."""
     fig = draw_trajectory(
-        trajectory, obstacles, goal, tolerance, closest, title, path_label=path_label
+        trajectory,
+        obstacles,
+        goal,
+        tolerance,
+        closest,
+        title,
+        path_label=path_label,
+        footprint=footprint,
+        poses=poses,
     )
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, metadata={"Software": None})

@@ -13,10 +13,10 @@ from otonav.hal.mujoco import SceneError
 from otonav.record.reader import read_messages, summarize
 from otonav.record.verify import Damage
 from otonav.scenario.config import ScenarioConfig
-from otonav.scenario.plot import plot_trajectory
+from otonav.scenario.plot import key_poses, plot_trajectory
 from otonav.scenario.run import effective_stack, verdict_title
 from otonav.stack import StackConfig, build_world
-from otonav.stack.worldmeta import WORLD_METADATA, boxes_from_metadata
+from otonav.stack.worldmeta import WORLD_METADATA, boxes_from_metadata, geometry_from_metadata
 
 
 def recorded_path(
@@ -54,6 +54,9 @@ class RecordedPlot:
     """Chunks that failed their CRC: not drawn."""
     closest: tuple[float, float] | None = None
     """Where the recorded verdict says the robot came closest to an obstacle."""
+    footprint: tuple[tuple[float, float], ...] = ()
+    """The recorded robot's outline (base frame), drawn at the start, closest and end."""
+    start_yaw: float = 0.0
 
 
 def recorded_plot(recording: Path) -> RecordedPlot:
@@ -93,6 +96,7 @@ def recorded_plot(recording: Path) -> RecordedPlot:
         title += ", cut off: complete chunks only"
     if summary.damaged:
         title += f", {len(summary.damaged)} damaged chunk(s) not drawn"
+    geometry = geometry_from_metadata(summary.metadata.get(WORLD_METADATA, {}))
     return RecordedPlot(
         recorded_path(recording, damage),
         obstacles,
@@ -102,6 +106,8 @@ def recorded_plot(recording: Path) -> RecordedPlot:
         summary.truncated,
         summary.damaged,
         closest,
+        geometry.footprint if geometry is not None else (),
+        scenario.start.yaw if scenario is not None else 0.0,
     )
 
 
@@ -132,4 +138,6 @@ def plot_recording(recording: Path, png: Path | None = None) -> Path:
         plot.closest,
         plot.title,
         path_label="path (odometry)",
+        footprint=plot.footprint,
+        poses=key_poses(plot.trajectory, plot.start_yaw, plot.closest),
     )

@@ -21,6 +21,7 @@ from otonav import limits
 from otonav._version import __version__
 from otonav.actors import topics
 from otonav.hal import RobotHardwareInterface
+from otonav.hal.types import Reach
 from otonav.msgs import Header, Point, Pose, PoseStamped, ScenarioVerdict, Time
 from otonav.record.diskfull import DiskFullError, is_disk_full
 from otonav.record.outlock import lock_output
@@ -41,10 +42,10 @@ from otonav.runtime._asyncio_compat import preload_anyio_backend
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.crash import RunCrashedError, crash_reason
 from otonav.scenario.judge import Judge
-from otonav.scenario.plot import plot_trajectory
+from otonav.scenario.plot import key_poses, plot_trajectory
 from otonav.scenario.validate import check_cost, check_goal
 from otonav.stack import StackConfig, build_actors, build_world
-from otonav.stack.robot import describe_robot
+from otonav.stack.robot import describe_robot, reached, slower
 from otonav.stack.session import StackSession
 
 VERDICT_TOPIC = "/scenario/verdict"
@@ -121,10 +122,16 @@ under the default ``nav.max_v``). A robot whose description states a lower top s
 its top speed, so the same courses judge it fairly (ADR 0041)."""
 
 
-def for_robot(scenario: ScenarioConfig, stack: StackConfig) -> ScenarioConfig:
+def for_robot(
+    scenario: ScenarioConfig, stack: StackConfig, reach: Reach | None = None
+) -> ScenarioConfig:
     """``scenario`` as run with ``stack``'s robot: its sim budget scaled to the robot's
-    stated top speed when that is below :data:`BUDGET_SPEED`."""
+    stated top speed, or to the one it really reaches or its control range allows
+    (``reach``, ADR 0066), when that is below :data:`BUDGET_SPEED`."""
     top = describe_robot(stack.robot).max_v
+    if reach is not None:  # what it reaches, or may be asked (its control range)
+        real = reach.v if slower(reach) < 1.0 else reach.asked_v
+        top = min(top, real) if top is not None else real
     if top is None or top >= BUDGET_SPEED:
         return scenario
     budget = min(scenario.sim_budget * BUDGET_SPEED / top, limits.MAX_SIM_BUDGET_S)
@@ -139,13 +146,13 @@ def scenario_world(
     pose, checked: a goal or start outside the arena or on an obstacle raises
     ``ConfigFileError`` naming ``source`` (the world is then closed)."""
     stack = effective_stack(scenario, stack)
-    scenario = for_robot(scenario, stack)
     hal = build_world(
         stack,
         extra_obstacles=[b.to_obstacle() for b in scenario.obstacles],
         start=scenario.start.as_tuple(),
     )
     try:
+        scenario = for_robot(scenario, stack, reached(stack, hal))
         check_goal(scenario, stack.world.scene, hal.obstacles(), hal.walls(), source=source)
         check_cost(scenario, stack, len(hal.obstacles() + hal.walls()), source=source)
     except BaseException:
@@ -509,6 +516,8 @@ def save_artifacts(
                 scenario.goal_tolerance,
                 judge.min_clearance_at,
                 verdict_title(verdict.scenario, verdict.passed, verdict.reason),
+                footprint=judge.hal.geometry.footprint,
+                poses=key_poses(judge.trajectory, scenario.start.yaw, judge.min_clearance_at),
             )
         except OSError as exc:
             if not is_disk_full(exc):
@@ -591,8 +600,22 @@ def robot_summary(stack: StackConfig, hal: RobotHardwareInterface) -> dict[str, 
         "wheel_separation": g.wheel_separation,
         "footprint_radius": g.footprint_radius,
         "laser_offset": [g.laser_offset_x, g.laser_offset_z],
+        "reach": asdict(reach) if (reach := reached(stack, hal)) is not None else None,
         "sources": hal.geometry_sources(),
+        "warnings": lidar_over_obstacles(hal),
     }
+
+
+def lidar_over_obstacles(hal: RobotHardwareInterface) -> list[str]:
+    """A lidar above the tallest obstacle sees none of them (issue 38): a warning."""
+    g, top = hal.geometry, hal.tallest_obstacle()
+    height = g.base_height + g.laser_offset_z
+    if top is None or height < top:
+        return []
+    return [
+        f"warning: the lidar is {height:.2f} m above the floor, over the tallest obstacle "
+        f"({top:.2f} m): it sees none of them; mount it lower (robot.lidar)"
+    ]
 
 
 def judge_verdict(
@@ -651,6 +674,8 @@ def judge_verdict(
             else f"reported unreachable at {judge.unreachable_at:.1f} s, as expected, "
             "with clearance"
         )
+    reasons.extend(judge.slips)
+    reasons.extend((robot or {}).get("warnings", ()))
     if judge.recoveries:
         reasons.append(f"recoveries: {'; '.join(judge.recoveries)}")
     return Verdict(

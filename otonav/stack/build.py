@@ -21,10 +21,10 @@ from otonav.actors import (
 from otonav.actors.localized_navigator import LocalizedNavigator
 from otonav.actors.localizer import Localizer, LocalizerParams
 from otonav.actors.odometry_error import OdometryError
-from otonav.actors.topics import Frames
 from otonav.control import DiffDriveGeometry
 from otonav.hal import BoxObstacle, RobotGeometry, RobotHardwareInterface
 from otonav.hal.mujoco import MujocoInterface
+from otonav.hal.types import Reach
 from otonav.nav import GoToGoalParams, GuardParams
 from otonav.nav.dwa import DwaParams
 from otonav.nav.footprint import centre_clearance
@@ -35,7 +35,14 @@ from otonav.runtime import Actor
 from otonav.stack.config import StackConfig
 from otonav.stack.files import ConfigFileError
 from otonav.stack.launch import launch
-from otonav.stack.robot import describe_robot, robot_base
+from otonav.stack.robot import (
+    deadband,
+    describe_robot,
+    reached,
+    robot_base,
+    robot_frames,
+    slower,
+)
 
 if TYPE_CHECKING:
     from otonav.hal.can import CanBusInterface
@@ -172,13 +179,14 @@ def build_actors(
             scan_hz=rates.scan_hz,
             initial_pose=initial_pose,
             odometry_error=odometry_error(config),
-            frames=Frames(**config.robot.frames.model_dump()),
+            frames=robot_frames(config.robot),
         ),
         BaseController(
             DiffDriveGeometry(geometry.wheel_radius, geometry.wheel_separation),
             BaseLimits(base.max_v, base.max_omega, base.max_accel, base.max_alpha),
             rate_hz=base.rate_hz,
             cmd_timeout=base.cmd_timeout,
+            deadband=deadband(reached(config, hal)),
         ),
     ]
     if config.hal.kind == "can" and config.hal.can.record_frames:
@@ -220,7 +228,7 @@ def build_actors(
             navigator_class = LocalizedNavigator if nav.localization.enabled else AvoidingNavigator
             actors.append(
                 navigator_class(
-                    navigation_params(config, geometry),
+                    navigation_params(config, geometry, reached(config, hal)),
                     laser_offset_x=geometry.laser_offset_x,
                     start=(initial_pose[0], initial_pose[1]),
                     rate_hz=nav.rate_hz,
@@ -261,26 +269,37 @@ _MAP_NAMES = {"half_size": "map_half_size", "resolution": "map_resolution"}
 """``nav.map`` fields whose NavigationParams name says "map" (the others match)."""
 
 
-def navigation_params(config: StackConfig, geometry: RobotGeometry) -> NavigationParams:
+def navigation_params(
+    config: StackConfig, geometry: RobotGeometry, reach: Reach | None = None
+) -> NavigationParams:
     """The avoiding navigator's settings from ``nav.*`` and the base's limits: the
     ``nav.dwa``, ``nav.map`` and ``nav.recovery`` sections pass through by name (their
     defaults are NavigationParams' and DwaParams', ADR 0054); what depends on the base
-    or the footprint is derived here."""
+    or the footprint is derived here. ``reach``: what the robot really reaches (ADR
+    0066): the DWA's window grows by the accelerations it really has, and a robot slower
+    than asked gets a progress window as much longer as it is slower. The window's top
+    stays the asked speed: a servo short of its setpoint reaches most when asked most."""
     nav, base = config.nav, robot_base(config)
     radius = centre_clearance(nav.clearance, geometry.footprint_radius, nav.footprint_padding)
+    fastest_v, fastest_omega = min(nav.max_v, base.max_v), min(nav.max_omega, base.max_omega)
+    if reach is not None:  # no faster than the wheels' control range lets it ask
+        fastest_v, fastest_omega = reach.asked_v, reach.asked_omega
+    accel, alpha = base.max_accel, base.max_alpha
+    if reach is not None:
+        accel, alpha = min(accel, reach.accel), min(alpha, reach.alpha)
     dwa = DwaParams(
         **nav.dwa.model_dump(),
-        max_v=min(nav.max_v, base.max_v),
-        max_omega=min(nav.max_omega, base.max_omega),
-        max_accel=base.max_accel,
-        max_alpha=base.max_alpha,
+        max_v=fastest_v,
+        max_omega=fastest_omega,
+        max_accel=accel,
+        max_alpha=alpha,
         period=1.0 / nav.rate_hz,
         radius=radius,
         rotate_threshold=nav.turn_in_place_threshold,
     )
     grid = {_MAP_NAMES.get(k, k): v for k, v in nav.map.model_dump().items()}
     recovery = nav.recovery.model_dump()
-    fastest_v, fastest_omega = min(nav.max_v, base.max_v), min(nav.max_omega, base.max_omega)
+    recovery["progress_window"] /= slower(reach)
     for name in ("backup_speed", "follow_speed"):
         recovery[name] = min(recovery[name], fastest_v)
     recovery["spin_speed"] = min(recovery["spin_speed"], fastest_omega)

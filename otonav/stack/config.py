@@ -512,14 +512,16 @@ class MountConfig(_Section):
 
 class FramesConfig(_Section):
     """The frame ids of the robot's links in /odom, /tf, /tf_static, /scan and /imu, as
-    its URDF names them (REP 105); ``odom`` stays ``odom``."""
+    its URDF names them (REP 105); ``odom`` stays ``odom``. Unset: the model's names (the
+    base body, the lidar's and the IMU's site or body), ``base_link``, ``laser`` and
+    ``imu_link`` for otonav's own robot or a sensor otonav mounts on the base."""
 
-    base: _Name = "base_link"
+    base: _Name | None = None
     """The base frame: /odom's child frame and the parent of the sensors' (a Nav2 robot
     often says ``base_footprint``)."""
-    laser: _Name = "laser"
+    laser: _Name | None = None
     """The lidar's frame (/scan's ``frame_id``)."""
-    imu: _Name = "imu_link"
+    imu: _Name | None = None
     """The IMU's frame (/imu's ``frame_id``)."""
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import types
+import typing
 from collections.abc import Sequence
 from typing import Any, TypeVar
 
@@ -12,6 +14,22 @@ from otonav.stack import safe_yaml
 from otonav.stack.files import ConfigFileError, describe_validation_error, to_json
 
 _M = TypeVar("_M", bound=BaseModel)
+
+
+def _section(model: type[BaseModel] | None, name: str) -> type[BaseModel] | None:
+    """The model of section ``name`` of ``model`` (an optional section's too), or None."""
+    field = model.model_fields.get(name) if model is not None else None
+    if field is None:
+        return None
+    kinds = [field.annotation]
+    if isinstance(field.annotation, types.UnionType) or typing.get_origin(field.annotation) is (
+        typing.Union
+    ):
+        kinds = list(typing.get_args(field.annotation))
+    for kind in kinds:
+        if isinstance(kind, type) and issubclass(kind, BaseModel):
+            return kind
+    return None
 
 
 def _actor_path(data: dict[str, Any], parts: list[str], source: str, key: str) -> list[str]:
@@ -55,20 +73,27 @@ def apply_overrides(model: _M, assignments: Sequence[str], *, source: str = "--s
         node = data
         parts = key.strip().split(".")
         parts = _actor_path(data, parts, source, key)
+        section: type[BaseModel] | None = type(model)
         for i, part in enumerate(parts[:-1]):
+            parent, section = section, _section(section, part)
             child = node.get(part)
+            if child is None and section is not None:  # an optional section left out
+                child = node[part] = {}
             if not isinstance(child, dict):
                 where = ".".join(parts[: i + 1])
+                sections = [k for k in node if isinstance(node[k], dict) or _section(parent, k)]
                 raise ConfigFileError(
                     f"{source} {key}: '{where}' is not a section; valid sections: "
-                    f"{', '.join(k for k, v in node.items() if isinstance(v, dict))}"
+                    f"{', '.join(sections)}"
                 )
             node = child
-        if parts[-1] not in node:
+        fields = list(section.model_fields) if section is not None else []
+        known = [*node, *(name for name in fields if name not in node)]
+        if parts[-1] not in known:
             raise ConfigFileError(
-                f"{source} {key}: unknown key '{parts[-1]}'; valid keys here: {', '.join(node)}"
+                f"{source} {key}: unknown key '{parts[-1]}'; valid keys here: {', '.join(known)}"
             )
-        if isinstance(node[parts[-1]], dict):
+        if isinstance(node.get(parts[-1]), dict):
             raise ConfigFileError(
                 f"{source} {key}: is a section; set its keys one by one, e.g. "
                 f"{key}.{next(iter(node[parts[-1]]), 'key')}=VALUE"

@@ -5,12 +5,24 @@ against the config file it was written in."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Final
 
+from otonav.actors.topics import FRAMES, Frames
 from otonav.hal.description import BUILTIN_ROBOTS, Mount, RobotDescription, builtin_robot
+from otonav.hal.interface import RobotHardwareInterface
+from otonav.hal.types import Reach
 from otonav.stack.config import BaseConfig, MountConfig, RobotConfig, StackConfig
 from otonav.stack.files import ConfigFileError
 
-__all__ = ["describe_robot", "robot_base", "top_speed"]
+__all__ = [
+    "deadband",
+    "describe_robot",
+    "reached",
+    "robot_base",
+    "robot_frames",
+    "slower",
+    "top_speed",
+]
 
 
 def _mount(config: MountConfig | None) -> Mount | None:
@@ -56,6 +68,32 @@ def describe_robot(config: RobotConfig) -> RobotDescription:
     )
 
 
+def _frame(mount: Mount | None, default: str) -> str:
+    if mount is None:
+        return default
+    return mount.site or mount.body or default
+
+
+def robot_frames(config: RobotConfig) -> Frames:
+    """The frame ids otonav stamps: ``robot.frames`` where set, else the model's names
+    (the base body; the lidar's and the IMU's site or body), else otonav's."""
+    given = config.frames
+    if config.model == "otonav":
+        model = FRAMES
+    else:
+        robot = describe_robot(config)
+        model = Frames(
+            base=robot.base,
+            laser=_frame(robot.lidar, FRAMES.laser),
+            imu=_frame(robot.imu, FRAMES.imu),
+        )
+    return Frames(
+        base=given.base or model.base,
+        laser=given.laser or model.laser,
+        imu=given.imu or model.imu,
+    )
+
+
 def robot_base(stack: StackConfig) -> BaseConfig:
     """``stack.base`` with its speed limits capped at the robot's top speeds (a robot
     description may state them: ``robot.max_v`` / ``robot.max_omega``)."""
@@ -72,3 +110,31 @@ def robot_base(stack: StackConfig) -> BaseConfig:
 def top_speed(stack: StackConfig) -> float:
     """m/s: the fastest the robot may drive (the base's limit, capped by the robot's)."""
     return robot_base(stack).max_v
+
+
+REACHED: Final = 0.95
+"""A robot that reaches this share of the asked speed is taken at the asked figure (the
+identification's few percent are not worth a different navigator; ADR 0066)."""
+
+
+def reached(stack: StackConfig, hal: RobotHardwareInterface) -> Reach | None:
+    """What ``hal``'s robot really reaches when the navigator asks its top speeds (the
+    nav's, capped by the base's and the robot's); None when the HAL cannot tell."""
+    base, nav = robot_base(stack), stack.nav
+    return hal.reach(min(nav.max_v, base.max_v), min(nav.max_omega, base.max_omega))
+
+
+def slower(reach: Reach | None) -> float:
+    """The share of the asked speed the robot reaches: 1.0 when it reaches at least
+    :data:`REACHED` of it, none of it, or nobody measured."""
+    if reach is None:
+        return 1.0
+    share = reach.v / reach.asked_v
+    return share if 0.0 < share < REACHED else 1.0  # 0: it never moved; nothing to scale
+
+
+def deadband(reach: Reach | None) -> float:
+    """rad/s the base adds to each turning wheel's command (ADR 0066): the robot's
+    identified deadband when it is slower than asked, else 0 (a robot that reaches its
+    speed is driven exactly as before)."""
+    return reach.deadband if reach is not None and slower(reach) < 1.0 else 0.0

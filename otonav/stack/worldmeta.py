@@ -8,8 +8,10 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping
+from dataclasses import asdict
 
 from otonav.hal import BoxObstacle, RobotGeometry, RobotHardwareInterface
+from otonav.hal.types import Reach
 
 WORLD_METADATA = "otonav.world"
 """The metadata record's name."""
@@ -39,6 +41,10 @@ def world_metadata(hal: RobotHardwareInterface) -> dict[str, str]:
         "walls": _boxes(hal.walls()),
         "robot": json.dumps(robot),
     }
+    identified = hal.identified()
+    if identified is not None:  # what the actors were built for (ADR 0066)
+        (v, omega), reach = identified
+        record["reach"] = json.dumps({"request": [v, omega], **asdict(reach)})
     sources = hal.geometry_sources()
     if sources:  # where each value came from: derived from the model, or given
         record["robot_sources"] = json.dumps(sources, sort_keys=True)
@@ -63,6 +69,21 @@ def geometry_from_metadata(record: Mapping[str, str]) -> RobotGeometry | None:
             imu_offset=(x, y, z),
             footprint=tuple((float(cx), float(cy)) for cx, cy in robot["footprint"]),
         )
+    except (ValueError, TypeError, KeyError):
+        return None
+
+
+def reach_from_metadata(
+    record: Mapping[str, str],
+) -> tuple[tuple[float, float], Reach] | None:
+    """The identification a :func:`world_metadata` record kept (None: none kept)."""
+    text = record.get("reach")
+    if text is None:
+        return None
+    try:
+        values = json.loads(text)
+        v, omega = (float(x) for x in values.pop("request"))
+        return (v, omega), Reach(**{k: float(x) for k, x in values.items()})
     except (ValueError, TypeError, KeyError):
         return None
 

@@ -20,7 +20,7 @@ pytestmark = pytest.mark.sil
 EXPECTED_TOPICS = {
     "/clock", "/odom", "/imu", "/scan", "/tf", "/tf_static", "/cmd_vel", "/wheel_cmd",
     "/goal", "/nav/state", "/rosout", "/scenario/verdict", "/cmd_vel_nav", "/safety/state",
-    "/hardware/status", "/diagnostics",
+    "/hardware/status", "/diagnostics", "/joint_states",
 }  # fmt: skip
 
 

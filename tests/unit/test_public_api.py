@@ -123,6 +123,7 @@ PINNED: dict[str, tuple[str, ...]] = {
         "HardwareStatus",
         "Header",
         "Imu",
+        "JointState",
         "KeyValue",
         "LaserScan",
         "Log",

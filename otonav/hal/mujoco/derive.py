@@ -19,6 +19,9 @@ from otonav.hal.types import RobotGeometry
 __all__: list[str] = []
 
 
+_CASTER_GAP: Final = 3e-3  # m: a geom (not a wheel's) this close to the floor is a caster
+
+
 @dataclass(frozen=True, slots=True)
 class _Probe:
     mass: float  # kg, the robot's
@@ -26,6 +29,7 @@ class _Probe:
     top: float  # m, the highest point of the robot above its base's origin
     bottom: float  # m, the lowest point of its collision geoms above the floor
     floor: float  # m, that lowest point relative to the base's origin
+    resting: tuple[int, ...]  # the geoms other than the wheels' on the floor: casters
 
 
 def _probe(parts: _RobotSpec) -> _Probe:
@@ -37,26 +41,35 @@ def _probe(parts: _RobotSpec) -> _Probe:
     data = mujoco.MjData(model)
     mujoco.mj_kinematics(model, data)
     base = int(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, parts.base.name))
-    joint = int(
-        mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, parts.joints["left_wheel"].name)
-    )
-    wheel = int(model.jnt_bodyid[joint])
+    wheel_bodies = [
+        int(model.jnt_bodyid[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j.name)])
+        for j in parts.joints.values()
+    ]
+    wheels = set(wheel_bodies)
     geoms = _subtree_geoms(model, base)
     radius = max(
-        (float(model.geom_rbound[g]) for g in geoms if model.geom_bodyid[g] == wheel), default=0.0
+        (float(model.geom_rbound[g]) for g in geoms if model.geom_bodyid[g] == wheel_bodies[0]),
+        default=0.0,
     )
-    lows, highs = [], []
+    lows: dict[int, float] = {}
+    highs = []
     for g in geoms:
         corners = _geom_corners(model, data, g)[:, 2]
         highs.append(float(corners.max()))
         if _collides(model, g):
-            lows.append(float(corners.min()))
+            lows[g] = float(corners.min())
+    bottom = min(lows.values(), default=0.0)
     return _Probe(
         mass=float(model.body_subtreemass[base]),
         wheel_radius=radius,
         top=max(highs, default=0.0) - float(data.xpos[base][2]),
-        bottom=min(lows, default=0.0),
-        floor=min(lows, default=0.0) - float(data.xpos[base][2]),
+        bottom=bottom,
+        floor=bottom - float(data.xpos[base][2]),
+        resting=tuple(
+            g
+            for g, low in lows.items()
+            if low - bottom < _CASTER_GAP and int(model.geom_bodyid[g]) not in wheels
+        ),
     )
 
 
@@ -95,13 +108,20 @@ def _geom_half(model: Any, geom: int) -> tuple[NDArray[np.float64], NDArray[np.f
 
 
 def _geom_corners(model: Any, data: Any, geom: int) -> NDArray[np.float64]:
-    """The 8 corners of ``geom``'s bounding box, world frame."""
-    centre, half = _geom_half(model, geom)
-    local = _SIGNS * half + centre
-    corners: NDArray[np.float64] = (
+    """Points that bound ``geom``, world frame: a mesh's own vertices (its bounding box
+    turns with the mesh's principal axes, arbitrary about a wheel's axle, and reached
+    ~14 mm under a tyre), else the 8 corners of its bounding box."""
+    if int(model.geom_type[geom]) == mujoco.mjtGeom.mjGEOM_MESH:
+        mesh = int(model.geom_dataid[geom])
+        start, count = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
+        local = np.asarray(model.mesh_vert[start : start + count], dtype=np.float64)
+    else:
+        centre, half = _geom_half(model, geom)
+        local = _SIGNS * half + centre
+    points: NDArray[np.float64] = (
         local @ data.geom_xmat[geom].reshape(3, 3).T + data.geom_xpos[geom]
     )
-    return corners
+    return points
 
 
 def _shown_name(model: Any, kind: Any, ident: int) -> str:
@@ -151,29 +171,29 @@ class _Derivation:
         mujoco.mj_kinematics(model, self.data)
         self.origin = self.data.xpos[base].copy()
         self.to_base = self.data.xmat[base].reshape(3, 3).T.copy()
+        self.mover = base  # the body that moves the base: itself, or up fixed links
+        while int(model.body_jntnum[self.mover]) == 0 and int(model.body_parentid[self.mover]):
+            self.mover = int(model.body_parentid[self.mover])
 
     def in_base(self, world: NDArray[np.float64]) -> NDArray[np.float64]:
         result: NDArray[np.float64] = (world - self.origin) @ self.to_base.T
         return result
 
-    def geometry(
-        self, joints: tuple[int, int], lidar: int, imu: int, base_qpos: int
-    ) -> RobotGeometry:
-        m = self.model
+    def geometry(self, joints: tuple[int, int], lidar: int, imu: int) -> RobotGeometry:
         radius = self.wheel_radius(joints[0])
         separation = self.separation(*joints)
         laser = self.site_offset(lidar, "lidar")
         imu_pos = self.site_offset(imu, "imu")
         footprint = self.footprint()
-        self.check_lidar_outside(lidar)
         return RobotGeometry(
             wheel_radius=radius,
             wheel_separation=separation,
             laser_offset_x=float(laser[0]),
             laser_offset_z=float(laser[2]),
-            base_height=float(m.qpos0[base_qpos + 2]),
+            base_height=float(self.origin[2]),
             imu_offset=(float(imu_pos[0]), float(imu_pos[1]), float(imu_pos[2])),
             footprint=footprint,
+            wheel_joints=(self.robot.left_wheel, self.robot.right_wheel),
         )
 
     def _given(self, key: str, value: object) -> bool:
@@ -223,7 +243,14 @@ class _Derivation:
         k = int(np.argmax(np.abs(axis)))
         aligned = abs(float(axis[k])) > 0.999
         round_about_z = kind in (mujoco.mjtGeom.mjGEOM_CYLINDER, mujoco.mjtGeom.mjGEOM_CAPSULE)
-        if kind == mujoco.mjtGeom.mjGEOM_SPHERE or (round_about_z and aligned and k == 2):
+        if round_about_z and not (aligned and k == 2):
+            raise self.parts.fail(
+                "left_wheel",
+                f"the wheel's geom {name} is a {mujoco.mjtGeom(kind).name[7:].lower()} whose "
+                "axis is not the joint's axle, so it cannot roll: turn it (MJCF angles are "
+                'degrees unless <compiler angle="radian"/>)',
+            )
+        if kind == mujoco.mjtGeom.mjGEOM_SPHERE or round_about_z:
             radius = float(size[0])
         elif kind == mujoco.mjtGeom.mjGEOM_ELLIPSOID and aligned:
             radius = float(max(size[i] for i in range(3) if i != k))
@@ -241,11 +268,18 @@ class _Derivation:
         return radius
 
     def separation(self, left: int, right: int) -> float:
+        m = self.model
+        anchors = self.in_base(np.array([self.data.xanchor[left], self.data.xanchor[right]]))
+        if float(anchors[0][1]) <= float(anchors[1][1]):
+            raise self.parts.fail(
+                "left_wheel",
+                f"joint {self.robot.left_wheel!r} is at y = {anchors[0][1]:.3f} m, not left of "
+                f"{self.robot.right_wheel!r} (y = {anchors[1][1]:.3f} m; left is +y in the "
+                f"base frame): swap {self.robot.key}left_wheel and {self.robot.key}right_wheel",
+            )
         if self._given("wheel_separation", self.robot.wheel_separation):
             return float(self.robot.wheel_separation or 0.0)
-        m = self.model
         lb, rb = int(m.jnt_bodyid[left]), int(m.jnt_bodyid[right])
-        anchors = self.in_base(np.array([self.data.xanchor[left], self.data.xanchor[right]]))
         middle = anchors.mean(axis=0)
         if abs(float(middle[0])) > _CENTRED or abs(float(middle[1])) > _CENTRED:
             raise self.parts.fail(
@@ -295,7 +329,7 @@ class _Derivation:
         if self._given("footprint", self.robot.footprint):
             return tuple(self.robot.footprint or ())
         m = self.model
-        geoms = [g for g in _subtree_geoms(m, self.base) if _collides(m, g)]
+        geoms = [g for g in _subtree_geoms(m, self.mover) if _collides(m, g)]
         if not geoms:
             raise self.parts.fail("model", f"the robot {self.robot.base!r} has no collision geom")
         points = np.concatenate(
@@ -307,20 +341,3 @@ class _Derivation:
             f"derived: the rectangle bounding {len(geoms)} collision geoms on the floor"
         )
         return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
-
-    def check_lidar_outside(self, site: int) -> None:
-        """A lidar inside the robot's own collision geometry would cast from inside it."""
-        m = self.model
-        point = self.data.site_xpos[site]
-        for g in _subtree_geoms(m, self.base):
-            if not _collides(m, g):
-                continue
-            centre, half = _geom_half(m, g)
-            local = self.data.geom_xmat[g].reshape(3, 3).T @ (point - self.data.geom_xpos[g])
-            if np.all(np.abs(local - centre) < half):
-                name = _shown_name(m, mujoco.mjtObj.mjOBJ_GEOM, g)
-                raise self.parts.fail(
-                    "lidar",
-                    f"the lidar's origin is inside the robot's collision geom {name!r}: mount it "
-                    "above the robot (a pos whose z clears the geom)",
-                )

@@ -5,6 +5,8 @@ merged. Each choice recorded with where it came from."""
 
 from __future__ import annotations
 
+import re
+import xml.etree.ElementTree as ElementTree
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, Final
@@ -26,7 +28,6 @@ _SERVO_SLIP: Final = 0.1
 _DEFAULT_TORQUE_G: Final = 0.2
 """A wheel with no stated torque limit gets 0.2 m g r: both wheels can then accelerate
 the robot at 0.4 g (ample for any base limit) without lifting a caster off the floor."""
-_CASTER_GAP: Final = 3e-3  # m: a base sphere this close to the floor is a caster
 
 
 def _names(elements: Sequence[Any]) -> str:
@@ -48,7 +49,7 @@ class _RobotSpec:
         self.ctrl_scale: dict[str, float] = {}
         self.lidar_site = ""
         self.imu_site = ""
-        self.base = self._body(robot.base, "base")
+        self.base = self._mover(self._body(robot.base, "base"))
         self.joints = {
             "left_wheel": self._wheel(robot.left_wheel, "left_wheel"),
             "right_wheel": self._wheel(robot.right_wheel, "right_wheel"),
@@ -65,7 +66,22 @@ class _RobotSpec:
             )
         return body
 
+    @staticmethod
+    def _mover(body: Any) -> Any:
+        """The body that moves ``body``: itself, or the first ancestor up a chain of
+        fixed (jointless) links that has a joint or sits in the world (base_footprint
+        above base_link, as a URDF's fixed joints nest them)."""
+        while not body.joints and body.parent is not None and body.parent.name != "world":
+            body = body.parent
+        return body
+
     def _wheel(self, name: str, key: str) -> Any:
+        if key == "right_wheel" and name == self.robot.left_wheel:
+            raise self.fail(
+                key,
+                f"names the same joint as {self.robot.key}left_wheel ({name!r}); "
+                "name the right wheel's joint",
+            )
         hinges = [j for j in self.spec.joints if j.type == mujoco.mjtJoint.mjJNT_HINGE]
         joint = self.spec.joint(name)
         if joint is None or joint.type != mujoco.mjtJoint.mjJNT_HINGE:
@@ -82,20 +98,27 @@ class _RobotSpec:
             body = body.parent
         return False
 
-    def casters(self, floor: float) -> None:
-        """Spheres of the base that rest on the floor with the wheels are casters: made
-        frictionless (condim 1, priority 1), as a URDF cannot say (its friction tags are
-        Gazebo's); otherwise they drag like brakes."""
-        made = []
-        for geom in self.base.geoms:
-            if geom.type != mujoco.mjtGeom.mjGEOM_SPHERE or int(geom.condim) == 1:
+    def casters(self, resting: Sequence[int]) -> None:
+        """Geoms of the robot other than the wheels that rest on the floor with them
+        (``resting``: indexes into the spec's geoms) are casters: made frictionless
+        (condim 1, priority 1 so the floor's friction does not win the contact), as a
+        URDF cannot say (its friction tags are Gazebo's); otherwise they drag like
+        brakes."""
+        geoms = self.spec.geoms
+        made, kept = [], []
+        for index in resting:
+            geom = geoms[index]
+            name = repr(geom.name) if geom.name else f"#{index} of body {geom.parent.name!r}"
+            if int(geom.condim) == 1 and int(geom.priority) >= 1:
+                kept.append(name)
                 continue
-            if float(geom.pos[2]) - float(geom.size[0]) - floor < _CASTER_GAP:
-                geom.condim = 1
-                geom.priority = 1
-                made.append(geom.name or f"sphere at x = {float(geom.pos[0]):.3g} m")
+            made.append(f"{name} (condim {int(geom.condim)}, priority {int(geom.priority)})")
+            geom.condim = 1
+            geom.priority = max(1, int(geom.priority))
         if made:
             self.sources["casters"] = f"made frictionless by otonav: {', '.join(made)}"
+        elif kept:
+            self.sources["casters"] = f"frictionless in the model: {', '.join(kept)}"
 
     def prepare(self, mass: float, wheel_radius: float) -> None:
         """Free base, wheel actuators, sensor sites, geom groups (after :meth:`probe`)."""
@@ -299,6 +322,29 @@ def _absolute_assets(spec: Any, path: Path) -> None:
     spec.texturedir = ""
 
 
+_XACRO_NS: Final = "{http://ros.org/wiki/xacro}"
+_XACRO_SUBST: Final = re.compile(r"\$[{(]")
+
+
+def _xacro_use(path: Path) -> str | None:
+    """What in ``path`` is xacro (an element or a ``${...}``/``$(...)``), or None. MuJoCo
+    would read such a file without its macros (ADR 0068): a caster silently gone."""
+    text = path.read_text(errors="replace")
+    if "xacro" not in text and "${" not in text:
+        return None
+    try:
+        root = ElementTree.fromstring(text)
+    except ElementTree.ParseError:
+        return None  # MuJoCo's own parse error says where
+    for element in root.iter():
+        if isinstance(element.tag, str) and element.tag.startswith(_XACRO_NS):
+            return f"<xacro:{element.tag.removeprefix(_XACRO_NS)}>"
+        for value in element.attrib.values():
+            if _XACRO_SUBST.search(value):
+                return repr(value)
+    return None
+
+
 def _load_robot(robot: RobotDescription) -> tuple[Any, str]:
     """The robot's model as a spec, its asset files found where the model says."""
     path = Path(robot.model)
@@ -307,6 +353,15 @@ def _load_robot(robot: RobotDescription) -> tuple[Any, str]:
         raise SceneError(
             f"{robot.key}model: {label!r} is neither a built-in robot "
             f"({', '.join(BUILTIN_ROBOTS)}) nor an existing MJCF or URDF file"
+        )
+    xacro = _xacro_use(path)
+    if xacro is not None:
+        expanded = (
+            path.name.removesuffix(".xacro") if path.name.endswith(".xacro") else "robot.urdf"
+        )
+        raise SceneError(
+            f"{robot.key}model: {label} uses xacro ({xacro}), which otonav does not expand: "
+            f"expand it first (xacro {path.name} > {expanded}) and name the result"
         )
     try:
         spec = mujoco.MjSpec.from_file(str(path))

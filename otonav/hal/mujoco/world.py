@@ -44,6 +44,7 @@ from otonav.hal.description import RobotDescription, builtin_robot
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.mujoco._lib import mujoco, viewer_module
 from otonav.hal.mujoco.derive import _actuator_of, _Derivation, _probe, _site_sensor
+from otonav.hal.mujoco.identify import SECONDS, _Robot, identify
 from otonav.hal.mujoco.prepare import ROBOT_PREFIX, _load_robot, _merge_options, _RobotSpec
 from otonav.hal.mujoco.scene import SceneError, _add_box, _compile, _load_spec
 from otonav.hal.mujoco.static_geoms import ray_caster
@@ -53,6 +54,7 @@ from otonav.hal.types import (
     GroundTruth,
     ImuSample,
     RangeScan,
+    Reach,
     RobotGeometry,
     WheelSetpoint,
     WheelState,
@@ -65,6 +67,15 @@ _RAY_GROUPS: Final = np.array([1, 0, 1, 0, 0, 0], dtype=np.uint8)  # groups 0 an
 _SETTLE_TIME: Final = 0.25  # s of physics run at construction, before tick 0
 _MOUNT_ABOVE: Final = 0.02  # m: a default lidar sits this far above the robot's top
 _REST_TOLERANCE: Final = 1e-3  # m: a model resting within this of the floor is not moved
+
+
+_IDENTIFIED: dict[object, Reach] = {}
+"""Identifications by robot, model file version, scene, timestep and speeds asked: a
+sweep's runs of one robot identify it once per process (~0.1 s each otherwise)."""
+
+
+def _mtime(path: str) -> int:
+    return os.stat(path).st_mtime_ns
 
 
 def _yaw_of_quat(w: float, x: float, y: float, z: float) -> float:
@@ -126,12 +137,13 @@ class MujocoInterface(RobotHardwareInterface):
             prefix = ROBOT_PREFIX
         parts = _RobotSpec(robot_spec, robot, robot_file)
         probe = _probe(parts)
-        parts.casters(probe.floor)
+        parts.casters(probe.resting)
         parts.prepare(probe.mass, probe.wheel_radius)
         lidar_site = parts.mount("lidar", robot.lidar, (0.0, 0.0, probe.top + _MOUNT_ABOVE))
         imu_site = parts.mount("imu", robot.imu, (0.0, 0.0, 0.0))
         parts.imu_sensors(imu_site)
         self._ctrl_scale = (parts.ctrl_scale["left_wheel"], parts.ctrl_scale["right_wheel"])
+        mover = str(parts.base.name)  # the body that moves: robot.base, or above it
         if prefix:
             if abs(probe.bottom) > _REST_TOLERANCE:
                 parts.base.pos[2] -= probe.bottom  # rest on the floor, not in or above it
@@ -152,7 +164,7 @@ class MujocoInterface(RobotHardwareInterface):
                 raise SceneError(f"{robot_file}: {name!r} missing after compiling")
             return found
 
-        self._chassis = ident(obj.mjOBJ_BODY, robot.base)
+        self._chassis = ident(obj.mjOBJ_BODY, mover)
         base_joint = int(m.body_jntadr[self._chassis])
         self._base_qpos = int(m.jnt_qposadr[base_joint])
         self._base_qvel = int(m.jnt_dofadr[base_joint])
@@ -168,7 +180,7 @@ class MujocoInterface(RobotHardwareInterface):
         self._accel = _site_sensor(m, mujoco.mjtSensor.mjSENS_ACCELEROMETER, self._imu_site)
         self._quat = _site_sensor(m, mujoco.mjtSensor.mjSENS_FRAMEQUAT, self._imu_site)
 
-        derived = _Derivation(m, self._chassis, parts)
+        derived = _Derivation(m, ident(obj.mjOBJ_BODY, robot.base), parts)
         self._wheel_sign = (derived.wheel_sign(left_joint), derived.wheel_sign(right_joint))
         self._mirrored = self._wheel_sign != (1.0, 1.0)
         self._ctrl_scale = (
@@ -176,9 +188,19 @@ class MujocoInterface(RobotHardwareInterface):
             self._ctrl_scale[1] * self._wheel_sign[1],
         )
         self._geometry = derived.geometry(
-            (left_joint, right_joint), self._lidar_site, self._imu_site, self._base_qpos
+            (left_joint, right_joint), self._lidar_site, self._imu_site
         )
         self._sources = {**parts.sources, **derived.sources}
+        self._spec = spec
+        self._identity = _Robot(
+            body=prefix + mover,
+            left=prefix + robot.left_wheel,
+            right=prefix + robot.right_wheel,
+            scale=self._ctrl_scale,
+            radius=self._geometry.wheel_radius,
+            separation=self._geometry.wheel_separation,
+        )
+        self._reach: dict[tuple[float, float], Reach] = {}
         self._obstacles = self._static_boxes("obstacle")
         self._walls = self._static_boxes("wall")
         self._is_floor = np.asarray(m.geom_type == mujoco.mjtGeom.mjGEOM_PLANE, dtype=np.bool_)
@@ -491,6 +513,48 @@ class MujocoInterface(RobotHardwareInterface):
     def robot(self) -> RobotDescription:
         """The description this world's robot was built from."""
         return self._robot
+
+    def tallest_obstacle(self) -> float | None:
+        m, tops = self._model, []  # the boxes, not the arena's walls
+        for g in range(m.ngeom):
+            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g) or ""
+            if name.startswith("obstacle") and int(m.geom_bodyid[g]) == 0:
+                tops.append(float(m.geom_pos[g][2] + m.geom_rbound[g]))
+                if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX:  # upright: its half height
+                    tops[-1] = float(m.geom_pos[g][2] + m.geom_size[g][2])
+        return max(tops, default=None)
+
+    def reach(self, v: float, omega: float) -> Reach:
+        """Identified in sim time on a copy of the world with only the robot in it
+        (ADR 0066): this world's physics is not touched. Recorded in the sources. The
+        speeds asked are capped at what the wheels' control range allows (ROBOTIS's
+        +-6.67 rad/s: 0.22 m/s), and the result says so in ``asked_v``/``asked_omega``."""
+        if (v, omega) not in self._reach:
+            wheel = self._wheel_top()
+            radius, half_track = self._geometry.wheel_radius, self._geometry.wheel_separation / 2
+            asked = (min(v, wheel * radius), min(omega, wheel * radius / half_track))
+            robot, scene = self._robot, self._label  # the scene: its floor's friction
+            key = (repr(robot), _mtime(robot.model), scene, self.tick, self._identity, asked)
+            found = _IDENTIFIED.get(key) or identify(self._spec, self._identity, *asked)
+            _IDENTIFIED[key] = found
+            self._reach[(v, omega)] = found
+            capped = (
+                f" (the wheels' control range: {wheel:.3g} rad/s)" if asked != (v, omega) else ""
+            )
+            self._sources["reach"] = f"identified in {SECONDS:g} s of sim: {found.line()}{capped}"
+        return self._reach[(v, omega)]
+
+    def identified(self) -> tuple[tuple[float, float], Reach] | None:
+        return next(reversed(self._reach.items()), None)
+
+    def _wheel_top(self) -> float:
+        """rad/s: the fastest wheel speed the actuators' control ranges can ask."""
+        m, top = self._model, math.inf
+        for act, scale in zip((self._left_act, self._right_act), self._ctrl_scale, strict=True):
+            if bool(m.actuator_ctrllimited[act]):
+                lo, hi = (float(c) for c in m.actuator_ctrlrange[act])
+                top = min(top, min(abs(lo), abs(hi)) / abs(scale))
+        return top
 
     def obstacles(self) -> tuple[BoxObstacle, ...]:
         return self._obstacles

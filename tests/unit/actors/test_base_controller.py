@@ -282,3 +282,20 @@ def test_a_stream_of_bad_commands_is_logged_at_most_once_per_second() -> None:
     assert base.rejected_commands == 150
     assert [round(log.stamp.to_seconds(), 2) for log in logs] == [0.02, 1.02, 2.02]
     assert "(49 more since the last warning)" in logs[1].msg  # 0.04 .. 1.00 s
+
+
+def test_a_deadband_is_added_to_each_turning_wheel_in_its_direction() -> None:
+    """ADR 0066: a servo that loses 1 rad/s to friction gets it added to every wheel
+    that turns, in its direction (a turn in place: one wheel each way); a wheel asked
+    nothing gets nothing."""
+    base = BaseController(GEOMETRY, deadband=1.0)
+    without = _drive([(0.0, 0.0, 1.0), *_every(0.1, 0.1, 1.0, 0.0, 1.0)], until=1.0)
+    carried = _drive([(0.0, 0.0, 1.0), *_every(0.1, 0.1, 1.0, 0.0, 1.0)], until=1.0, base=base)
+    assert (carried[-1].left, carried[-1].right) == pytest.approx(
+        (without[-1].left - 1.0, without[-1].right + 1.0), abs=EPS
+    )
+    assert without[-1].left < 0 < without[-1].right
+    stopped = _drive(
+        _every(0.1, 0.0, 0.5, 0.0, 0.0), until=0.5, base=BaseController(GEOMETRY, deadband=1.0)
+    )
+    assert {(s.left, s.right) for s in stopped} == {(0.0, 0.0)}

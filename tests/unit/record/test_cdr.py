@@ -423,6 +423,8 @@ def example(kind: type[Message], i: int = 1) -> Message:
             values[name] = example(tp, i + len(name))
         elif tp == tuple[float, ...]:
             values[name] = (1.0, -INF, 0.5)[: i % 4]
+        elif tp == tuple[str, ...]:
+            values[name] = FRAMES[: i % 4]
         else:
             pytest.fail(f"no example for {kind.__name__}.{name}: {tp!r}")
     return kind(**values)

@@ -9,12 +9,13 @@ import sys
 import pytest
 
 from otonav.hal import FakeHardware, RobotGeometry, WheelSetpoint
+from otonav.hal.description import builtin_robot
 from otonav.hal.mujoco import MujocoInterface
 from otonav.replay import ReplayInputError
 from otonav.replay.nodes import build_nodes, stack_actor_names
 from otonav.replay.world import RecordedRobot
 from otonav.stack import StackConfig
-from otonav.stack.worldmeta import geometry_from_metadata, world_metadata
+from otonav.stack.worldmeta import geometry_from_metadata, reach_from_metadata, world_metadata
 
 pytestmark = pytest.mark.unit
 
@@ -109,3 +110,19 @@ def test_a_can_stack_replays_its_actors_without_a_bus() -> None:
     assert stack_actor_names(stack, ODD) == ["base", "nav", "safety"]
     with pytest.raises(ReplayInputError, match="can_tap: cannot be replayed"):
         build_nodes(["can_tap"], stack, ODD)
+
+
+def test_the_recorded_reach_is_the_replayed_robots_without_building_the_world() -> None:
+    """ADR 0066: the identification the actors were built from is in the recording;
+    asked the same, the recorded robot answers it; asked otherwise, it identifies again;
+    none recorded (a CAN robot, an older file), none."""
+    world = MujocoInterface("empty", robot=builtin_robot("burger"))
+    measured = world.reach(0.22, 1.2)
+    kept = reach_from_metadata(world_metadata(world))
+    assert kept == ((0.22, 1.2), measured)
+    robot = RecordedRobot(ODD, lambda: world, kept)
+    assert robot.reach(0.22, 1.2) == measured
+    assert not robot.built
+    assert robot.reach(0.2, 1.0) == world.reach(0.2, 1.0)
+    assert robot.built
+    assert RecordedRobot(ODD, lambda: pytest.fail("built")).reach(0.22, 1.2) is None

@@ -10,13 +10,14 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from matplotlib.patches import Polygon
 from matplotlib.path import Path as Path_
 
 from otonav.cli import main
 from otonav.hal import BoxObstacle
 from otonav.msgs import Header, Odometry, Point, Pose, PoseStamped, PoseWithCovariance, Time
 from otonav.record.writer import RecordingWriter
-from otonav.scenario.plot import box_outlines, draw_trajectory
+from otonav.scenario.plot import box_outlines, draw_trajectory, key_poses
 from otonav.scenario.replay import plot_recording, recorded_plot
 from otonav.stack.worldmeta import WORLD_METADATA
 
@@ -178,3 +179,22 @@ def test_a_box_the_window_cuts_is_drawn_whole_and_a_wall_stays_cut() -> None:
     assert bottom == pytest.approx(box_outlines((box,))[0][:, 1].min())  # the whole box
     assert top == pytest.approx(1.6)  # the wall's whole thickness
     assert (left, right) == pytest.approx((-2.0, 4.0))  # its length: at most 1 m more
+
+
+def test_the_footprint_is_drawn_at_start_closest_approach_and_end() -> None:
+    """Issue 38: the robot's outline, turned the way it drove, at the three poses."""
+    trajectory = [(0.1 * i, 0.1 * i, 0.0) for i in range(11)]  # along +x to (1, 0)
+    trajectory += [(1.1 + 0.1 * i, 1.0, 0.1 * (i + 1)) for i in range(10)]  # then +y
+    poses = key_poses(trajectory, math.pi, (1.0, 0.5))
+    assert poses[0] == (0.0, 0.0, math.pi)  # the start as given
+    assert poses[1][:2] == (1.0, 0.5)
+    assert poses[1][2] == pytest.approx(math.pi / 2)  # driving +y there
+    assert poses[2][:2] == (1.0, 1.0)
+    assert poses[2][2] == pytest.approx(math.pi / 2)
+    footprint = ((-0.1, -0.2), (0.3, -0.2), (0.3, 0.2), (-0.1, 0.2))
+    fig = draw_trajectory(trajectory, (), None, None, None, "t", footprint=footprint, poses=poses)
+    drawn = [p for p in fig.axes[0].patches if isinstance(p, Polygon)]
+    assert len(drawn) == 3
+    corners = drawn[2].get_xy()[:4]  # at the end, facing +y: x' = x - y_b, y' = y + x_b
+    expected = [1.2, 0.9, 1.2, 1.3, 0.8, 1.3, 0.8, 0.9]
+    assert corners.ravel().tolist() == pytest.approx(expected)
