@@ -19,9 +19,9 @@ from collections.abc import Callable
 
 import anyio
 
-from otonav.runtime.errors import TimeSourceError
 from otonav.runtime.loop import VirtualTimeLoop
-from otonav.runtime.timesource import FrozenSource, TimeSource, tick_rate
+from otonav.runtime.stepper import Stepper
+from otonav.runtime.timesource import TimeSource
 
 _current: contextvars.ContextVar[Clock] = contextvars.ContextVar("otonav_clock")
 
@@ -63,6 +63,12 @@ class Clock(ABC):
     def rate(self, hz: float) -> Rate:
         """A drift-free periodic timer at ``hz`` (like ``rclpy`` ``Rate``)."""
         return Rate(self, hz)
+
+    def add_failure_listener(self, listener: Callable[[BaseException], None]) -> None:
+        """Call ``listener(error)`` when the world fails inside this clock (a System
+        listens and stops with it). A clock whose world fails elsewhere (the virtual
+        loop's, which cancels the run itself) has nothing to report: the default."""
+        del listener
 
 
 class Rate:
@@ -160,12 +166,10 @@ class RealTimeClock(Clock):
             raise ValueError(f"real-time scale must be a finite number > 0, got {scale!r}")
         if max_step_batch is not None and not max_step_batch > 0:
             raise ValueError(f"max_step_batch must be > 0 s, got {max_step_batch!r}")
-        self._source = source
-        self._rate = tick_rate(source.tick)
+        self._stepper = Stepper(source, self._failed)
+        self._rate = self._stepper.rate
         self.scale = scale
-        self._ticks = 0
         self._wall0: float | None = None
-        self._watchers: list[Callable[[], bool]] = []
         self._failure_listeners: list[Callable[[BaseException], None]] = []
         self.failure: BaseException | None = None
         self.max_batch_ticks = (
@@ -191,7 +195,7 @@ class RealTimeClock(Clock):
     @property
     def source(self) -> TimeSource:
         """What is stepped (a :class:`FrozenSource` once the world's advance raised)."""
-        return self._source
+        return self._stepper.source
 
     def add_failure_listener(self, listener: Callable[[BaseException], None]) -> None:
         """Call ``listener(error)`` when the world's ``advance()`` (a
@@ -208,27 +212,10 @@ class RealTimeClock(Clock):
             listener(error)
 
     def _advance_to(self, ticks: int) -> None:
-        if ticks > self._ticks:
-            try:
-                self._source.advance(ticks - self._ticks)
-            except Exception as exc:
-                # Not the actor's fault that asked for the time: freeze the world (time
-                # runs on so the system can stop) and report the world's failure.
-                error = TimeSourceError(self._ticks / self._rate, exc)
-                error.__cause__ = exc
-                self._source = FrozenSource(self._source)
-                self._source.advance(ticks - self._ticks)
-                self._ticks = ticks
-                self._failed(error)
-            self._ticks = ticks
-            for watcher in tuple(self._watchers):
-                try:
-                    done = watcher()
-                except Exception as exc:
-                    done = True
-                    self._failed(exc)
-                if done and watcher in self._watchers:
-                    self._watchers.remove(watcher)
+        stepper = self._stepper
+        if ticks > stepper.ticks:
+            stepper.step_to(ticks, stepper.ticks / self._rate)
+            stepper.run_watchers()
 
     def _follow_wall(self) -> None:
         wall = self._wall()
@@ -236,7 +223,7 @@ class RealTimeClock(Clock):
         ticks_per_wall_s = self.scale * self._rate
         target = math.floor((wall - self._wall0) * ticks_per_wall_s + 1e-9)
         if self.max_batch_ticks is not None:
-            excess = target - self._ticks - self.max_batch_ticks
+            excess = target - self._stepper.ticks - self.max_batch_ticks
             if excess > 0:
                 # Slip: from now on the wall clock maps to sim time `excess` ticks later.
                 self._wall0 += excess / ticks_per_wall_s
@@ -256,7 +243,7 @@ class RealTimeClock(Clock):
 
     def now(self) -> float:
         self._follow_wall()
-        return self._ticks / self._rate
+        return self._stepper.ticks / self._rate
 
     def to_loop_time(self, sim_time: float) -> float:
         self._wall()
@@ -268,22 +255,16 @@ class RealTimeClock(Clock):
         while True:
             await anyio.sleep_until(self.to_loop_time(sim_time))
             self._follow_wall()
-            if self._ticks >= goal:
+            if self._stepper.ticks >= goal:
                 return
-            if goal - self._ticks <= 1:
+            if goal - self._stepper.ticks <= 1:
                 # The timer fired a hair early: the world still reaches the asked instant.
                 self._advance_to(goal)
                 return
             # Sim time slipped while we slept: the instant is later on the wall clock now.
 
     def watch(self, check: Callable[[], bool]) -> Callable[[], None]:
-        self._watchers.append(check)
-
-        def remove() -> None:
-            if check in self._watchers:
-                self._watchers.remove(check)
-
-        return remove
+        return self._stepper.watch(check)
 
 
 def current_clock() -> Clock:

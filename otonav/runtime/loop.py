@@ -27,13 +27,13 @@ from concurrent.futures import Executor
 from typing import Any, TypeVar, TypeVarTuple
 
 from otonav.runtime._asyncio_compat import SteppedSelectorLoop
-from otonav.runtime.errors import DeadlockError, TimeSourceError, WallClockCeilingError
-from otonav.runtime.timesource import FrozenSource, JumpSource, TimeSource, tick_rate
+from otonav.runtime.errors import DeadlockError, WallClockCeilingError
+from otonav.runtime.stepper import Stepper, Watcher
+from otonav.runtime.timesource import JumpSource, TimeSource
 from otonav.runtime.watchdog import LoopWatchdog
 
 _T = TypeVar("_T")
 _Ts = TypeVarTuple("_Ts")
-_Watcher = Callable[[], bool]
 
 
 class VirtualTimeLoop(SteppedSelectorLoop):
@@ -57,17 +57,15 @@ class VirtualTimeLoop(SteppedSelectorLoop):
         hold_grace: float = 2.0,
     ) -> None:
         super().__init__()
-        self._source: TimeSource = source if source is not None else JumpSource()
-        self._rate = tick_rate(self._source.tick)
+        # The world's stepping, freezing and watchers, shared with the real-time clock.
+        self._stepper = Stepper(source if source is not None else JumpSource(), self._fail)
         self._base = 0.0
-        self._ticks = 0
-        self._now = 0.0  # time(), kept with _base and _ticks (read ~9 times an instant)
+        self._now = 0.0  # time(), kept with _base and the ticks (read ~9 times an instant)
         # The loop advances to the first tick at or after a deadline; the resolution lets
         # a timer whose deadline is float noise above a tick fire at that tick. It must
         # stay well above the float spacing of large times (a year in: ~4e-9 s).
-        self.clock_resolution = 0.25 / self._rate
+        self.clock_resolution = 0.25 / self._stepper.rate
         self._holds = 0
-        self._watchers: list[_Watcher] = []
         self._wall_ceiling = wall_ceiling
         self._wall_start = time.monotonic()
         self._deadlock_grace = deadlock_grace
@@ -83,62 +81,36 @@ class VirtualTimeLoop(SteppedSelectorLoop):
     # -- time ---------------------------------------------------------------------------
 
     def time(self) -> float:
-        # _base + _ticks / _rate, computed when they change (the same float).
+        # _base + ticks / rate, computed when they change (the same float).
         return self._now
-
-    def _time_at(self, ticks: int) -> float:
-        return self._base + ticks / self._rate
 
     @property
     def source(self) -> TimeSource:
-        return self._source
+        return self._stepper.source
 
     @property
     def ticks(self) -> int:
         """Ticks advanced since the current source was attached."""
-        return self._ticks
+        return self._stepper.ticks
 
     def attach_source(self, source: TimeSource) -> None:
         """Let ``source`` drive time from now on; time continues, never goes back."""
         self._base = self.time()
-        self._ticks = 0
-        self._source = source
-        self._rate = tick_rate(source.tick)
-        self._now = self._base + self._ticks / self._rate
-        self.clock_resolution = 0.25 / self._rate
+        self._stepper.attach(source)
+        self._now = self._base
+        self.clock_resolution = 0.25 / self._stepper.rate
 
     # -- watchers: predicates evaluated whenever the system is idle at an instant -------
 
-    def add_idle_watcher(self, watcher: _Watcher) -> Callable[[], None]:
+    def add_idle_watcher(self, watcher: Watcher) -> Callable[[], None]:
         """Call ``watcher()`` each time the loop is idle, before time moves on; it is
-        dropped once it returns True. Returns a function that removes it."""
-        self._watchers.append(watcher)
+        dropped once it returns True (one that raises fails the run: it never escapes
+        the selector mid-step). Returns a function that removes it."""
+        return self._stepper.watch(watcher)
 
-        def remove() -> None:
-            if watcher in self._watchers:
-                self._watchers.remove(watcher)
-
-        return remove
-
-    def has_idle_watchers(self, other_than: _Watcher | None = None) -> bool:
+    def has_idle_watchers(self, other_than: Watcher | None = None) -> bool:
         """Whether an idle watcher besides ``other_than`` is registered."""
-        return any(w is not other_than for w in self._watchers)
-
-    def _run_watchers(self) -> None:
-        if not self._watchers:
-            return
-        # Iterate a snapshot in registration order: deterministic, and safe if a watcher
-        # registers or removes others.
-        for watcher in tuple(self._watchers):
-            try:
-                done = watcher()
-            except Exception as exc:
-                # Never let it escape the selector (it would leave the loop mid-step):
-                # the run fails with it. (until() hands its own to the awaiting task.)
-                done = True
-                self._fail(exc)
-            if done and watcher in self._watchers:
-                self._watchers.remove(watcher)
+        return any(w is not other_than for w in self._stepper.watchers)
 
     # -- blocking work: the one way to run it while sim time holds still ----------------
 
@@ -181,8 +153,8 @@ class VirtualTimeLoop(SteppedSelectorLoop):
                 return inner.select(0)
             return []
         # Nothing is ready: the system has settled at this instant.
-        if self._watchers:
-            self._run_watchers()
+        if self._stepper.watchers:
+            self._stepper.run_watchers()
             if self.has_ready():
                 return inner.select(0)
         if self.polls:
@@ -211,21 +183,14 @@ class VirtualTimeLoop(SteppedSelectorLoop):
         Always moving on matters: anyio re-arms a deadline timer that fired within the
         clock resolution but before its deadline; staying put would livelock.
         """
-        base, rate, resolution = self._base, self._rate, self.clock_resolution
-        target = max(self._ticks + 1, math.ceil((when - base) * rate - 1.0))
-        while base + target / rate + resolution <= when:  # _time_at(target), inline
+        stepper, base, resolution = self._stepper, self._base, self.clock_resolution
+        rate = stepper.rate
+        target = max(stepper.ticks + 1, math.ceil((when - base) * rate - 1.0))
+        while base + target / rate + resolution <= when:  # the time at target, inline
             target += 1
-        try:
-            self._source.advance(target - self._ticks)
-        except Exception as exc:
-            # Not out of the selector: fail the run with it, freeze the world and let
-            # time run on so the run's cleanup (on_stop, the recording) still gets it.
-            error = TimeSourceError(self.time(), exc)
-            error.__cause__ = exc
-            self._source = FrozenSource(self._source)
-            self._source.advance(target - self._ticks)
-            self._fail(error)
-        self._ticks = target
+        # A world that raises is not let out of the selector: the run fails with it, the
+        # world is frozen and time runs on so the cleanup (on_stop, the recording) runs.
+        stepper.step_to(target, self._now)
         self._now = base + target / rate
         self.wakes += 1
 

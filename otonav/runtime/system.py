@@ -28,7 +28,6 @@ from anyio.abc import TaskGroup
 from otonav.runtime.actor import Actor, check_wirable
 from otonav.runtime.clock import (
     Clock,
-    RealTimeClock,
     VirtualClock,
     reset_current_clock,
     set_current_clock,
@@ -110,7 +109,7 @@ class System:
                 self._wire(state.actor, direction)
         for state in self._states.values():
             state.actor.on_wired(self.bus)
-        if isinstance(clock, RealTimeClock):
+        if clock is not None:
             clock.add_failure_listener(self._clock_failed)
 
     def _wire(self, actor: Actor, direction: str) -> None:
