@@ -102,4 +102,10 @@ def install(*, verbose: bool = False) -> None:
         logger.propagate = False
     handler.setLevel(logging.DEBUG if verbose else logging.WARNING)
     logger.setLevel(logging.DEBUG if verbose else logging.NOTSET)
-    logging.getLogger(_NODES).setLevel(logging.DEBUG if verbose else logging.NOTSET)
+    nodes = logging.getLogger(_NODES)
+    nodes.setLevel(logging.DEBUG if verbose else logging.NOTSET)
+    # The console is the command's: a sweep worker made in this process earlier (a test's,
+    # or Ray's in-process actor) silenced the nodes' lines for its runs.
+    nodes.propagate = True
+    for quiet in [h for h in nodes.handlers if isinstance(h, logging.NullHandler)]:
+        nodes.removeHandler(quiet)

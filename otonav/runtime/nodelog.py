@@ -15,10 +15,21 @@ from __future__ import annotations
 import logging
 import sys
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, Final
+from typing import TYPE_CHECKING, Any, Final, Protocol
 
 if TYPE_CHECKING:
-    from otonav.runtime.actor import Actor
+    from otonav.runtime.clock import Clock
+
+
+class _Node(Protocol):
+    """What a logger needs of its actor (:class:`~otonav.runtime.actor.Actor`)."""
+
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def _otonav_clock(self) -> Clock | None: ...
+
 
 __all__ = ["LOGGER_NAME", "LogSink", "NodeLogger"]
 
@@ -36,7 +47,7 @@ class NodeLogger:
 
     __slots__ = ("_actor", "sink")
 
-    def __init__(self, actor: Actor) -> None:
+    def __init__(self, actor: _Node) -> None:
         self._actor = actor
         self.sink: LogSink | None = None
 
