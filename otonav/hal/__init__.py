@@ -15,6 +15,7 @@ from otonav.hal.types import (
     ImuSample,
     RangeScan,
     RobotGeometry,
+    RoundObstacle,
     WheelSetpoint,
     WheelState,
 )
@@ -29,6 +30,7 @@ __all__ = (
     "RangeScan",
     "RobotGeometry",
     "RobotHardwareInterface",
+    "RoundObstacle",
     "WheelSetpoint",
     "WheelState",
 )

@@ -19,6 +19,7 @@ from otonav.hal.types import (
     ImuSample,
     RangeScan,
     RobotGeometry,
+    RoundObstacle,
     WheelSetpoint,
     WheelState,
 )
@@ -104,6 +105,16 @@ class RobotHardwareInterface(abc.ABC):
 
     def walls(self) -> tuple[BoxObstacle, ...]:
         """The world's boundary walls as boxes (m). Empty if the world has none."""
+        return ()
+
+    def round_obstacles(self) -> tuple[RoundObstacle, ...]:
+        """The world's upright cylinders, capsules and spheres as disks (m), for
+        ground-truth clearance. Empty if the world has none."""
+        return ()
+
+    def unjudged_geoms(self) -> tuple[str, ...]:
+        """The static geoms the robot could hit whose clearance cannot be measured (a
+        mesh, a tilted cylinder), ``name (type)`` each: a judged run fails on them."""
         return ()
 
     def clearance_boxes(self) -> tuple[BoxObstacle, ...]:

@@ -18,6 +18,7 @@ __all__ = [
     "ImuSample",
     "RangeScan",
     "RobotGeometry",
+    "RoundObstacle",
     "WheelSetpoint",
     "WheelState",
 ]
@@ -176,3 +177,21 @@ class BoxObstacle:
         ex = max(abs(lx) - self.half_x, 0.0)
         ey = max(abs(ly) - self.half_y, 0.0)
         return math.hypot(ex, ey)
+
+
+@dataclass(frozen=True, slots=True)
+class RoundObstacle:
+    """An upright cylinder, capsule or a sphere in the world plane: the disk it covers,
+    centre (x, y) m and radius m (issue 42: the judge measures every static geom)."""
+
+    x: float
+    y: float
+    radius: float
+
+    def __post_init__(self) -> None:
+        if not self.radius > 0.0:
+            raise ValueError(f"a round obstacle's radius must be positive, got {self.radius}")
+
+    def distance_to(self, px: float, py: float) -> float:
+        """Euclidean distance, m, from the point (px, py) to the disk; 0 inside."""
+        return max(math.hypot(px - self.x, py - self.y) - self.radius, 0.0)

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav.hal import BoxObstacle
+from otonav.hal import BoxObstacle, RoundObstacle
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -30,24 +30,36 @@ def box_outlines(boxes: tuple[BoxObstacle, ...]) -> NDArray[np.float64]:
     return np.stack((x, y), axis=-1)
 
 
-def _boxes_path(boxes: tuple[BoxObstacle, ...]) -> MplPath:
-    """All boxes as one compound path: one artist to draw, and one vertex array for the
-    legend's "best" placement to test (a patch per box made it test each one: 3000
-    boxes drew in 1.7 s, issue 30). The outlines all turn the same way, so where boxes
-    overlap the non-zero fill rule fills them once."""
+Obstacle = BoxObstacle | RoundObstacle
+
+
+def _boxes_path(obstacles: tuple[Obstacle, ...]) -> MplPath:
+    """All boxes and disks as one compound path: one artist to draw, and one vertex
+    array for the legend's "best" placement to test (a patch per box made it test each
+    one: 3000 boxes drew in 1.7 s, issue 30). The outlines all turn the same way, so
+    where they overlap the non-zero fill rule fills them once."""
     from matplotlib.path import Path as MplPath
 
+    boxes = tuple(o for o in obstacles if isinstance(o, BoxObstacle))
     outlines = box_outlines(boxes)
     codes = np.tile(
         np.array([MplPath.MOVETO, *[MplPath.LINETO] * 3, MplPath.CLOSEPOLY], MplPath.code_type),
         len(boxes),
     )
-    return MplPath(outlines.reshape(-1, 2), codes)
+    paths = [MplPath(outlines.reshape(-1, 2), codes)]
+    unit = MplPath.circle()  # Bezier arcs, counter-clockwise like the box outlines
+    circle: NDArray[np.float64] = np.asarray(unit.vertices, dtype=np.float64)
+    paths += [
+        MplPath(circle * o.radius + np.array((o.x, o.y)), unit.codes)
+        for o in obstacles
+        if isinstance(o, RoundObstacle)
+    ]
+    return MplPath.make_compound_path(*paths)
 
 
 def draw_trajectory(
     trajectory: list[tuple[float, float, float]],
-    obstacles: tuple[BoxObstacle, ...] | None,
+    obstacles: tuple[Obstacle, ...] | None,
     goal: tuple[float, float] | None,
     tolerance: float | None,
     closest: tuple[float, float] | None,
@@ -55,7 +67,7 @@ def draw_trajectory(
     *,
     path_label: str = "path (ground truth)",
 ) -> Figure:
-    """The figure of a run: ``trajectory`` as (t, x, y), the obstacle boxes (``None``:
+    """The figure of a run: ``trajectory`` as (t, x, y), the obstacles (``None``:
     not known, and the figure says so), the goal and its tolerance circle (``None``:
     not known, said likewise), the closest approach."""
     # Imported here: matplotlib costs ~0.3 s, and only a drawn plot needs it. A Figure
@@ -115,7 +127,7 @@ def draw_trajectory(
 def plot_trajectory(
     path: Path,
     trajectory: list[tuple[float, float, float]],
-    obstacles: tuple[BoxObstacle, ...] | None,
+    obstacles: tuple[Obstacle, ...] | None,
     goal: tuple[float, float] | None,
     tolerance: float | None,
     closest: tuple[float, float] | None,

@@ -316,6 +316,7 @@ def opened_scenario(
             scenario.goal_tolerance,
             progress=progress,
             nav_must_say_reached=stack.nav.planner != "external",
+            arrival=scenario.arrival,
         )
         session = scenario_session(
             scenario,
@@ -528,7 +529,7 @@ def save_artifacts(
             plot_trajectory(
                 png,
                 judge.trajectory,
-                judge.boxes,
+                judge.boxes + judge.rounds,
                 (scenario.goal.x, scenario.goal.y),
                 scenario.goal_tolerance,
                 judge.min_clearance_at,
@@ -629,7 +630,8 @@ def judge_verdict(
 ) -> Verdict:
     """Pass when the scenario's expected outcome happened (``expect``: the goal reached,
     or the navigator's ``unreachable`` inside the budget) and the clearance held."""
-    clear = judge.min_clearance >= scenario.min_clearance
+    unmeasured = judge.clearance_problem
+    clear = judge.min_clearance >= scenario.min_clearance and unmeasured is None
     gave_up = judge.unreachable_at is not None and judge.unreachable_at <= scenario.sim_budget
     reasons = []
     if scenario.expect == "reached":
@@ -663,7 +665,9 @@ def judge_verdict(
         reasons.append(
             f"hardware fault since {health.since:.2f} s: {health.fault}: {health.message}"
         )
-    if not clear:
+    if unmeasured is not None:
+        reasons.append(unmeasured)
+    elif not clear:
         reasons.append(
             f"came {judge.min_clearance:.3f} m from an obstacle "
             f"(minimum {scenario.min_clearance} m)"

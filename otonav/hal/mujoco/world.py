@@ -43,7 +43,7 @@ from numpy.typing import NDArray
 from otonav.hal.description import RobotDescription, builtin_robot
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.mujoco._lib import mujoco, viewer_module
-from otonav.hal.mujoco.derive import _actuator_of, _Derivation, _probe, _site_sensor
+from otonav.hal.mujoco.derive import _actuator_of, _collides, _Derivation, _probe, _site_sensor
 from otonav.hal.mujoco.prepare import ROBOT_PREFIX, _load_robot, _merge_options, _RobotSpec
 from otonav.hal.mujoco.scene import SceneError, _add_box, _compile, _load_spec
 from otonav.hal.mujoco.static_geoms import ray_caster
@@ -54,6 +54,7 @@ from otonav.hal.types import (
     ImuSample,
     RangeScan,
     RobotGeometry,
+    RoundObstacle,
     WheelSetpoint,
     WheelState,
 )
@@ -179,8 +180,7 @@ class MujocoInterface(RobotHardwareInterface):
             (left_joint, right_joint), self._lidar_site, self._imu_site, self._base_qpos
         )
         self._sources = {**parts.sources, **derived.sources}
-        self._obstacles = self._static_boxes("obstacle")
-        self._walls = self._static_boxes("wall")
+        self._static_shapes()
         self._is_floor = np.asarray(m.geom_type == mujoco.mjtGeom.mjGEOM_PLANE, dtype=np.bool_)
 
         # Lidar: beam directions in the site frame and preallocated ray buffers.
@@ -230,27 +230,43 @@ class MujocoInterface(RobotHardwareInterface):
 
     # -- model facts ----------------------------------------------------------------------
 
-    def _static_boxes(self, prefix: str) -> tuple[BoxObstacle, ...]:
-        m = self._model
-        boxes = []
+    def _static_shapes(self) -> None:
+        """Every static geom the robot can touch (welded to the world, colliding, not a
+        plane), as what the judge measures (issue 42): boxes (``wall*`` ones are the
+        walls), upright cylinders, capsules and spheres as disks; the rest unjudged."""
+        m, d = self._model, self._data
+        kinds = mujoco.mjtGeom
+        obstacles: list[BoxObstacle] = []
+        walls: list[BoxObstacle] = []
+        rounds: list[RoundObstacle] = []
+        unjudged: list[str] = []
         for g in range(m.ngeom):
-            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g) or ""
-            if (
-                name.startswith(prefix)
-                and int(m.geom_bodyid[g]) == 0
-                and m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX
+            body = int(m.geom_bodyid[g])
+            kind = int(m.geom_type[g])
+            if int(m.body_weldid[body]) != 0 or kind == kinds.mjGEOM_PLANE or not _collides(m, g):
+                continue
+            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g) or f"geom {g}"
+            if body == 0:  # the model's floats, as before (no rounding through mj_forward)
+                x, y = float(m.geom_pos[g][0]), float(m.geom_pos[g][1])
+                w, qx, qy, qz = (float(v) for v in m.geom_quat[g])
+                yaw = _yaw_of_quat(w, qx, qy, qz)
+                upright = 1.0 - 2.0 * (qx * qx + qy * qy)
+            else:
+                x, y = float(d.geom_xpos[g][0]), float(d.geom_xpos[g][1])
+                xmat = d.geom_xmat[g]
+                yaw, upright = math.atan2(float(xmat[3]), float(xmat[0])), float(xmat[8])
+            size = m.geom_size[g]
+            if kind == kinds.mjGEOM_BOX:
+                box = BoxObstacle(x, y, float(size[0]), float(size[1]), yaw)
+                (walls if name.startswith("wall") else obstacles).append(box)
+            elif kind == kinds.mjGEOM_SPHERE or (
+                kind in (kinds.mjGEOM_CYLINDER, kinds.mjGEOM_CAPSULE) and upright > 1.0 - 1e-6
             ):
-                w, x, y, z = (float(v) for v in m.geom_quat[g])
-                boxes.append(
-                    BoxObstacle(
-                        x=float(m.geom_pos[g][0]),
-                        y=float(m.geom_pos[g][1]),
-                        half_x=float(m.geom_size[g][0]),
-                        half_y=float(m.geom_size[g][1]),
-                        yaw=_yaw_of_quat(w, x, y, z),
-                    )
-                )
-        return tuple(boxes)
+                rounds.append(RoundObstacle(x, y, float(size[0])))
+            else:
+                unjudged.append(f"{name} ({mujoco.mjtGeom(kind).name.removeprefix('mjGEOM_')})")
+        self._obstacles, self._walls = tuple(obstacles), tuple(walls)
+        self._rounds, self._unjudged = tuple(rounds), tuple(unjudged)
 
     @property
     def scene_file(self) -> str:
@@ -497,6 +513,12 @@ class MujocoInterface(RobotHardwareInterface):
 
     def walls(self) -> tuple[BoxObstacle, ...]:
         return self._walls
+
+    def round_obstacles(self) -> tuple[RoundObstacle, ...]:
+        return self._rounds
+
+    def unjudged_geoms(self) -> tuple[str, ...]:
+        return self._unjudged
 
     def close(self) -> None:
         self._closed = True
