@@ -35,7 +35,7 @@ from otonav.runtime import Actor
 from otonav.stack.config import StackConfig
 from otonav.stack.files import ConfigFileError
 from otonav.stack.launch import launch
-from otonav.stack.robot import describe_robot, robot_base
+from otonav.stack.robot import describe_robot, nav_speeds, robot_base
 
 if TYPE_CHECKING:
     from otonav.hal.can import CanBusInterface
@@ -205,8 +205,8 @@ def build_actors(
                     GoToGoalParams(
                         kp_lin=nav.kp_lin,
                         kp_ang=nav.kp_ang,
-                        max_v=min(nav.max_v, base.max_v),
-                        max_omega=min(nav.max_omega, base.max_omega),
+                        max_v=nav_speeds(config)[0],
+                        max_omega=nav_speeds(config)[1],
                         tolerance=nav.tolerance,
                         turn_in_place_threshold=nav.turn_in_place_threshold,
                     ),
@@ -268,10 +268,11 @@ def navigation_params(config: StackConfig, geometry: RobotGeometry) -> Navigatio
     or the footprint is derived here."""
     nav, base = config.nav, robot_base(config)
     radius = centre_clearance(nav.clearance, geometry.footprint_radius, nav.footprint_padding)
+    fastest_v, fastest_omega = nav_speeds(config)
     dwa = DwaParams(
         **nav.dwa.model_dump(),
-        max_v=min(nav.max_v, base.max_v),
-        max_omega=min(nav.max_omega, base.max_omega),
+        max_v=fastest_v,
+        max_omega=fastest_omega,
         max_accel=base.max_accel,
         max_alpha=base.max_alpha,
         period=1.0 / nav.rate_hz,
@@ -280,7 +281,6 @@ def navigation_params(config: StackConfig, geometry: RobotGeometry) -> Navigatio
     )
     grid = {_MAP_NAMES.get(k, k): v for k, v in nav.map.model_dump().items()}
     recovery = nav.recovery.model_dump()
-    fastest_v, fastest_omega = min(nav.max_v, base.max_v), min(nav.max_omega, base.max_omega)
     for name in ("backup_speed", "follow_speed"):
         recovery[name] = min(recovery[name], fastest_v)
     recovery["spin_speed"] = min(recovery["spin_speed"], fastest_omega)

@@ -115,7 +115,8 @@ class BaseConfig(_Section):
     """s of sim time without a valid /cmd_vel before the wheels stop (watchdog)."""
     # Bounded so that wheel speeds stay finite and the limits still limit (limits.py).
     max_v: PositiveFloat = Field(0.5, le=limits.MAX_BASE_V)
-    """m/s, the fastest the base drives, whatever /cmd_vel asks."""
+    """m/s, the fastest the base drives, whatever /cmd_vel asks (``robot.max_v``, when
+    stated, sets it)."""
     max_omega: PositiveFloat = Field(1.5, le=limits.MAX_BASE_OMEGA)
     """rad/s, the fastest the base turns."""
     max_accel: PositiveFloat = Field(1.0, le=limits.MAX_BASE_ACCEL)
@@ -257,7 +258,7 @@ class NavConfig(_Section):
     kp_ang: float = Field(_NAV.kp_ang, ge=0.0)
     """Proportional gain on the heading error, 1/s."""
     max_v: PositiveFloat = _NAV.dwa.max_v
-    """m/s, the fastest the navigator asks for."""
+    """m/s, the fastest the navigator asks for (``robot.max_v``, when stated, sets it)."""
     max_omega: PositiveFloat = _NAV.dwa.max_omega
     """rad/s, the fastest turn the navigator asks for."""
     tolerance: PositiveFloat = _NAV.tolerance
@@ -547,9 +548,12 @@ class RobotConfig(_Section):
     footprint: tuple[tuple[float, float], ...] | None = Field(None, min_length=3)
     """(x, y) points in base_link, m: overrides the derived outline."""
     max_v: float | None = Field(None, gt=0.0, le=limits.MAX_BASE_V)
-    """m/s, the robot's top speed: caps ``base.max_v`` and scales scenario budgets."""
+    """m/s, the robot's top speed: what the base and the navigator use (up or down from
+    their defaults; a ``base.max_v`` / ``nav.max_v`` set away from its default lowers it,
+    with a warning), and it scales scenario budgets."""
     max_omega: float | None = Field(None, gt=0.0, le=limits.MAX_BASE_OMEGA)
-    """rad/s, the robot's top yaw rate: caps ``base.max_omega``."""
+    """rad/s, the robot's top yaw rate: what the base and the navigator use (as
+    ``max_v``)."""
     frames: FramesConfig = FramesConfig()
     """The frame ids otonav stamps its messages with (``--set robot.frames.base=...``)."""
 

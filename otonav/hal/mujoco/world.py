@@ -234,7 +234,7 @@ class MujocoInterface(RobotHardwareInterface):
         """Every static geom the robot can touch (welded to the world, colliding, not a
         plane), as what the judge measures (issue 42): boxes (``wall*`` ones are the
         walls), upright cylinders, capsules and spheres as disks; the rest unjudged."""
-        m, d = self._model, self._data
+        m, d = self._model, None
         kinds = mujoco.mjtGeom
         obstacles: list[BoxObstacle] = []
         walls: list[BoxObstacle] = []
@@ -251,7 +251,10 @@ class MujocoInterface(RobotHardwareInterface):
                 w, qx, qy, qz = (float(v) for v in m.geom_quat[g])
                 yaw = _yaw_of_quat(w, qx, qy, qz)
                 upright = 1.0 - 2.0 * (qx * qx + qy * qy)
-            else:
+            else:  # a body welded to the world: where its kinematics put the geom
+                if d is None:
+                    d = mujoco.MjData(m)
+                    mujoco.mj_kinematics(m, d)
                 x, y = float(d.geom_xpos[g][0]), float(d.geom_xpos[g][1])
                 xmat = d.geom_xmat[g]
                 yaw, upright = math.atan2(float(xmat[3]), float(xmat[0])), float(xmat[8])

@@ -1,0 +1,88 @@
+"""Every static geom the robot can touch is judged (issue 42): boxes whatever their
+name, upright cylinders, capsules and spheres as disks; a mesh or a tilted cylinder is
+named as unjudged, and a run among them fails: a clearance never measured is no pass."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from otonav.hal import BoxObstacle, RoundObstacle
+from otonav.hal.mujoco import MujocoInterface
+from otonav.scenario import run_scenario
+from otonav.scenario.config import GoalSpec, ScenarioConfig
+from otonav.stack import StackConfig
+
+pytestmark = pytest.mark.unit
+
+SCENE = """<mujoco>
+  <asset>
+    <mesh name="rock" vertex="0 0 0  0.2 0 0  0 0.2 0  0 0 0.2"/>
+  </asset>
+  <worldbody>
+    <geom name="floor" type="plane" size="10 10 0.1"/>
+    <geom name="pillar" type="cylinder" pos="2 1 0.5" size="0.1 0.5"/>
+    <geom name="ball" type="sphere" pos="-2 1 0.3" size="0.3"/>
+    <geom name="post" type="capsule" pos="0 -2 0.5" size="0.05 0.4"/>
+    <geom name="crate" type="box" pos="3 -3 0.2" size="0.2 0.3 0.2"/>
+    <geom name="ghost" type="cylinder" pos="4 4 0.5" size="0.1 0.5" contype="0"
+          conaffinity="0"/>
+    <body name="shelf" pos="-3 -3 0">
+      <geom name="shelf_leg" type="cylinder" pos="0.5 0 0.5" size="0.05 0.5"/>
+    </body>
+    {extra}
+  </worldbody>
+</mujoco>
+"""
+TILTED = '<geom name="log" type="cylinder" pos="-3 3 0.1" size="0.1 0.5" euler="1.5708 0 0"/>'
+MESH = '<geom name="boulder" type="mesh" mesh="rock" pos="3 3 0"/>'
+
+
+def _scene(tmp_path: Path, extra: str = "") -> Path:
+    path = tmp_path / "shapes.xml"
+    path.write_text(SCENE.replace("{extra}", extra))
+    return path
+
+
+def test_every_static_shape_is_seen(tmp_path: Path) -> None:
+    world = MujocoInterface(_scene(tmp_path))
+    try:
+        assert world.obstacles() == (BoxObstacle(3.0, -3.0, 0.2, 0.3, 0.0),)
+        rounds = sorted(world.round_obstacles(), key=lambda r: (r.x, r.y))
+        expected = [(-2.5, -3.0, 0.05), (-2.0, 1.0, 0.3), (0.0, -2.0, 0.05), (2.0, 1.0, 0.1)]
+        for r, (x, y, radius) in zip(rounds, expected, strict=True):
+            assert (r.x, r.y, r.radius) == pytest.approx((x, y, radius), abs=1e-9)
+        assert all(isinstance(r, RoundObstacle) for r in rounds)
+        assert world.unjudged_geoms() == ()
+    finally:
+        world.close()
+
+
+def test_tilted_cylinders_and_meshes_are_named_unjudged(tmp_path: Path) -> None:
+    world = MujocoInterface(_scene(tmp_path, TILTED + MESH))
+    try:
+        assert world.unjudged_geoms() == ("log (CYLINDER)", "boulder (MESH)")
+    finally:
+        world.close()
+
+
+def test_a_run_whose_clearance_was_not_measured_fails(tmp_path: Path) -> None:
+    scenario = ScenarioConfig(
+        name="unjudged", scene=str(_scene(tmp_path, MESH)), goal=GoalSpec(x=1.0, y=0.0)
+    )
+    verdict = run_scenario(scenario, StackConfig(), record=False, plot=False)
+    assert verdict.reached  # the robot did arrive ...
+    assert not verdict.passed  # ... but nobody measured how close it came to the boulder
+    assert "clearance not measured" in verdict.reason and "boulder (MESH)" in verdict.reason
+
+
+def test_a_cylinder_s_clearance_is_measured(tmp_path: Path) -> None:
+    scenario = ScenarioConfig(
+        name="cylinders", scene=str(_scene(tmp_path)), goal=GoalSpec(x=1.0, y=0.0)
+    )
+    verdict = run_scenario(scenario, StackConfig(), record=False, plot=False)
+    assert verdict.passed, verdict.reason
+    # The pillar (r 0.1 at (2, 1)) is the nearest near the goal: hypot(1, 1) - 0.1 =
+    # 1.314 m from it; the post (r 0.05 at (0, -2)) 1.95 m from the start.
+    assert 1.3 < verdict.min_clearance_m < 1.95
