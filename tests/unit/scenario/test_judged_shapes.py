@@ -74,7 +74,8 @@ def test_a_run_whose_clearance_was_not_measured_fails(tmp_path: Path) -> None:
     verdict = run_scenario(scenario, StackConfig(), record=False, plot=False)
     assert verdict.reached  # the robot did arrive ...
     assert not verdict.passed  # ... but nobody measured how close it came to the boulder
-    assert "clearance not measured" in verdict.reason and "boulder (MESH)" in verdict.reason
+    assert "clearance not measured" in verdict.reason
+    assert "boulder (MESH)" in verdict.reason
 
 
 def test_a_cylinder_s_clearance_is_measured(tmp_path: Path) -> None:
