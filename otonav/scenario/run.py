@@ -43,6 +43,7 @@ from otonav.scenario.judge import Judge
 from otonav.scenario.plot import plot_trajectory
 from otonav.scenario.validate import check_cost, check_goal
 from otonav.stack import StackConfig, build_actors, build_world
+from otonav.stack.config import NavConfig
 from otonav.stack.robot import describe_robot
 from otonav.stack.session import StackSession
 
@@ -161,11 +162,16 @@ def finite_figures(figures: dict[str, Any]) -> dict[str, Any]:
 
 
 def effective_stack(scenario: ScenarioConfig, stack: StackConfig) -> StackConfig:
-    """The stack config with the scenario's scene, if it names one."""
-    if scenario.scene is None:
-        return stack
-    world = stack.world.model_copy(update={"scene": scenario.scene})
-    return stack.model_copy(update={"world": world})
+    """The stack config with the scenario's scene, if it names one, and the navigator's
+    goal tolerance following the scenario's (half of it, never below ``nav.tolerance``'s
+    default) unless ``nav.tolerance`` is set (issue 42, ADR 0079)."""
+    updates: dict[str, Any] = {}
+    if scenario.scene is not None:
+        updates["world"] = stack.world.model_copy(update={"scene": scenario.scene})
+    default = NavConfig().tolerance
+    if stack.nav.tolerance == default and scenario.goal_tolerance / 2 > default:
+        updates["nav"] = stack.nav.model_copy(update={"tolerance": scenario.goal_tolerance / 2})
+    return stack.model_copy(update=updates) if updates else stack
 
 
 async def drive_to_goal(
