@@ -14,18 +14,19 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
 
-from otonav.nav.dwa import DwaParams, dwa_step
+from otonav.nav.dwa import ClearanceFn, DwaParams, dwa_step
 
 pytestmark = pytest.mark.unit
 
 
-def _field(centres: list[tuple[float, float]]):  # type: ignore[no-untyped-def]
+def _field(centres: list[tuple[float, float]]) -> ClearanceFn:
     """Distance to the nearest of BARN-sized cylinders (r 0.075 m)."""
     c = np.array(centres, dtype=np.float64).reshape(-1, 2)
 
     def clearance(x: NDArray[np.float64], y: NDArray[np.float64]) -> NDArray[np.float32]:
         d = np.hypot(x[..., None] - c[:, 0], y[..., None] - c[:, 1]).min(axis=-1) - 0.075
-        return d.astype(np.float32)
+        out: NDArray[np.float32] = d.astype(np.float32)
+        return out
 
     return clearance
 
