@@ -85,6 +85,7 @@ PINNED: dict[str, tuple[str, ...]] = {
         "RangeScan",
         "RobotGeometry",
         "RobotHardwareInterface",
+        "RoundObstacle",
         "WheelSetpoint",
         "WheelState",
     ),
