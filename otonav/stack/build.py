@@ -59,6 +59,7 @@ def build_world(
         lidar_beams=world.lidar_beams,
         lidar_range_min=world.lidar_range_min,
         lidar_range_max=world.lidar_range_max,
+        lidar_fov=world.lidar_fov,
         timestep=world.timestep,
         extra_obstacles=extra_obstacles,
         start=start,

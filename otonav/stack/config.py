@@ -93,6 +93,10 @@ class WorldConfig(_Section):
     """m, returns closer than this read as -inf (below range), < ``lidar_range_max``."""
     lidar_range_max: PositiveFloat = Field(8.0, le=limits.MAX_LIDAR_RANGE_M)
     """m, at most 1 km: ranges are float32 in the recording."""
+    lidar_fov: float = Field(2.0 * math.pi, gt=0.0, le=2.0 * math.pi)
+    """rad, the lidar's field of view, centred ahead, in (0, 2 pi] (BARN's Jackal: 4.71,
+    270 degrees). Below a full circle the first and last beams are at -fov/2 and +fov/2,
+    as /scan's ``angle_min`` and ``angle_max`` say."""
     odometry_error: OdometryErrorConfig = OdometryErrorConfig()
     """Simulated odometry drift (off by default): see :class:`OdometryErrorConfig`."""
 

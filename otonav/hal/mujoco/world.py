@@ -76,7 +76,8 @@ class MujocoInterface(RobotHardwareInterface):
     """The otonav robot simulated by MuJoCo.
 
     ``scene``: built-in scene name (``"empty"``, ``"obstacles"``) or an MJCF path.
-    ``lidar_beams`` beams over a full circle from -pi; ranges in
+    ``lidar_beams`` beams over ``lidar_fov`` rad centred ahead (a full circle: from -pi,
+    the last one an increment short of +pi; narrower: from -fov/2 to +fov/2); ranges in
     [``lidar_range_min``, ``lidar_range_max``] m, otherwise +inf. ``timestep`` (s)
     overrides the scene's. ``extra_obstacles`` become 0.5 m tall static boxes named
     ``obstacle_extra_<i>``. ``start`` is the robot's pose (x, y, yaw)
@@ -90,6 +91,7 @@ class MujocoInterface(RobotHardwareInterface):
         lidar_beams: int = 360,
         lidar_range_min: float = 0.12,
         lidar_range_max: float = 8.0,
+        lidar_fov: float = 2.0 * math.pi,
         timestep: float | None = None,
         extra_obstacles: Sequence[BoxObstacle] = (),
         start: tuple[float, float, float] = (0.0, 0.0, 0.0),
@@ -102,6 +104,8 @@ class MujocoInterface(RobotHardwareInterface):
                 f"need 0 <= lidar_range_min < lidar_range_max, got "
                 f"{lidar_range_min}, {lidar_range_max}"
             )
+        if not 0.0 < lidar_fov <= 2.0 * math.pi:
+            raise ValueError(f"lidar_fov must be in (0, 2 pi] rad, got {lidar_fov}")
         if timestep is not None and not timestep > 0.0:
             raise ValueError(f"timestep must be positive, got {timestep}")
 
@@ -186,8 +190,13 @@ class MujocoInterface(RobotHardwareInterface):
         # Lidar: beam directions in the site frame and preallocated ray buffers.
         self._range_min = float(lidar_range_min)
         self._range_max = float(lidar_range_max)
-        self._angle_min = -math.pi
-        self._angle_increment = 2.0 * math.pi / lidar_beams
+        # A full circle: beams from -pi, the last one increment short of +pi (no beam
+        # twice). A narrower field of view (issue 42): centred ahead, both ends a beam.
+        full = lidar_fov >= 2.0 * math.pi
+        self._angle_min = -lidar_fov / 2.0
+        self._angle_increment = lidar_fov / (
+            lidar_beams if full or lidar_beams < 2 else lidar_beams - 1
+        )
         angles = self._angle_min + self._angle_increment * np.arange(lidar_beams)
         self._beams_local = np.zeros((lidar_beams, 3))
         self._beams_local[:, 0] = np.cos(angles)
