@@ -17,6 +17,7 @@ from otonav.hal.types import (
     BoxObstacle,
     GroundTruth,
     ImuSample,
+    PolygonObstacle,
     RangeScan,
     RobotGeometry,
     RoundObstacle,
@@ -112,9 +113,14 @@ class RobotHardwareInterface(abc.ABC):
         ground-truth clearance. Empty if the world has none."""
         return ()
 
+    def polygon_obstacles(self) -> tuple[PolygonObstacle, ...]:
+        """The world's meshes as the convex hull of their vertices on the floor (m), for
+        ground-truth clearance. Empty if the world has none."""
+        return ()
+
     def unjudged_geoms(self) -> tuple[str, ...]:
         """The static geoms the robot could hit whose clearance cannot be measured (a
-        mesh, a tilted cylinder), ``name (type)`` each: a judged run fails on them."""
+        tilted cylinder, an ellipsoid), ``name (type)`` each: a judged run fails on them."""
         return ()
 
     def clearance_boxes(self) -> tuple[BoxObstacle, ...]:

@@ -34,7 +34,7 @@ import heapq
 import math
 from collections.abc import Sequence
 
-from otonav.hal import BoxObstacle, RoundObstacle
+from otonav.hal import BoxObstacle, PolygonObstacle, RoundObstacle
 
 __all__ = ("ClearanceTracker",)
 
@@ -59,6 +59,7 @@ class ClearanceTracker:
         self,
         boxes: Sequence[BoxObstacle],
         rounds: Sequence[RoundObstacle] = (),
+        polygons: Sequence[PolygonObstacle] = (),
         *,
         cell: float = 0.5,
         reach: float = 0.5,
@@ -80,6 +81,14 @@ class ClearanceTracker:
         self._math = [
             (b.x, b.y, b.half_x, b.half_y, math.cos(b.yaw), math.sin(b.yaw), 0.0) for b in boxes
         ] + [(r.x, r.y, 0.0, 0.0, 1.0, 0.0, r.radius) for r in rounds]
+        # A mesh's hull: its own distance_to (entries after the boxes and disks), its
+        # bounding rectangle's centre and half sizes for the grid.
+        self._polygons = tuple(polygons)
+        self._first_polygon = len(self._math)
+        for p in self._polygons:
+            xs, ys = [q[0] for q in p.points], [q[1] for q in p.points]
+            hx, hy = (max(xs) - min(xs)) / 2, (max(ys) - min(ys)) / 2
+            self._math.append((min(xs) + hx, min(ys) + hy, hx, hy, 1.0, 0.0, 0.0))
         self._key = [-math.inf] * len(self._math)
         """Per box: distance at its last computation + the path driven then (-inf: never)."""
         self._grid: dict[tuple[int, int], list[int]] = {}
@@ -121,13 +130,16 @@ class ClearanceTracker:
         done: list[int] = []
         while heap and heap[0][0] <= due:
             i = heapq.heappop(heap)[1]
-            bx, by, hx, hy, c, s, radius = self._math[i]
-            dx, dy = x - bx, y - by
-            lx = c * dx + s * dy
-            ly = -s * dx + c * dy
-            d = math.hypot(max(abs(lx) - hx, 0.0), max(abs(ly) - hy, 0.0))
-            if radius:  # RoundObstacle.distance_to's floats (lx, ly are dx, dy exactly)
-                d = max(d - radius, 0.0)
+            if i >= self._first_polygon:
+                d = self._polygons[i - self._first_polygon].distance_to(x, y)
+            else:
+                bx, by, hx, hy, c, s, radius = self._math[i]
+                dx, dy = x - bx, y - by
+                lx = c * dx + s * dy
+                ly = -s * dx + c * dy
+                d = math.hypot(max(abs(lx) - hx, 0.0), max(abs(ly) - hy, 0.0))
+                if radius:  # RoundObstacle.distance_to's floats (lx, ly: dx, dy exactly)
+                    d = max(d - radius, 0.0)
             self._key[i] = d + path
             self.checks += 1
             done.append(i)

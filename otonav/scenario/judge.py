@@ -84,7 +84,8 @@ class Judge(Actor):
         self.rate_hz = rate_hz
         self.boxes: tuple[BoxObstacle, ...] = hal.obstacles() + hal.walls()
         self.rounds = hal.round_obstacles()
-        self._clearance = ClearanceTracker(self.boxes, self.rounds)
+        self.polygons = hal.polygon_obstacles()
+        self._clearance = ClearanceTracker(self.boxes, self.rounds, self.polygons)
         self.min_clearance = math.inf
         self.min_clearance_at: tuple[float, float] = (math.nan, math.nan)
         self.path_length = 0.0
@@ -126,15 +127,15 @@ class Judge(Actor):
     @property
     def clearance_problem(self) -> str | None:
         """Why the clearance was not measured (static geoms of a shape the judge cannot
-        measure: a mesh, a tilted cylinder); None: every static geom was measured. A
+        measure: a tilted cylinder, an ellipsoid); None: every static geom was measured. A
         clearance never measured is not a pass (issue 42)."""
         unjudged = self.hal.unjudged_geoms()
         if not unjudged:
             return None
         more = f" and {len(unjudged) - 5} more" if len(unjudged) > 5 else ""
         return (
-            f"clearance not measured: the judge measures boxes, upright cylinders, capsules "
-            f"and spheres, not {', '.join(unjudged[:5])}{more}"
+            f"clearance not measured: the judge measures boxes, upright cylinders and "
+            f"capsules, spheres and meshes, not {', '.join(unjudged[:5])}{more}"
         )
 
     def _entered(self, now: float) -> None:

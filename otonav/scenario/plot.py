@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav.hal import BoxObstacle, RoundObstacle
+from otonav.hal import BoxObstacle, PolygonObstacle, RoundObstacle
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -30,7 +30,7 @@ def box_outlines(boxes: tuple[BoxObstacle, ...]) -> NDArray[np.float64]:
     return np.stack((x, y), axis=-1)
 
 
-Obstacle = BoxObstacle | RoundObstacle
+Obstacle = BoxObstacle | RoundObstacle | PolygonObstacle
 
 
 def _boxes_path(obstacles: tuple[Obstacle, ...]) -> MplPath:
@@ -53,6 +53,11 @@ def _boxes_path(obstacles: tuple[Obstacle, ...]) -> MplPath:
         MplPath(circle * o.radius + np.array((o.x, o.y)), unit.codes)
         for o in obstacles
         if isinstance(o, RoundObstacle)
+    ]
+    paths += [
+        MplPath(np.array([*o.points, o.points[0]]), closed=True)
+        for o in obstacles
+        if isinstance(o, PolygonObstacle)
     ]
     return MplPath.make_compound_path(*paths)
 

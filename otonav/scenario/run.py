@@ -535,7 +535,7 @@ def save_artifacts(
             plot_trajectory(
                 png,
                 judge.trajectory,
-                judge.boxes + judge.rounds,
+                judge.boxes + judge.rounds + judge.polygons,
                 (scenario.goal.x, scenario.goal.y),
                 scenario.goal_tolerance,
                 judge.min_clearance_at,

@@ -82,6 +82,7 @@ PINNED: dict[str, tuple[str, ...]] = {
         "HardwareHealth",
         "HealthLevel",
         "ImuSample",
+        "PolygonObstacle",
         "RangeScan",
         "RobotGeometry",
         "RobotHardwareInterface",

@@ -52,11 +52,13 @@ from otonav.hal.types import (
     BoxObstacle,
     GroundTruth,
     ImuSample,
+    PolygonObstacle,
     RangeScan,
     RobotGeometry,
     RoundObstacle,
     WheelSetpoint,
     WheelState,
+    convex_hull,
 )
 from otonav.hal.viewer import ViewerHandle, check_display, launch_viewer
 
@@ -66,6 +68,17 @@ _RAY_GROUPS: Final = np.array([1, 0, 1, 0, 0, 0], dtype=np.uint8)  # groups 0 an
 _SETTLE_TIME: Final = 0.25  # s of physics run at construction, before tick 0
 _MOUNT_ABOVE: Final = 0.02  # m: a default lidar sits this far above the robot's top
 _REST_TOLERANCE: Final = 1e-3  # m: a model resting within this of the floor is not moved
+
+
+def _mesh_footprint(m: Any, d: Any, g: int) -> PolygonObstacle | None:
+    """A mesh geom's vertices in the world (``d`` through ``mj_kinematics``), projected
+    on the floor: their convex hull (None: fewer than 3 corners)."""
+    mesh = int(m.geom_dataid[g])
+    start, count = int(m.mesh_vertadr[mesh]), int(m.mesh_vertnum[mesh])
+    local = np.asarray(m.mesh_vert[start : start + count], dtype=np.float64)
+    world = local @ np.asarray(d.geom_xmat[g]).reshape(3, 3).T + np.asarray(d.geom_xpos[g])
+    hull = convex_hull([(float(x), float(y)) for x, y in world[:, :2]])
+    return PolygonObstacle(hull) if len(hull) >= 3 else None
 
 
 def _yaw_of_quat(w: float, x: float, y: float, z: float) -> float:
@@ -248,6 +261,7 @@ class MujocoInterface(RobotHardwareInterface):
         obstacles: list[BoxObstacle] = []
         walls: list[BoxObstacle] = []
         rounds: list[RoundObstacle] = []
+        polygons: list[PolygonObstacle] = []
         unjudged: list[str] = []
         for g in range(m.ngeom):
             body = int(m.geom_bodyid[g])
@@ -275,10 +289,20 @@ class MujocoInterface(RobotHardwareInterface):
                 kind in (kinds.mjGEOM_CYLINDER, kinds.mjGEOM_CAPSULE) and upright > 1.0 - 1e-6
             ):
                 rounds.append(RoundObstacle(x, y, float(size[0])))
+            elif kind == kinds.mjGEOM_MESH:
+                if d is None:
+                    d = mujoco.MjData(m)
+                    mujoco.mj_kinematics(m, d)
+                hull = _mesh_footprint(m, d, g)
+                if hull is not None:
+                    polygons.append(hull)
+                else:  # a mesh edge-on to the floor: no area to measure from
+                    unjudged.append(f"{name} (MESH)")
             else:
                 unjudged.append(f"{name} ({mujoco.mjtGeom(kind).name.removeprefix('mjGEOM_')})")
         self._obstacles, self._walls = tuple(obstacles), tuple(walls)
         self._rounds, self._unjudged = tuple(rounds), tuple(unjudged)
+        self._polygons = tuple(polygons)
 
     @property
     def scene_file(self) -> str:
@@ -528,6 +552,9 @@ class MujocoInterface(RobotHardwareInterface):
 
     def round_obstacles(self) -> tuple[RoundObstacle, ...]:
         return self._rounds
+
+    def polygon_obstacles(self) -> tuple[PolygonObstacle, ...]:
+        return self._polygons
 
     def unjudged_geoms(self) -> tuple[str, ...]:
         return self._unjudged

@@ -4,6 +4,7 @@ named as unjudged, and a run among them fails: a clearance never measured is no 
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import pytest
@@ -36,6 +37,7 @@ SCENE = """<mujoco>
 </mujoco>
 """
 TILTED = '<geom name="log" type="cylinder" pos="-3 3 0.1" size="0.1 0.5" euler="1.5708 0 0"/>'
+EGG = '<geom name="egg" type="ellipsoid" pos="4 -4 0.2" size="0.1 0.2 0.3"/>'
 MESH = '<geom name="boulder" type="mesh" mesh="rock" pos="3 3 0"/>'
 
 
@@ -59,23 +61,39 @@ def test_every_static_shape_is_seen(tmp_path: Path) -> None:
         world.close()
 
 
-def test_tilted_cylinders_and_meshes_are_named_unjudged(tmp_path: Path) -> None:
-    world = MujocoInterface(_scene(tmp_path, TILTED + MESH))
+def test_tilted_cylinders_and_ellipsoids_are_named_unjudged(tmp_path: Path) -> None:
+    world = MujocoInterface(_scene(tmp_path, TILTED + EGG))
     try:
-        assert world.unjudged_geoms() == ("log (CYLINDER)", "boulder (MESH)")
+        assert world.unjudged_geoms() == ("log (CYLINDER)", "egg (ELLIPSOID)")
+    finally:
+        world.close()
+
+
+def test_a_mesh_is_judged_by_its_footprint(tmp_path: Path) -> None:
+    """The tetrahedron (0,0,0) (0.2,0,0) (0,0.2,0) (0,0,0.2) at (3, 3): its floor
+    footprint is the triangle (3,3) (3.2,3) (3,3.2), wherever MuJoCo puts the mesh frame."""
+    world = MujocoInterface(_scene(tmp_path, MESH))
+    try:
+        (hull,) = world.polygon_obstacles()
+        corners = [c for point in sorted(hull.points) for c in point]
+        assert corners == pytest.approx([3.0, 3.0, 3.0, 3.2, 3.2, 3.0])
+        assert hull.distance_to(3.05, 3.05) == 0.0
+        assert hull.distance_to(2.0, 3.0) == pytest.approx(1.0)
+        assert hull.distance_to(3.2, 3.2) == pytest.approx(math.sqrt(0.02))  # 0.2 / sqrt 2
+        assert world.unjudged_geoms() == ()
     finally:
         world.close()
 
 
 def test_a_run_whose_clearance_was_not_measured_fails(tmp_path: Path) -> None:
     scenario = ScenarioConfig(
-        name="unjudged", scene=str(_scene(tmp_path, MESH)), goal=GoalSpec(x=1.0, y=0.0)
+        name="unjudged", scene=str(_scene(tmp_path, EGG)), goal=GoalSpec(x=1.0, y=0.0)
     )
     verdict = run_scenario(scenario, StackConfig(), record=False, plot=False)
     assert verdict.reached  # the robot did arrive ...
-    assert not verdict.passed  # ... but nobody measured how close it came to the boulder
+    assert not verdict.passed  # ... but nobody measured how close it came to the egg
     assert "clearance not measured" in verdict.reason
-    assert "boulder (MESH)" in verdict.reason
+    assert "egg (ELLIPSOID)" in verdict.reason
 
 
 def test_a_cylinder_s_clearance_is_measured(tmp_path: Path) -> None:
