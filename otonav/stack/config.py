@@ -275,9 +275,11 @@ class NavConfig(_Section):
     approach_radius: float = Field(_NAV.approach_radius, ge=0.0, le=5.0)
     """m (dwa planner): within this distance of the goal a proportional controller
     (``kp_lin``, ``kp_ang``) finishes, in reverse if the goal is behind, in [0, 5]."""
-    footprint_padding: float = Field(0.05, ge=0.0, le=1.0)
+    footprint_padding: float = Field(0.03, ge=0.0, le=1.0)
     """m, gap kept between the footprint (read from the MJCF) and any return, in [0, 1].
-    The planner keeps its centre max(clearance, footprint radius + padding) away."""
+    The planner keeps its centre max(clearance, footprint radius + padding) away. The
+    safety layer's by default (issue 42: 0.05 m, more than the layer that guarantees the
+    stop, refused BARN passages a Jackal-sized robot passes; Nav2's is 0.01 m)."""
     dwa: DwaConfig = DwaConfig()
     map: MapConfig = MapConfig()
     recovery: RecoveryConfig = RecoveryConfig()
