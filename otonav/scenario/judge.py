@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import Literal
 
 from otonav.actors import topics
 from otonav.hal import BoxObstacle, RobotHardwareInterface
@@ -53,7 +54,7 @@ class Judge(Actor):
         settle_s: float = ARRIVAL_SETTLE_S,
         max_speed: float = ARRIVAL_MAX_SPEED,
         nav_must_say_reached: bool = True,
-        arrival: str = "stop",
+        arrival: Literal["stop", "enter"] = "stop",
         name: str = "judge",
     ) -> None:
         super().__init__(name)
