@@ -44,6 +44,7 @@ import numpy as np
 from otonav.scenario import run_scenario
 from otonav.scenario.config import GoalSpec, ScenarioConfig, StartSpec
 from otonav.stack import StackConfig
+from otonav.stack.files import ConfigFileError
 from otonav.stack.loading import load_stack_file
 from otonav.stack.overrides import apply_overrides
 
@@ -261,8 +262,12 @@ def main() -> int:
     if missing:
         print(f"--worlds: {missing[:5]} not among BARN's worlds 0..299", file=sys.stderr)
         return 2
-    stack = load_stack_file(args.config) if args.config else StackConfig()
-    stack = apply_overrides(stack, args.overrides)
+    try:
+        stack = load_stack_file(args.config) if args.config else StackConfig()
+        stack = apply_overrides(stack, args.overrides)
+    except ConfigFileError as error:
+        print(error, file=sys.stderr)
+        return 2
     tasks = [(worlds[n], stack) for n in sample]
     started = time.perf_counter()
     runs: list[Run] = []
