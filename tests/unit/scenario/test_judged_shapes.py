@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from otonav.hal import BoxObstacle, RoundObstacle
@@ -105,3 +106,23 @@ def test_a_cylinder_s_clearance_is_measured(tmp_path: Path) -> None:
     # The pillar (r 0.1 at (2, 1)) is the nearest near the goal: hypot(1, 1) - 0.1 =
     # 1.314 m from it; the post (r 0.05 at (0, -2)) 1.95 m from the start.
     assert 1.3 < verdict.min_clearance_m < 1.95
+
+
+def test_the_plot_draws_disks_and_mesh_footprints_with_the_boxes() -> None:
+    """Issue 42: a scene of cylinders drew no obstacle. One artist still draws them all."""
+    from otonav.hal import PolygonObstacle
+    from otonav.scenario.plot import draw_trajectory
+
+    shapes = (
+        BoxObstacle(1.0, 0.5, 0.2, 0.3, 0.0),
+        RoundObstacle(-1.0, 2.0, 0.075),
+        PolygonObstacle(((3.0, 3.0), (3.2, 3.0), (3.0, 3.2))),
+    )
+    trajectory = [(0.0, 0.0, 0.0), (1.0, 0.0, 1.0)]
+    fig = draw_trajectory(trajectory, shapes, (0.0, 3.0), 0.15, None, "shapes")
+    (ax,) = fig.axes
+    (patch,) = [p for p in ax.patches if p.get_label() == "obstacles, walls"]
+    vertices = [(float(vx), float(vy)) for vx, vy in np.asarray(patch.get_path().vertices)]
+    # The disk's rightmost and top points, and the triangle's corners, are outlined.
+    for x, y in ((-0.925, 2.0), (-1.0, 2.075), (3.2, 3.0), (3.0, 3.2)):
+        assert min(math.hypot(vx - x, vy - y) for vx, vy in vertices) < 1e-9, (x, y)
