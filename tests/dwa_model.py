@@ -68,14 +68,15 @@ def dwa_reference(
         )
         if d[i] < 0.05:
             bearing = 0.0
-        gain = (math.hypot(target[0] - x0, target[1] - y0) - d[i]) / (p.max_v * p.horizon)
+        top = max(v_hi, 1e-3)  # the window's top speed, not max_v (issue 42)
+        gain = (math.hypot(target[0] - x0, target[1] - y0) - d[i]) / (top * p.horizon)
         least = float(clear.min())
         room = min(max(least - p.radius, 0.0), p.clearance_cap) / p.clearance_cap
         score = (
             p.w_heading * (1 - bearing / math.pi)
             + p.w_progress * gain
             + p.w_clearance * room
-            + p.w_speed * v / p.max_v
+            + p.w_speed * v / top
         )
         if best is None or score > best[2]:
             best = (v, w, score, least)

@@ -11,8 +11,10 @@ from otonav.hal.types import (
     BoxObstacle,
     GroundTruth,
     ImuSample,
+    PolygonObstacle,
     RangeScan,
     RobotGeometry,
+    RoundObstacle,
     WheelSetpoint,
     WheelState,
 )
@@ -24,9 +26,11 @@ __all__ = (
     "HardwareHealth",
     "HealthLevel",
     "ImuSample",
+    "PolygonObstacle",
     "RangeScan",
     "RobotGeometry",
     "RobotHardwareInterface",
+    "RoundObstacle",
     "WheelSetpoint",
     "WheelState",
 )

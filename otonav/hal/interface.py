@@ -17,9 +17,11 @@ from otonav.hal.types import (
     BoxObstacle,
     GroundTruth,
     ImuSample,
+    PolygonObstacle,
     RangeScan,
     Reach,
     RobotGeometry,
+    RoundObstacle,
     WheelSetpoint,
     WheelState,
 )
@@ -119,6 +121,21 @@ class RobotHardwareInterface(abc.ABC):
 
     def walls(self) -> tuple[BoxObstacle, ...]:
         """The world's boundary walls as boxes (m). Empty if the world has none."""
+        return ()
+
+    def round_obstacles(self) -> tuple[RoundObstacle, ...]:
+        """The world's upright cylinders, capsules and spheres as disks (m), for
+        ground-truth clearance. Empty if the world has none."""
+        return ()
+
+    def polygon_obstacles(self) -> tuple[PolygonObstacle, ...]:
+        """The world's meshes as the convex hull of their vertices on the floor (m), for
+        ground-truth clearance. Empty if the world has none."""
+        return ()
+
+    def unjudged_geoms(self) -> tuple[str, ...]:
+        """The static geoms the robot could hit whose clearance cannot be measured (a
+        tilted cylinder, an ellipsoid), ``name (type)`` each: a judged run fails on them."""
         return ()
 
     def clearance_boxes(self) -> tuple[BoxObstacle, ...]:

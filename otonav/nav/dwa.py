@@ -22,9 +22,13 @@ One step:
    length: ``v * latency + v**2 / (2 * max_accel) <= free length``.
 4. **Score** (higher is better), each term in [0, 1] or [-1, 1]:
    ``w_heading * (1 - |bearing error to the target| / pi)
-   + w_progress * (distance to the target gained) / (max_v * horizon)
+   + w_progress * (distance to the target gained) / (v_top * horizon)
    + w_clearance * min(min clearance - radius, clearance_cap) / clearance_cap
-   + w_speed * v / max_v``.
+   + w_speed * v / v_top``, with ``v_top`` the top of this step's window (at least
+   1 mm/s), not ``max_v``: the progress and speed terms compare the samples the window
+   offers, so raising ``max_v`` (the same window while the robot accelerates) does not
+   shrink them under the clearance term (issue 42: a 2 m/s robot, whose terms were a
+   fifth of a 0.4 m/s one's, crept at 0.017 m/s in the open; ADR 0078).
    The target is a point of the global path ahead of the robot (or the goal); heading
    and progress are taken at the rollout's closest approach to it, among its poses
    before the first one under the threshold (the heading at the last of those poses
@@ -160,6 +164,11 @@ class DwaResult(NamedTuple):
     best_score: float
     clearance: float
     reason: str
+
+
+_MIN_V_TOP = 1e-3
+"""m/s: the smallest speed the progress and speed terms are scaled by (a window that
+reaches no faster, e.g. turning on the spot from rest, scores them as at 1 mm/s)."""
 
 
 @lru_cache(maxsize=8)
@@ -364,7 +373,8 @@ def dwa_step(
     bearing = np.abs(np.remainder(bearing + math.pi, math.tau) - math.pi)
     np.putmask(bearing, closest < 0.05, 0.0)  # at the target: no bearing to keep
     d0 = math.hypot(tx - x0, ty - y0)
-    gain = (d0 - closest) / (p.max_v * p.horizon)
+    v_top = max(v_hi, _MIN_V_TOP)  # the window's, not max_v (module docstring, ADR 0078)
+    gain = (d0 - closest) / (v_top * p.horizon)
     min_clear = np.minimum.reduce(clear, axis=1)
     # np.minimum(np.maximum()) is np.clip's result without its ~4 us Python wrapper.
     room = np.minimum(np.maximum(min_clear - p.radius, 0.0), p.clearance_cap) / p.clearance_cap
@@ -372,7 +382,7 @@ def dwa_step(
         p.w_heading * (1.0 - bearing / math.pi)
         + p.w_progress * gain
         + p.w_clearance * room
-        + p.w_speed * v / p.max_v
+        + p.w_speed * v / v_top
     )
     np.putmask(score, ~admissible, -np.inf)
     best = int(score.argmax())

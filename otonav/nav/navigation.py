@@ -29,9 +29,10 @@ Each :meth:`Navigation.step` (at the navigator's rate):
    goal side), ``backup`` (reverse ``backup_distance``), ``follow`` (follow the
    obstacle's boundary on the side that heads closer to the goal, Bug2-style, until
    ``distance`` m closer to the goal than where it started or ``follow_time`` s),
-   then ``unreachable``: "no progress after spin, backup and follow". Getting
-   ``distance`` m closer to the goal than at the start of the ladder resets it. The
-   ladder runs once: the robot never oscillates until the budget ends.
+   then the ladder again (``round 2``, ...) from a fresh plan: only a search that
+   proved there is no path says ``unreachable`` (issue 42: the ladder alone called 12
+   of 60 reachable BARN worlds unreachable). Getting ``distance`` m closer to the goal
+   than at the start of the ladder resets it.
 """
 
 from __future__ import annotations
@@ -208,6 +209,7 @@ class Navigation:
     _checked_at: float = -math.inf
     _looked_around: bool = False
     _ladder: int = 0
+    _rounds: int = 1
     _ladder_best: float = math.inf
     _ladder_to_go: float | None = None
     _remaining: NDArray[np.float64] | None = None
@@ -251,6 +253,7 @@ class Navigation:
             self._reached = False
             self._stage = None
             self._ladder = 0
+            self._rounds = 1
             self._ladder_best = math.inf
             self._ladder_to_go = None
             self._looked_around = False
@@ -363,12 +366,14 @@ class Navigation:
             # the goal and the verdict waits for it: at most max_expansions /
             # expansions_per_tick steps)
             if self._ladder >= len(LADDER):
-                return self._give_up(
-                    f"no progress after {', '.join(LADDER)} ({stuck})", distance, heading
-                )
+                # A path exists (no search proved otherwise): the goal is not
+                # unreachable, however stuck the robot is. The ladder starts over from
+                # a fresh plan until the budget ends (issue 42: false `unreachable`).
+                self._ladder, self._rounds = 0, self._rounds + 1
             stage = LADDER[self._ladder]
             self._ladder += 1
-            why = f"rung {self._ladder}/{len(LADDER)}, {stuck}"
+            again = f" (round {self._rounds})" if self._rounds > 1 else ""
+            why = f"rung {self._ladder}/{len(LADDER)}{again}, {stuck}"
             return self._begin(stage, now, pose, distance, heading, points, why)
         if distance < self.params.approach_radius:
             return self._approach(distance, heading)

@@ -1,5 +1,6 @@
 """The judge's minimum clearance: the smallest distance from the robot's centre to any box
-over a run, exact, at a cost per sample that does not grow with the number of boxes.
+or round obstacle (a disk: an upright cylinder, capsule or a sphere; issue 42) over a
+run, exact, at a cost per sample that does not grow with the number of boxes.
 
 Units m, world frame. A box's distance is computed with the arithmetic of
 :meth:`~otonav.hal.types.BoxObstacle.distance_to` (the same floats), so the figure is
@@ -33,7 +34,7 @@ import heapq
 import math
 from collections.abc import Sequence
 
-from otonav.hal import BoxObstacle
+from otonav.hal import BoxObstacle, PolygonObstacle, RoundObstacle
 
 __all__ = ("ClearanceTracker",)
 
@@ -55,7 +56,13 @@ class ClearanceTracker:
     """
 
     def __init__(
-        self, boxes: Sequence[BoxObstacle], *, cell: float = 0.5, reach: float = 0.5
+        self,
+        boxes: Sequence[BoxObstacle],
+        rounds: Sequence[RoundObstacle] = (),
+        polygons: Sequence[PolygonObstacle] = (),
+        *,
+        cell: float = 0.5,
+        reach: float = 0.5,
     ) -> None:
         if not (math.isfinite(cell) and cell > 0.0):
             raise ValueError(f"ClearanceTracker.cell must be a positive length in m, got {cell!r}")
@@ -70,17 +77,25 @@ class ClearanceTracker:
         self._cell = cell
         self._reach = reach
         # Per box: centre, half sizes, its yaw's cos and sin (BoxObstacle.distance_to's
-        # floats, computed once).
+        # floats, computed once), radius 0; a disk is a box of no size with a radius.
         self._math = [
-            (b.x, b.y, b.half_x, b.half_y, math.cos(b.yaw), math.sin(b.yaw)) for b in boxes
-        ]
+            (b.x, b.y, b.half_x, b.half_y, math.cos(b.yaw), math.sin(b.yaw), 0.0) for b in boxes
+        ] + [(r.x, r.y, 0.0, 0.0, 1.0, 0.0, r.radius) for r in rounds]
+        # A mesh's hull: its own distance_to (entries after the boxes and disks), its
+        # bounding rectangle's centre and half sizes for the grid.
+        self._polygons = tuple(polygons)
+        self._first_polygon = len(self._math)
+        for p in self._polygons:
+            xs, ys = [q[0] for q in p.points], [q[1] for q in p.points]
+            hx, hy = (max(xs) - min(xs)) / 2, (max(ys) - min(ys)) / 2
+            self._math.append((min(xs) + hx, min(ys) + hy, hx, hy, 1.0, 0.0, 0.0))
         self._key = [-math.inf] * len(self._math)
         """Per box: distance at its last computation + the path driven then (-inf: never)."""
         self._grid: dict[tuple[int, int], list[int]] = {}
         self._big: list[int] = []
-        for i, (bx, by, hx, hy, c, s) in enumerate(self._math):
-            ex = abs(c) * hx + abs(s) * hy + _MARGIN
-            ey = abs(s) * hx + abs(c) * hy + _MARGIN
+        for i, (bx, by, hx, hy, c, s, radius) in enumerate(self._math):
+            ex = abs(c) * hx + abs(s) * hy + radius + _MARGIN
+            ey = abs(s) * hx + abs(c) * hy + radius + _MARGIN
             i0, i1 = self._span(bx - ex, bx + ex)
             j0, j1 = self._span(by - ey, by + ey)
             if (i1 - i0 + 1) * (j1 - j0 + 1) > _MAX_CELLS_PER_BOX:
@@ -115,11 +130,16 @@ class ClearanceTracker:
         done: list[int] = []
         while heap and heap[0][0] <= due:
             i = heapq.heappop(heap)[1]
-            bx, by, hx, hy, c, s = self._math[i]
-            dx, dy = x - bx, y - by
-            lx = c * dx + s * dy
-            ly = -s * dx + c * dy
-            d = math.hypot(max(abs(lx) - hx, 0.0), max(abs(ly) - hy, 0.0))
+            if i >= self._first_polygon:
+                d = self._polygons[i - self._first_polygon].distance_to(x, y)
+            else:
+                bx, by, hx, hy, c, s, radius = self._math[i]
+                dx, dy = x - bx, y - by
+                lx = c * dx + s * dy
+                ly = -s * dx + c * dy
+                d = math.hypot(max(abs(lx) - hx, 0.0), max(abs(ly) - hy, 0.0))
+                if radius:  # RoundObstacle.distance_to's floats (lx, ly: dx, dy exactly)
+                    d = max(d - radius, 0.0)
             self._key[i] = d + path
             self.checks += 1
             done.append(i)

@@ -75,7 +75,11 @@ class ScenarioConfig(BaseModel):
     """Where the robot starts; odometry starts there too (odom = world frame)."""
     goal: GoalSpec = GoalSpec(x=4.0, y=1.5)
     goal_tolerance: Distance = 0.15
-    """m: reached when the true position is this close to the goal."""
+    """m: reached when the true position is this close to the goal (see ``arrival``)."""
+    arrival: Literal["stop", "enter"] = "stop"
+    """What counts as arriving: ``stop`` (within the tolerance, stopped, and the navigator
+    says ``reached``, 2 s after the first entry) or ``enter`` (the first entry into the
+    tolerance, as BARN counts success; issue 42)."""
     sim_budget: PositiveFloat = Field(20.0, le=limits.MAX_SIM_BUDGET_S)
     """s of sim time to reach the goal, at most half an hour (and see
     :func:`~otonav.scenario.validate.check_cost`)."""

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import Literal
 
 from otonav.actors import topics
 from otonav.hal import BoxObstacle, RobotHardwareInterface
@@ -55,9 +56,13 @@ class Judge(Actor):
         settle_s: float = ARRIVAL_SETTLE_S,
         max_speed: float = ARRIVAL_MAX_SPEED,
         nav_must_say_reached: bool = True,
+        arrival: Literal["stop", "enter"] = "stop",
         name: str = "judge",
     ) -> None:
         super().__init__(name)
+        self.arrival = arrival
+        """``stop`` (the arrival check above) or ``enter`` (BARN's criterion: the first
+        entry into the tolerance is arriving; issue 42)."""
         self.nav_must_say_reached = nav_must_say_reached
         self.settle_s = settle_s
         self.max_speed = max_speed
@@ -84,7 +89,9 @@ class Judge(Actor):
         self.tolerance = tolerance
         self.rate_hz = rate_hz
         self.boxes: tuple[BoxObstacle, ...] = hal.obstacles() + hal.walls()
-        self._clearance = ClearanceTracker(self.boxes)
+        self.rounds = hal.round_obstacles()
+        self.polygons = hal.polygon_obstacles()
+        self._clearance = ClearanceTracker(self.boxes, self.rounds, self.polygons)
         self.min_clearance = math.inf
         self.min_clearance_at: tuple[float, float] = (math.nan, math.nan)
         self.path_length = 0.0
@@ -136,6 +143,26 @@ class Judge(Actor):
         return (
             self.arrival_checked_at is not None or self.gave_up or self.hardware_fault is not None
         )
+
+    @property
+    def clearance_problem(self) -> str | None:
+        """Why the clearance was not measured (static geoms of a shape the judge cannot
+        measure: a tilted cylinder, an ellipsoid); None: every static geom was measured. A
+        clearance never measured is not a pass (issue 42)."""
+        unjudged = self.hal.unjudged_geoms()
+        if not unjudged:
+            return None
+        more = f" and {len(unjudged) - 5} more" if len(unjudged) > 5 else ""
+        return (
+            f"clearance not measured: the judge measures boxes, upright cylinders and "
+            f"capsules, spheres and meshes, not {', '.join(unjudged[:5])}{more}"
+        )
+
+    def _entered(self, now: float) -> None:
+        """The first entry into the tolerance: with ``arrival: enter`` that is arriving."""
+        self.time_to_goal = now
+        if self.arrival == "enter":
+            self.arrival_checked_at = now
 
     def _check_arrival(self, now: float) -> None:
         problems = []
@@ -196,7 +223,7 @@ class Judge(Actor):
         self.distance = math.hypot(self.goal[0] - x, self.goal[1] - y)
         self.speed = math.hypot(vx, vy)
         if self.time_to_goal is None and self.distance <= self.tolerance:
-            self.time_to_goal = now
+            self._entered(now)
         if (
             self.time_to_goal is not None
             and self.arrival_checked_at is None

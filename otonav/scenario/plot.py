@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav.hal import BoxObstacle
+from otonav.hal import BoxObstacle, PolygonObstacle, RoundObstacle
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -31,19 +31,36 @@ def box_outlines(boxes: tuple[BoxObstacle, ...]) -> NDArray[np.float64]:
     return np.stack((x, y), axis=-1)
 
 
-def _boxes_path(boxes: tuple[BoxObstacle, ...]) -> MplPath:
-    """All boxes as one compound path: one artist to draw, and one vertex array for the
-    renderer to draw (a patch per box made the legend's "best" placement test each one:
-    3000 boxes drew in 1.7 s, issue 30). The outlines all turn the same way, so where boxes
-    overlap the non-zero fill rule fills them once."""
+Obstacle = BoxObstacle | RoundObstacle | PolygonObstacle
+
+
+def _boxes_path(obstacles: tuple[Obstacle, ...]) -> MplPath:
+    """All boxes and disks as one compound path: one artist to draw, and one vertex
+    array for the legend's "best" placement to test (a patch per box made it test each
+    one: 3000 boxes drew in 1.7 s, issue 30). The outlines all turn the same way, so
+    where they overlap the non-zero fill rule fills them once."""
     from matplotlib.path import Path as MplPath
 
+    boxes = tuple(o for o in obstacles if isinstance(o, BoxObstacle))
     outlines = box_outlines(boxes)
     codes = np.tile(
         np.array([MplPath.MOVETO, *[MplPath.LINETO] * 3, MplPath.CLOSEPOLY], MplPath.code_type),
         len(boxes),
     )
-    return MplPath(outlines.reshape(-1, 2), codes)
+    paths = [MplPath(outlines.reshape(-1, 2), codes)]
+    unit = MplPath.circle()  # Bezier arcs, counter-clockwise like the box outlines
+    circle: NDArray[np.float64] = np.asarray(unit.vertices, dtype=np.float64)
+    paths += [
+        MplPath(circle * o.radius + np.array((o.x, o.y)), unit.codes)
+        for o in obstacles
+        if isinstance(o, RoundObstacle)
+    ]
+    paths += [
+        MplPath(np.array([*o.points, o.points[0]]), closed=True)
+        for o in obstacles
+        if isinstance(o, PolygonObstacle)
+    ]
+    return MplPath.make_compound_path(*paths)
 
 
 def key_poses(
@@ -79,7 +96,7 @@ def key_poses(
 
 def draw_trajectory(
     trajectory: list[tuple[float, float, float]],
-    obstacles: tuple[BoxObstacle, ...] | None,
+    obstacles: tuple[Obstacle, ...] | None,
     goal: tuple[float, float] | None,
     tolerance: float | None,
     closest: tuple[float, float] | None,
@@ -89,7 +106,7 @@ def draw_trajectory(
     footprint: Sequence[tuple[float, float]] = (),
     poses: Sequence[tuple[float, float, float]] = (),
 ) -> Figure:
-    """The figure of a run: ``trajectory`` as (t, x, y), the obstacle boxes (``None``:
+    """The figure of a run: ``trajectory`` as (t, x, y), the obstacles (``None``:
     not known, and the figure says so), the goal and its tolerance circle (``None``:
     not known, said likewise), the closest approach; the robot's ``footprint`` (base
     frame) drawn at each of ``poses`` (x, y, yaw), e.g. start, closest approach, end."""
@@ -135,8 +152,9 @@ def draw_trajectory(
     span_x = [*xs, *(goal[:1] if goal else ())] or [0.0]
     span_y = [*ys, *(goal[1:] if goal else ())] or [0.0]
     x0, x1, y0, y1 = min(span_x) - 1.0, max(span_x) + 1.0, min(span_y) - 1.0, max(span_y) + 1.0
-    if obstacles:  # a box the window cuts is drawn whole, up to 1 m more (walls stay cut)
-        corners = box_outlines(obstacles)
+    boxes = tuple(o for o in obstacles or () if isinstance(o, BoxObstacle))
+    if boxes:  # a box the window cuts is drawn whole, up to 1 m more (walls stay cut)
+        corners = box_outlines(boxes)
         lo, hi = corners.min(axis=1), corners.max(axis=1)
         cut = (lo[:, 0] < x1) & (hi[:, 0] > x0) & (lo[:, 1] < y1) & (hi[:, 1] > y0)
         if cut.any():
@@ -167,7 +185,7 @@ def draw_trajectory(
 def plot_trajectory(
     path: Path,
     trajectory: list[tuple[float, float, float]],
-    obstacles: tuple[BoxObstacle, ...] | None,
+    obstacles: tuple[Obstacle, ...] | None,
     goal: tuple[float, float] | None,
     tolerance: float | None,
     closest: tuple[float, float] | None,

@@ -45,6 +45,7 @@ from otonav.scenario.judge import Judge
 from otonav.scenario.plot import key_poses, plot_trajectory
 from otonav.scenario.validate import check_cost, check_goal
 from otonav.stack import StackConfig, build_actors, build_world
+from otonav.stack.config import NavConfig
 from otonav.stack.robot import describe_robot, reached, slower
 from otonav.stack.session import StackSession
 
@@ -169,11 +170,16 @@ def finite_figures(figures: dict[str, Any]) -> dict[str, Any]:
 
 
 def effective_stack(scenario: ScenarioConfig, stack: StackConfig) -> StackConfig:
-    """The stack config with the scenario's scene, if it names one."""
-    if scenario.scene is None:
-        return stack
-    world = stack.world.model_copy(update={"scene": scenario.scene})
-    return stack.model_copy(update={"world": world})
+    """The stack config with the scenario's scene, if it names one, and the navigator's
+    goal tolerance following the scenario's (half of it, never below ``nav.tolerance``'s
+    default) unless ``nav.tolerance`` is set (issue 42, ADR 0079)."""
+    updates: dict[str, Any] = {}
+    if scenario.scene is not None:
+        updates["world"] = stack.world.model_copy(update={"scene": scenario.scene})
+    default = NavConfig().tolerance
+    if stack.nav.tolerance == default and scenario.goal_tolerance / 2 > default:
+        updates["nav"] = stack.nav.model_copy(update={"tolerance": scenario.goal_tolerance / 2})
+    return stack.model_copy(update=updates) if updates else stack
 
 
 def scenario_session(
@@ -299,6 +305,7 @@ def opened_scenario(
             scenario.goal_tolerance,
             progress=progress,
             nav_must_say_reached=stack.nav.planner != "external",
+            arrival=scenario.arrival,
         )
         session = scenario_session(
             scenario,
@@ -511,7 +518,7 @@ def save_artifacts(
             plot_trajectory(
                 png,
                 judge.trajectory,
-                judge.boxes,
+                judge.boxes + judge.rounds + judge.polygons,
                 (scenario.goal.x, scenario.goal.y),
                 scenario.goal_tolerance,
                 judge.min_clearance_at,
@@ -628,7 +635,8 @@ def judge_verdict(
 ) -> Verdict:
     """Pass when the scenario's expected outcome happened (``expect``: the goal reached,
     or the navigator's ``unreachable`` inside the budget) and the clearance held."""
-    clear = judge.min_clearance >= scenario.min_clearance
+    unmeasured = judge.clearance_problem
+    clear = judge.min_clearance >= scenario.min_clearance and unmeasured is None
     gave_up = judge.unreachable_at is not None and judge.unreachable_at <= scenario.sim_budget
     reasons = []
     if scenario.expect == "reached":
@@ -662,7 +670,9 @@ def judge_verdict(
         reasons.append(
             f"hardware fault since {health.since:.2f} s: {health.fault}: {health.message}"
         )
-    if not clear:
+    if unmeasured is not None:
+        reasons.append(unmeasured)
+    elif not clear:
         reasons.append(
             f"came {judge.min_clearance:.3f} m from an obstacle "
             f"(minimum {scenario.min_clearance} m)"

@@ -38,6 +38,7 @@ from otonav.stack.launch import launch
 from otonav.stack.robot import (
     deadband,
     describe_robot,
+    nav_speeds,
     reached,
     robot_base,
     robot_frames,
@@ -66,6 +67,7 @@ def build_world(
         lidar_beams=world.lidar_beams,
         lidar_range_min=world.lidar_range_min,
         lidar_range_max=world.lidar_range_max,
+        lidar_fov=world.lidar_fov,
         timestep=world.timestep,
         extra_obstacles=extra_obstacles,
         start=start,
@@ -213,8 +215,8 @@ def build_actors(
                     GoToGoalParams(
                         kp_lin=nav.kp_lin,
                         kp_ang=nav.kp_ang,
-                        max_v=min(nav.max_v, base.max_v),
-                        max_omega=min(nav.max_omega, base.max_omega),
+                        max_v=nav_speeds(config)[0],
+                        max_omega=nav_speeds(config)[1],
                         tolerance=nav.tolerance,
                         turn_in_place_threshold=nav.turn_in_place_threshold,
                     ),
@@ -281,7 +283,7 @@ def navigation_params(
     stays the asked speed: a servo short of its setpoint reaches most when asked most."""
     nav, base = config.nav, robot_base(config)
     radius = centre_clearance(nav.clearance, geometry.footprint_radius, nav.footprint_padding)
-    fastest_v, fastest_omega = min(nav.max_v, base.max_v), min(nav.max_omega, base.max_omega)
+    fastest_v, fastest_omega = nav_speeds(config)
     if reach is not None:  # no faster than the wheels' control range lets it ask
         fastest_v, fastest_omega = reach.asked_v, reach.asked_omega
     accel, alpha = base.max_accel, base.max_alpha

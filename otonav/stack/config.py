@@ -93,6 +93,10 @@ class WorldConfig(_Section):
     """m, returns closer than this read as -inf (below range), < ``lidar_range_max``."""
     lidar_range_max: PositiveFloat = Field(8.0, le=limits.MAX_LIDAR_RANGE_M)
     """m, at most 1 km: ranges are float32 in the recording."""
+    lidar_fov: float = Field(2.0 * math.pi, gt=0.0, le=2.0 * math.pi)
+    """rad, the lidar's field of view, centred ahead, in (0, 2 pi] (BARN's Jackal: 4.71,
+    270 degrees). Below a full circle the first and last beams are at -fov/2 and +fov/2,
+    as /scan's ``angle_min`` and ``angle_max`` say."""
     odometry_error: OdometryErrorConfig = OdometryErrorConfig()
     """Simulated odometry drift (off by default): see :class:`OdometryErrorConfig`."""
 
@@ -115,7 +119,8 @@ class BaseConfig(_Section):
     """s of sim time without a valid /cmd_vel before the wheels stop (watchdog)."""
     # Bounded so that wheel speeds stay finite and the limits still limit (limits.py).
     max_v: PositiveFloat = Field(0.5, le=limits.MAX_BASE_V)
-    """m/s, the fastest the base drives, whatever /cmd_vel asks."""
+    """m/s, the fastest the base drives, whatever /cmd_vel asks (``robot.max_v``, when
+    stated, sets it)."""
     max_omega: PositiveFloat = Field(1.5, le=limits.MAX_BASE_OMEGA)
     """rad/s, the fastest the base turns."""
     max_accel: PositiveFloat = Field(1.0, le=limits.MAX_BASE_ACCEL)
@@ -257,7 +262,7 @@ class NavConfig(_Section):
     kp_ang: float = Field(_NAV.kp_ang, ge=0.0)
     """Proportional gain on the heading error, 1/s."""
     max_v: PositiveFloat = _NAV.dwa.max_v
-    """m/s, the fastest the navigator asks for."""
+    """m/s, the fastest the navigator asks for (``robot.max_v``, when stated, sets it)."""
     max_omega: PositiveFloat = _NAV.dwa.max_omega
     """rad/s, the fastest turn the navigator asks for."""
     tolerance: PositiveFloat = _NAV.tolerance
@@ -270,9 +275,11 @@ class NavConfig(_Section):
     approach_radius: float = Field(_NAV.approach_radius, ge=0.0, le=5.0)
     """m (dwa planner): within this distance of the goal a proportional controller
     (``kp_lin``, ``kp_ang``) finishes, in reverse if the goal is behind, in [0, 5]."""
-    footprint_padding: float = Field(0.05, ge=0.0, le=1.0)
+    footprint_padding: float = Field(0.03, ge=0.0, le=1.0)
     """m, gap kept between the footprint (read from the MJCF) and any return, in [0, 1].
-    The planner keeps its centre max(clearance, footprint radius + padding) away."""
+    The planner keeps its centre max(clearance, footprint radius + padding) away. The
+    safety layer's by default (issue 42: 0.05 m, more than the layer that guarantees the
+    stop, refused BARN passages a Jackal-sized robot passes; Nav2's is 0.01 m)."""
     dwa: DwaConfig = DwaConfig()
     map: MapConfig = MapConfig()
     recovery: RecoveryConfig = RecoveryConfig()
@@ -549,9 +556,12 @@ class RobotConfig(_Section):
     footprint: tuple[tuple[float, float], ...] | None = Field(None, min_length=3)
     """(x, y) points in base_link, m: overrides the derived outline."""
     max_v: float | None = Field(None, gt=0.0, le=limits.MAX_BASE_V)
-    """m/s, the robot's top speed: caps ``base.max_v`` and scales scenario budgets."""
+    """m/s, the robot's top speed: what the base and the navigator use (up or down from
+    their defaults; a ``base.max_v`` / ``nav.max_v`` set away from its default lowers it,
+    with a warning), and it scales scenario budgets."""
     max_omega: float | None = Field(None, gt=0.0, le=limits.MAX_BASE_OMEGA)
-    """rad/s, the robot's top yaw rate: caps ``base.max_omega``."""
+    """rad/s, the robot's top yaw rate: what the base and the navigator use (as
+    ``max_v``)."""
     frames: FramesConfig = FramesConfig()
     """The frame ids otonav stamps its messages with (``--set robot.frames.base=...``)."""
 

@@ -4,6 +4,7 @@ against the config file it was written in."""
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Final
 
@@ -11,12 +12,13 @@ from otonav.actors.topics import FRAMES, Frames
 from otonav.hal.description import BUILTIN_ROBOTS, Mount, RobotDescription, builtin_robot
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.types import Reach
-from otonav.stack.config import BaseConfig, MountConfig, RobotConfig, StackConfig
+from otonav.stack.config import BaseConfig, MountConfig, NavConfig, RobotConfig, StackConfig
 from otonav.stack.files import ConfigFileError
 
 __all__ = [
     "deadband",
     "describe_robot",
+    "nav_speeds",
     "reached",
     "robot_base",
     "robot_frames",
@@ -94,17 +96,51 @@ def robot_frames(config: RobotConfig) -> Frames:
     )
 
 
+def _one_speed(key: str, stated: float | None, values: dict[str, tuple[float, float]]) -> float:
+    """The limit a section uses for ``key`` (``max_v``, ``max_omega``) given the robot's
+    stated top speed: the robot's; a section's key set away from its default (``values``:
+    section -> (set, default)) lowers it, with a warning that it overrides the robot's
+    (issue 42: one key for the top speed). With no stated speed, the section's own."""
+    section = next(iter(values))
+    value, default = values[section]
+    if stated is None:
+        return value
+    if value == default:
+        return stated
+    if value != stated:
+        warnings.warn(
+            f"{section}.{key} {value:g} overrides robot.{key} {stated:g}"
+            + ("" if value < stated else f" (capped at robot.{key})"),
+            stacklevel=3,
+        )
+    return min(value, stated)
+
+
 def robot_base(stack: StackConfig) -> BaseConfig:
-    """``stack.base`` with its speed limits capped at the robot's top speeds (a robot
-    description may state them: ``robot.max_v`` / ``robot.max_omega``)."""
+    """``stack.base`` with the robot's top speeds (``robot.max_v`` / ``robot.max_omega``,
+    or a built-in description's) as its speed limits, in either direction; a
+    ``base.max_v`` / ``base.max_omega`` set away from its default lowers them (a warning
+    says so)."""
     robot = describe_robot(stack.robot)
     base = stack.base
-    updates: dict[str, float] = {}
-    if robot.max_v is not None and robot.max_v < base.max_v:
-        updates["max_v"] = robot.max_v
-    if robot.max_omega is not None and robot.max_omega < base.max_omega:
-        updates["max_omega"] = robot.max_omega
-    return base.model_copy(update=updates) if updates else base
+    defaults = BaseConfig()
+    updates = {
+        key: _one_speed(
+            key, getattr(robot, key), {"base": (getattr(base, key), getattr(defaults, key))}
+        )
+        for key in ("max_v", "max_omega")
+    }
+    return base.model_copy(update=updates)
+
+
+def nav_speeds(stack: StackConfig) -> tuple[float, float]:
+    """The navigator's top speed and yaw rate: the robot's stated ones (``nav.max_v`` /
+    ``nav.max_omega`` set away from their defaults lower them), within the base's."""
+    robot = describe_robot(stack.robot)
+    base, nav, defaults = robot_base(stack), stack.nav, NavConfig()
+    v = _one_speed("max_v", robot.max_v, {"nav": (nav.max_v, defaults.max_v)})
+    w = _one_speed("max_omega", robot.max_omega, {"nav": (nav.max_omega, defaults.max_omega)})
+    return min(v, base.max_v), min(w, base.max_omega)
 
 
 def top_speed(stack: StackConfig) -> float:
@@ -120,8 +156,7 @@ identification's few percent are not worth a different navigator; ADR 0066)."""
 def reached(stack: StackConfig, hal: RobotHardwareInterface) -> Reach | None:
     """What ``hal``'s robot really reaches when the navigator asks its top speeds (the
     nav's, capped by the base's and the robot's); None when the HAL cannot tell."""
-    base, nav = robot_base(stack), stack.nav
-    return hal.reach(min(nav.max_v, base.max_v), min(nav.max_omega, base.max_omega))
+    return hal.reach(*nav_speeds(stack))
 
 
 def slower(reach: Reach | None) -> float:

@@ -296,3 +296,26 @@ def test_geometry_places_the_imu_site_in_base_link() -> None:
         assert hal.geometry.imu_offset == pytest.approx((0.0, 0.0, 0.02))
     finally:
         hal.close()
+
+
+def test_a_lidar_field_of_view_below_a_full_circle() -> None:
+    """``world.lidar_fov`` (issue 42; BARN's Jackal: 270 degrees): the beams span
+    -fov/2 .. +fov/2, both ends a beam, and nothing behind the robot is seen. A full
+    circle keeps its floats: from -pi, one increment short of +pi."""
+    full = MujocoInterface("obstacles", lidar_beams=360)
+    narrow = MujocoInterface("obstacles", lidar_beams=271, lidar_fov=math.radians(270))
+    try:
+        s = full.read_scan()
+        assert (s.angle_min, s.angle_increment) == (-math.pi, 2.0 * math.pi / 360)
+        n = narrow.read_scan()
+        assert n.angle_min == pytest.approx(-math.radians(135))
+        assert n.angle_max == pytest.approx(math.radians(135))
+        assert n.angle_increment == pytest.approx(math.radians(1.0))
+        assert len(n.ranges) == 271
+        # The beam straight ahead reads the same in both (the same ray).
+        assert n.ranges[135] == pytest.approx(s.ranges[180], abs=1e-9)
+    finally:
+        full.close()
+        narrow.close()
+    with pytest.raises(ValueError, match="lidar_fov"):
+        MujocoInterface("obstacles", lidar_fov=7.0)

@@ -43,7 +43,7 @@ from numpy.typing import NDArray
 from otonav.hal.description import RobotDescription, builtin_robot
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.mujoco._lib import mujoco, viewer_module
-from otonav.hal.mujoco.derive import _actuator_of, _Derivation, _probe, _site_sensor
+from otonav.hal.mujoco.derive import _actuator_of, _collides, _Derivation, _probe, _site_sensor
 from otonav.hal.mujoco.identify import SECONDS, _Robot, identify
 from otonav.hal.mujoco.prepare import ROBOT_PREFIX, _load_robot, _merge_options, _RobotSpec
 from otonav.hal.mujoco.scene import SceneError, _add_box, _compile, _load_spec
@@ -53,11 +53,14 @@ from otonav.hal.types import (
     BoxObstacle,
     GroundTruth,
     ImuSample,
+    PolygonObstacle,
     RangeScan,
     Reach,
     RobotGeometry,
+    RoundObstacle,
     WheelSetpoint,
     WheelState,
+    convex_hull,
 )
 from otonav.hal.viewer import ViewerHandle, check_display, launch_viewer
 
@@ -78,6 +81,17 @@ def _mtime(path: str) -> int:
     return os.stat(path).st_mtime_ns
 
 
+def _mesh_footprint(m: Any, d: Any, g: int) -> PolygonObstacle | None:
+    """A mesh geom's vertices in the world (``d`` through ``mj_kinematics``), projected
+    on the floor: their convex hull (None: fewer than 3 corners)."""
+    mesh = int(m.geom_dataid[g])
+    start, count = int(m.mesh_vertadr[mesh]), int(m.mesh_vertnum[mesh])
+    local = np.asarray(m.mesh_vert[start : start + count], dtype=np.float64)
+    world = local @ np.asarray(d.geom_xmat[g]).reshape(3, 3).T + np.asarray(d.geom_xpos[g])
+    hull = convex_hull([(float(x), float(y)) for x, y in world[:, :2]])
+    return PolygonObstacle(hull) if len(hull) >= 3 else None
+
+
 def _yaw_of_quat(w: float, x: float, y: float, z: float) -> float:
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
@@ -86,7 +100,8 @@ class MujocoInterface(RobotHardwareInterface):
     """The otonav robot simulated by MuJoCo.
 
     ``scene``: built-in scene name (``"empty"``, ``"obstacles"``) or an MJCF path.
-    ``lidar_beams`` beams over a full circle from -pi; ranges in
+    ``lidar_beams`` beams over ``lidar_fov`` rad centred ahead (a full circle: from -pi,
+    the last one an increment short of +pi; narrower: from -fov/2 to +fov/2); ranges in
     [``lidar_range_min``, ``lidar_range_max``] m, otherwise +inf. ``timestep`` (s)
     overrides the scene's. ``extra_obstacles`` become 0.5 m tall static boxes named
     ``obstacle_extra_<i>``. ``start`` is the robot's pose (x, y, yaw)
@@ -100,6 +115,7 @@ class MujocoInterface(RobotHardwareInterface):
         lidar_beams: int = 360,
         lidar_range_min: float = 0.12,
         lidar_range_max: float = 8.0,
+        lidar_fov: float = 2.0 * math.pi,
         timestep: float | None = None,
         extra_obstacles: Sequence[BoxObstacle] = (),
         start: tuple[float, float, float] = (0.0, 0.0, 0.0),
@@ -112,6 +128,8 @@ class MujocoInterface(RobotHardwareInterface):
                 f"need 0 <= lidar_range_min < lidar_range_max, got "
                 f"{lidar_range_min}, {lidar_range_max}"
             )
+        if not 0.0 < lidar_fov <= 2.0 * math.pi:
+            raise ValueError(f"lidar_fov must be in (0, 2 pi] rad, got {lidar_fov}")
         if timestep is not None and not timestep > 0.0:
             raise ValueError(f"timestep must be positive, got {timestep}")
 
@@ -201,15 +219,19 @@ class MujocoInterface(RobotHardwareInterface):
             separation=self._geometry.wheel_separation,
         )
         self._reach: dict[tuple[float, float], Reach] = {}
-        self._obstacles = self._static_boxes("obstacle")
-        self._walls = self._static_boxes("wall")
+        self._static_shapes()
         self._is_floor = np.asarray(m.geom_type == mujoco.mjtGeom.mjGEOM_PLANE, dtype=np.bool_)
 
         # Lidar: beam directions in the site frame and preallocated ray buffers.
         self._range_min = float(lidar_range_min)
         self._range_max = float(lidar_range_max)
-        self._angle_min = -math.pi
-        self._angle_increment = 2.0 * math.pi / lidar_beams
+        # A full circle: beams from -pi, the last one increment short of +pi (no beam
+        # twice). A narrower field of view (issue 42): centred ahead, both ends a beam.
+        full = lidar_fov >= 2.0 * math.pi
+        self._angle_min = -lidar_fov / 2.0
+        self._angle_increment = lidar_fov / (
+            lidar_beams if full or lidar_beams < 2 else lidar_beams - 1
+        )
         angles = self._angle_min + self._angle_increment * np.arange(lidar_beams)
         self._beams_local = np.zeros((lidar_beams, 3))
         self._beams_local[:, 0] = np.cos(angles)
@@ -252,27 +274,57 @@ class MujocoInterface(RobotHardwareInterface):
 
     # -- model facts ----------------------------------------------------------------------
 
-    def _static_boxes(self, prefix: str) -> tuple[BoxObstacle, ...]:
-        m = self._model
-        boxes = []
+    def _static_shapes(self) -> None:
+        """Every static geom the robot can touch (welded to the world, colliding, not a
+        plane), as what the judge measures (issue 42): boxes (``wall*`` ones are the
+        walls), upright cylinders, capsules and spheres as disks; the rest unjudged."""
+        m, d = self._model, None
+        kinds = mujoco.mjtGeom
+        obstacles: list[BoxObstacle] = []
+        walls: list[BoxObstacle] = []
+        rounds: list[RoundObstacle] = []
+        polygons: list[PolygonObstacle] = []
+        unjudged: list[str] = []
         for g in range(m.ngeom):
-            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g) or ""
-            if (
-                name.startswith(prefix)
-                and int(m.geom_bodyid[g]) == 0
-                and m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX
+            body = int(m.geom_bodyid[g])
+            kind = int(m.geom_type[g])
+            if int(m.body_weldid[body]) != 0 or kind == kinds.mjGEOM_PLANE or not _collides(m, g):
+                continue
+            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g) or f"geom {g}"
+            if body == 0:  # the model's floats, as before (no rounding through mj_forward)
+                x, y = float(m.geom_pos[g][0]), float(m.geom_pos[g][1])
+                w, qx, qy, qz = (float(v) for v in m.geom_quat[g])
+                yaw = _yaw_of_quat(w, qx, qy, qz)
+                upright = 1.0 - 2.0 * (qx * qx + qy * qy)
+            else:  # a body welded to the world: where its kinematics put the geom
+                if d is None:
+                    d = mujoco.MjData(m)
+                    mujoco.mj_kinematics(m, d)
+                x, y = float(d.geom_xpos[g][0]), float(d.geom_xpos[g][1])
+                xmat = d.geom_xmat[g]
+                yaw, upright = math.atan2(float(xmat[3]), float(xmat[0])), float(xmat[8])
+            size = m.geom_size[g]
+            if kind == kinds.mjGEOM_BOX:
+                box = BoxObstacle(x, y, float(size[0]), float(size[1]), yaw)
+                (walls if name.startswith("wall") else obstacles).append(box)
+            elif kind == kinds.mjGEOM_SPHERE or (
+                kind in (kinds.mjGEOM_CYLINDER, kinds.mjGEOM_CAPSULE) and upright > 1.0 - 1e-6
             ):
-                w, x, y, z = (float(v) for v in m.geom_quat[g])
-                boxes.append(
-                    BoxObstacle(
-                        x=float(m.geom_pos[g][0]),
-                        y=float(m.geom_pos[g][1]),
-                        half_x=float(m.geom_size[g][0]),
-                        half_y=float(m.geom_size[g][1]),
-                        yaw=_yaw_of_quat(w, x, y, z),
-                    )
-                )
-        return tuple(boxes)
+                rounds.append(RoundObstacle(x, y, float(size[0])))
+            elif kind == kinds.mjGEOM_MESH:
+                if d is None:
+                    d = mujoco.MjData(m)
+                    mujoco.mj_kinematics(m, d)
+                hull = _mesh_footprint(m, d, g)
+                if hull is not None:
+                    polygons.append(hull)
+                else:  # a mesh edge-on to the floor: no area to measure from
+                    unjudged.append(f"{name} (MESH)")
+            else:
+                unjudged.append(f"{name} ({mujoco.mjtGeom(kind).name.removeprefix('mjGEOM_')})")
+        self._obstacles, self._walls = tuple(obstacles), tuple(walls)
+        self._rounds, self._unjudged = tuple(rounds), tuple(unjudged)
+        self._polygons = tuple(polygons)
 
     @property
     def scene_file(self) -> str:
@@ -561,6 +613,15 @@ class MujocoInterface(RobotHardwareInterface):
 
     def walls(self) -> tuple[BoxObstacle, ...]:
         return self._walls
+
+    def round_obstacles(self) -> tuple[RoundObstacle, ...]:
+        return self._rounds
+
+    def polygon_obstacles(self) -> tuple[PolygonObstacle, ...]:
+        return self._polygons
+
+    def unjudged_geoms(self) -> tuple[str, ...]:
+        return self._unjudged
 
     def close(self) -> None:
         self._closed = True

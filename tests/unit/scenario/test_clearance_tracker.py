@@ -11,7 +11,8 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from otonav.hal import BoxObstacle
+from otonav.hal import BoxObstacle, PolygonObstacle, RoundObstacle
+from otonav.hal.types import convex_hull
 from otonav.scenario.clearance import ClearanceTracker
 
 pytestmark = pytest.mark.unit
@@ -132,6 +133,84 @@ def test_same_floats_in_clutter(
     """Hundreds of 0.1 m boxes, as in the clutter bench: the grid and the heap at work."""
     boxes = tuple(BoxObstacle(x, y, 0.05, 0.05, 0.3 * x) for x, y in seed_boxes)
     _walk(boxes, (0.0, 0.0), steps, ClearanceTracker(boxes))
+
+
+disk = st.builds(RoundObstacle, coord, coord, st.floats(0.01, 1.0))
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    boxes=st.lists(box, max_size=20).map(tuple),
+    rounds=st.lists(disk, min_size=1, max_size=40).map(tuple),
+    start=st.tuples(coord, coord),
+    steps=st.lists(step, max_size=300),
+    cell=st.sampled_from([0.05, 0.5, 4.0]),
+)
+def test_round_obstacles_are_measured_like_every_shape_at_every_sample(
+    boxes: tuple[BoxObstacle, ...],
+    rounds: tuple[RoundObstacle, ...],
+    start: tuple[float, float],
+    steps: list[tuple[float, float]],
+    cell: float,
+) -> None:
+    """Cylinders, capsules and spheres (issue 42): the minimum over boxes and disks is
+    the same float as checking every one of them at every sample."""
+    tracker = ClearanceTracker(boxes, rounds, cell=cell)
+    x, y = start
+    best = math.inf
+    for dx, dy in [(0.0, 0.0), *steps]:
+        x, y = x + dx, y + dy
+        tracker.update(x, y)
+        best = min([best, *(b.distance_to(x, y) for b in boxes)])
+        best = min([best, *(r.distance_to(x, y) for r in rounds)])
+        assert tracker.min_clearance == best
+
+
+def test_a_disk_is_measured_from_its_surface() -> None:
+    tracker = ClearanceTracker((), (RoundObstacle(1.0, 0.0, 0.075),))
+    tracker.update(0.0, 0.0)
+    assert tracker.min_clearance == pytest.approx(0.925, abs=1e-12)
+
+
+def _as_polygon(b: BoxObstacle) -> PolygonObstacle:
+    c, s = math.cos(b.yaw), math.sin(b.yaw)
+    hx, hy = b.half_x, b.half_y
+    corners = [
+        (b.x + c * u - s * v, b.y + s * u + c * v)
+        for u, v in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))
+    ]
+    return PolygonObstacle(convex_hull(corners))
+
+
+@settings(max_examples=200, deadline=None)
+@given(b=box, px=coord, py=coord)
+def test_a_box_as_a_polygon_is_the_same_distance(b: BoxObstacle, px: float, py: float) -> None:
+    """A mesh's hull (issue 42) against the box arithmetic, an independent one."""
+    assert _as_polygon(b).distance_to(px, py) == pytest.approx(b.distance_to(px, py), abs=1e-9)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    polygons=st.lists(box.map(_as_polygon), min_size=1, max_size=15).map(tuple),
+    rounds=st.lists(disk, max_size=10).map(tuple),
+    start=st.tuples(coord, coord),
+    steps=st.lists(step, max_size=300),
+)
+def test_meshes_are_measured_like_every_shape_at_every_sample(
+    polygons: tuple[PolygonObstacle, ...],
+    rounds: tuple[RoundObstacle, ...],
+    start: tuple[float, float],
+    steps: list[tuple[float, float]],
+) -> None:
+    tracker = ClearanceTracker((), rounds, polygons)
+    x, y = start
+    best = math.inf
+    for dx, dy in [(0.0, 0.0), *steps]:
+        x, y = x + dx, y + dy
+        tracker.update(x, y)
+        best = min([best, *(p.distance_to(x, y) for p in polygons)])
+        best = min([best, *(r.distance_to(x, y) for r in rounds)])
+        assert tracker.min_clearance == best
 
 
 def _checks_after_the_first_sample(far_boxes: int) -> int:
