@@ -8,7 +8,7 @@ from typing import Literal
 
 from otonav.actors import topics
 from otonav.hal import BoxObstacle, RobotHardwareInterface
-from otonav.msgs import NavDiagnostics, NavState
+from otonav.msgs import NavDiagnostics, NavState, Odometry
 from otonav.runtime import Actor, Input, QoS, Reliability
 from otonav.scenario.clearance import ClearanceTracker
 
@@ -40,6 +40,9 @@ class Judge(Actor):
 
     # depth 16: /nav/state comes at 20 Hz and the judge drains it at rate_hz (100 Hz).
     nav_state_in = Input(topics.NAV_STATE, NavState, QoS(Reliability.BEST_EFFORT, depth=16))
+    odom_in = Input(topics.ODOM, Odometry, topics.SENSOR_QOS)
+    """Where odometry puts the robot (its frame is the world's: it starts at the start
+    pose), against the truth when the navigator says ``reached``: wheel slip."""
     # The planner's reason (why it gave up, what it avoids): the latest is enough.
     nav_diag_in = Input(
         topics.NAV_DIAGNOSTICS, NavDiagnostics, QoS(Reliability.BEST_EFFORT, depth=1)
@@ -82,6 +85,7 @@ class Judge(Actor):
         stage and reason; issue 24: the verdict says which rung ran and why)."""
         self._stage = ""
         self.slips: list[str] = []
+        self._odom: Odometry | None = None
         """Each time the navigator said ``reached`` while the true pose was farther than
         the tolerance from the goal: its odometry and the truth had parted (wheel slip)."""
         self.hal = hal
@@ -198,13 +202,22 @@ class Judge(Actor):
             self._stage = diag.stage
 
     def _check_slip(self, now: float) -> None:
-        """The navigator says ``reached`` from its odometry: the truth must agree."""
+        """The navigator says ``reached`` from its odometry: where odometry puts the robot
+        must agree with the truth, to within the goal tolerance. (Not the truth's distance
+        to the goal: a navigator told a wider tolerance stops early without any slip.)"""
+        odom = self.odom_in.take_latest()
+        if odom is not None:
+            self._odom = odom
+        if self._odom is None:
+            return
         x, y, _, _ = self.hal.planar_truth()
-        truth = math.hypot(self.goal[0] - x, self.goal[1] - y)
-        if truth > self.tolerance:
+        at = self._odom.pose.pose.position
+        parted = math.hypot(at.x - x, at.y - y)
+        if parted > self.tolerance:
+            truth = math.hypot(self.goal[0] - x, self.goal[1] - y)
             self.slips.append(
-                f"odometry says reached at {now:.1f} s; ground truth is {truth:.2f} m away: "
-                "wheel slip"
+                f"odometry says reached at {now:.1f} s; ground truth is {truth:.2f} m away "
+                f"({parted:.2f} m from where odometry puts the robot): wheel slip"
             )
 
     def sample(self, now: float) -> None:

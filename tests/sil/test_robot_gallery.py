@@ -87,7 +87,16 @@ def test_odometry_parting_from_the_truth_is_flagged_in_the_verdict() -> None:
     verdict = run_scenario(BUILTIN["empty"], stack, record=False, plot=False)
     assert not verdict.passed
     assert "odometry says reached at " in verdict.reason
-    assert verdict.reason.endswith(" m away: wheel slip")
+    assert verdict.reason.endswith(" m from where odometry puts the robot): wheel slip")
+
+
+def test_a_navigator_told_a_wider_tolerance_is_no_wheel_slip() -> None:
+    """The navigator stops where its own tolerance (1 m) says, its odometry exact: the run
+    fails (not within the scenario's 0.15 m) but nothing slipped."""
+    stack = apply_overrides(StackConfig(), ["nav.tolerance=1.0"])
+    verdict = run_scenario(BUILTIN["empty"], stack, record=False, plot=False)
+    assert not verdict.passed
+    assert "wheel slip" not in verdict.reason, verdict.reason
 
 
 def test_the_base_of_a_robot_with_a_deadband_replays_byte_identical(
