@@ -136,10 +136,10 @@ def test_a_failed_generated_world_keeps_its_scenario_for_the_repro_even_with_kee
     tmp_path: Path,
 ) -> None:
     sweep = tmp_path / "gen.yaml"
-    sweep.write_text(  # the same small world, a robot too slow to make it in time
+    sweep.write_text(  # the same small world, a navigator that stops a metre short
         "scenarios:\n  - generate: {count: 1, seed: 7, params: {arena: 5, "
         "obstacle_count: [1, 1], start_goal_distance: [1.0, 1.2]}}\n"
-        "overrides: {nav.max_v: [0.02]}\nkeep: none\n"
+        "overrides: {nav.tolerance: [1.0]}\nkeep: none\n"
     )
     [record] = run_inline(sweep, tmp_path / "out")
     assert record["status"] == "failed", record["reason"]
