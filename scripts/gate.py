@@ -12,6 +12,8 @@ on every run instead of at random (issue 43):
 - the order: pytest-randomly shuffles each layer's tests with a seed the gate prints
   (``GATE_SEED=N`` repeats a gate's orders; ``pytest tests/sil -p randomly
   --randomly-seed=N`` one layer's, ``-p no:randomly`` runs the files' own order);
+- the process: the unit, smoke and SIL layers run on two pytest-xdist workers, so a test
+  that shares state with another one in its process fails too;
 - how the gate was started: each layer runs with SIGINT ignored, as a shell without job
   control starts ``make test &`` or a CI step. A test whose child must see Ctrl-C starts
   it with ``tests/children.py``'s ``terminal_signals``. Ctrl-C on the gate still stops
@@ -35,6 +37,10 @@ BIN = Path(PY).parent
 # the workflow's run: steps).
 SHELL_SCRIPTS = [*sorted(str(p.relative_to(ROOT)) for p in ROOT.glob("scripts/*.sh")), ".ci/run"]
 
+WORKERS = ["-n", str(min(2, os.cpu_count() or 1))]
+"""pytest-xdist: the unit, smoke and SIL layers on (up to) two cores; the sims run in
+virtual time, so they are CPU-bound and halve (SIL 206 -> 101 s on this machine)."""
+
 LAYERS: dict[str, list[list[str]]] = {
     "static": [
         [PY, "-m", "ruff", "check", "."],
@@ -47,9 +53,9 @@ LAYERS: dict[str, list[list[str]]] = {
         [str(BIN / "shellcheck"), *SHELL_SCRIPTS],
         [PY, "-m", "pytest", "tests/static", "-q"],
     ],
-    "unit": [[PY, "-m", "pytest", "tests/unit", "-q"]],
-    "smoke": [[PY, "-m", "pytest", "tests/smoke", "tests/embed", "-q"]],
-    "sil": [[PY, "-m", "pytest", "tests/sil", "-q"]],
+    "unit": [[PY, "-m", "pytest", "tests/unit", "-q", *WORKERS]],
+    "smoke": [[PY, "-m", "pytest", "tests/smoke", "tests/embed", "-q", *WORKERS]],
+    "sil": [[PY, "-m", "pytest", "tests/sil", "-q", *WORKERS]],
 }
 
 
