@@ -46,8 +46,8 @@ from otonav.runtime import (
     virtual_loop_factory,
 )
 from otonav.scenario import run_scenario
+from otonav.scenario.assembly import scenario_world
 from otonav.scenario.builtin import CLUTTERED
-from otonav.scenario.run import scenario_world
 from otonav.stack import StackConfig, build_actors
 from otonav.stack.session import StackSession
 

@@ -73,7 +73,7 @@ def _plot(boxes: tuple[BoxObstacle, ...]) -> float:
 def warm_up() -> None:
     """What a process's first run pays once and a second does not (matplotlib and its
     fonts, the lazy imports): paid here, outside every figure."""
-    from otonav.scenario.run import preload_lazy_imports
+    from otonav.scenario.judged import preload_lazy_imports
 
     preload_lazy_imports()
     _plot(())

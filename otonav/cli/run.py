@@ -253,7 +253,7 @@ def _main(args: argparse.Namespace, guard: StopOnSignals, locks: ExitStack) -> i
     from otonav.scenario import ScenarioConfig, run_scenario
     from otonav.scenario.builtin import BUILTIN
     from otonav.scenario.crash import RunCrashedError
-    from otonav.scenario.run import finite_figures
+    from otonav.scenario.verdict import finite_figures
     from otonav.stack.files import ConfigFileError, describe_validation_error
 
     scale = 1.0 if args.scale is None else args.scale

@@ -18,7 +18,7 @@ from otonav.runtime import (
     Actor,
 )
 from otonav.scenario import ScenarioConfig, Verdict, run_scenario
-from otonav.scenario.run import scenario_world
+from otonav.scenario.assembly import scenario_world
 from otonav.stack import StackConfig
 
 _T = TypeVar("_T")

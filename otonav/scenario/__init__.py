@@ -24,8 +24,9 @@ if TYPE_CHECKING:
         walled_in,
     )
     from otonav.scenario.judge import Judge
-    from otonav.scenario.run import Verdict, run_scenario
+    from otonav.scenario.run import run_scenario
     from otonav.scenario.validate import check_goal
+    from otonav.scenario.verdict import Verdict
 
 __all__ = (
     "BUILTIN",
@@ -56,7 +57,7 @@ _LAZY = {
     "generate_worlds": "otonav.scenario.generator",
     "walled_in": "otonav.scenario.generator",
     "Judge": "otonav.scenario.judge",
-    "Verdict": "otonav.scenario.run",
+    "Verdict": "otonav.scenario.verdict",
     "run_scenario": "otonav.scenario.run",
     "check_goal": "otonav.scenario.validate",
 }

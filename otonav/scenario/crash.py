@@ -2,7 +2,7 @@
 
 :func:`~otonav.scenario.run.run_scenario` raises :class:`RunCrashedError`, an
 :class:`~otonav.runtime.ActorCrashedError` (code catching that keeps working) that also
-carries the run's failed :class:`~otonav.scenario.run.Verdict`: its artifacts were
+carries the run's failed :class:`~otonav.scenario.verdict.Verdict`: its artifacts were
 written on the way out, and a host (the CLI) prints the table and the summary from it.
 The verdict's reason is one line (:func:`crash_reason`); the traceback is on /rosout.
 """
@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 from otonav.runtime import ActorCrashedError
 
 if TYPE_CHECKING:
-    from otonav.scenario.run import Verdict
+    from otonav.scenario.verdict import Verdict
 
 __all__ = ("RunCrashedError", "crash_reason")
 

@@ -17,16 +17,11 @@ from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
 from otonav.runtime import Actor, RealTime, RealTimeClock, System
 from otonav.runtime.timesource import tick_rate
+from otonav.scenario.assembly import opened_scenario
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
-from otonav.scenario.run import (
-    JudgedRun,
-    Verdict,
-    drive,
-    judged_run,
-    opened_scenario,
-    run_task,
-)
+from otonav.scenario.judged import JudgedRun, drive, judged_run, run_task
+from otonav.scenario.verdict import Verdict
 from otonav.stack import StackConfig
 from otonav.stack.session import StackSession
 

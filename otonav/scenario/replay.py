@@ -12,9 +12,10 @@ from otonav.hal import BoxObstacle
 from otonav.hal.mujoco import SceneError
 from otonav.record.reader import read_messages, summarize
 from otonav.record.verify import Damage
+from otonav.scenario.assembly import effective_stack
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.plot import key_poses, plot_trajectory
-from otonav.scenario.run import effective_stack, verdict_title
+from otonav.scenario.verdict import verdict_title
 from otonav.stack import StackConfig, build_world
 from otonav.stack.worldmeta import WORLD_METADATA, boxes_from_metadata, geometry_from_metadata
 

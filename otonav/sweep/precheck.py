@@ -11,7 +11,7 @@ from otonav.hal import BoxObstacle
 from otonav.hal.mujoco import SceneError
 from otonav.runtime import System
 from otonav.scenario import ScenarioConfig
-from otonav.scenario.run import effective_stack
+from otonav.scenario.assembly import effective_stack
 from otonav.scenario.validate import check_cost, check_goal
 from otonav.stack import StackConfig, build_actors, build_world
 from otonav.stack.files import ConfigFileError

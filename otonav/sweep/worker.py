@@ -32,7 +32,7 @@ from typing import Any, Literal
 
 from otonav.runtime.nodelog import LOGGER_NAME
 from otonav.scenario import ScenarioConfig, run_scenario
-from otonav.scenario.run import finite_figures
+from otonav.scenario.verdict import finite_figures
 from otonav.stack import StackConfig
 from otonav.sweep.plan import RunTask
 from otonav.sweep.worlds import draw_world

@@ -40,7 +40,8 @@ def main() -> int:
 
         return entry()
 
-    import otonav.scenario.run as run_module
+    import otonav.scenario.artifacts as artifacts_module
+    import otonav.scenario.assembly as assembly_module
     from otonav.cli import main as cli
     from otonav.scenario.judge import Judge
     from otonav.scenario.plot import plot_trajectory
@@ -64,9 +65,9 @@ def main() -> int:
             os.kill(os.getpid(), sig)
         return plot_trajectory(*args, **kwargs)
 
-    # Patched where run_scenario looks them up.
-    vars(run_module)["Judge"] = SignallingJudge
-    vars(run_module)["plot_trajectory"] = signalling_plot
+    # Patched where a judged run looks them up.
+    vars(assembly_module)["Judge"] = SignallingJudge
+    vars(artifacts_module)["plot_trajectory"] = signalling_plot
     return cli(["run", "--set", "nav.kp_lin=0", "--out", out])
 
 

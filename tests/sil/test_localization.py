@@ -20,9 +20,11 @@ from otonav.nav.scan_match import compose
 from otonav.record.reader import read_messages
 from otonav.runtime import Actor, Input, QoS, Reliability, virtual_loop_factory
 from otonav.scenario import Verdict, run_scenario
+from otonav.scenario.assembly import scenario_session, scenario_world
 from otonav.scenario.builtin import CLUTTERED
 from otonav.scenario.judge import Judge
-from otonav.scenario.run import drive, judge_verdict, scenario_session, scenario_world
+from otonav.scenario.judged import drive
+from otonav.scenario.verdict import judge_verdict
 from otonav.stack import StackConfig
 from otonav.stack.overrides import apply_overrides
 

@@ -16,6 +16,8 @@ ROOT = Path(__file__).resolve().parents[2]
 
 RUNNERS = [
     "otonav/scenario/run.py",
+    "otonav/scenario/assembly.py",
+    "otonav/scenario/judged.py",
     "otonav/scenario/realtime.py",
     "otonav/testing/stack.py",
     "otonav/engine/live.py",

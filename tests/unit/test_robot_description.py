@@ -16,7 +16,7 @@ import pytest
 from otonav.hal import BoxObstacle, WheelSetpoint
 from otonav.hal.description import Mount, RobotDescription, builtin_robot
 from otonav.hal.mujoco import MujocoInterface, SceneError
-from otonav.scenario.run import lidar_over_obstacles
+from otonav.scenario.verdict import lidar_over_obstacles
 
 PATHFINDER = Path(__file__).resolve().parents[2] / "examples" / "my_robot"
 

@@ -16,7 +16,8 @@ from otonav.record.reader import summarize
 from otonav.record.salvage import salvage
 from otonav.record.writer import RecordingWriter
 from otonav.scenario import ScenarioConfig, run_scenario
-from otonav.scenario.run import effective_stack, run_metadata
+from otonav.scenario.artifacts import run_metadata
+from otonav.scenario.assembly import effective_stack
 from otonav.stack import NavConfig, StackConfig
 from otonav.stack.worldmeta import WORLD_METADATA
 

@@ -8,8 +8,8 @@ import pytest
 
 from otonav.hal.fake import FakeHardware
 from otonav.hal.types import Reach
+from otonav.scenario.assembly import for_robot
 from otonav.scenario.builtin import BUILTIN
-from otonav.scenario.run import for_robot
 from otonav.stack import StackConfig
 from otonav.stack.build import navigation_params
 from otonav.stack.robot import deadband
