@@ -335,9 +335,8 @@ async def open_live_stack(
     ``@pytest.mark.sim``; ``otonav.testing.running_stack`` is this with virtual time as its
     default). ``extra_obstacles``: boxes added to the world. With ``record_to`` every
     topic goes to that MCAP file, finished on every exit (or to that writer, e.g. a
-    size-capped
-    :class:`~otonav.record.rotating.RotatingRecordingWriter`). ``goal``: an initial
-    goal for the navigator (or publish one later). Which planner runs, and whether the
+    size-capped :class:`~otonav.record.rotating.RotatingRecordingWriter`). ``goal``: an
+    initial goal for the navigator (or publish one later). Which planner runs, and whether the
     safety layer does, is the stack config's (``nav.planner``, ``safety.enabled``).
 
     On exit (normal, an exception, or the host's cancellation) the stack stops and the
@@ -362,10 +361,13 @@ async def open_live_stack(
     try:
         try:
             actors = [*build_actors(stack, hal, goal=goal), *extra_actors, *extras.actors]
-            # the session owns the world from here (it closes it if it fails)
-            session = StackSession(hal, actors, time=time, record_to=record_to)
         except BaseException:
             hal.close()
+            extras.close()
+            raise
+        try:  # the session owns the world from here (it closes it if it fails)
+            session = StackSession(hal, actors, time=time, record_to=record_to)
+        except BaseException:
             extras.close()
             raise
         session.add_cleanup(extras.close)
