@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
@@ -17,6 +18,10 @@ from otonav.scenario.plot import key_poses, plot_trajectory
 from otonav.scenario.verdict import Verdict, finite_figures, verdict_title
 from otonav.stack import StackConfig
 from otonav.stack.session import StackSession
+
+PlotWhen = bool | Callable[[Verdict], bool]
+"""Whether a judged run draws its trajectory plot: always, never, or when the verdict
+says so (a sweep draws only the runs it keeps, from the run's own ground truth)."""
 
 VERDICT_TOPIC = "/scenario/verdict"
 
@@ -37,7 +42,7 @@ def save_artifacts(
     judge: Judge,
     session: StackSession,
     out_dir: Path | None,
-    plot: bool,
+    plot: PlotWhen,
 ) -> Verdict:
     """Tear ``session`` down with the verdict appended to its recording, and draw the
     trajectory; the verdict names both files."""
@@ -51,7 +56,7 @@ def save_artifacts(
         if writer.failed is not None:  # the disk is full: no plot either
             raise disk_full_stop(writer.failed, verdict.sim_time_s) from writer.failed.cause
         verdict = replace(verdict, recording=str(writer.path))
-    if out_dir is not None and plot:
+    if out_dir is not None and (plot(verdict) if callable(plot) else plot):
         png = out_dir / "trajectory.png"
         try:
             plot_trajectory(

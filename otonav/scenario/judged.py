@@ -24,7 +24,7 @@ from otonav.runtime import (
     until,
 )
 from otonav.runtime._asyncio_compat import preload_anyio_backend
-from otonav.scenario.artifacts import save_artifacts
+from otonav.scenario.artifacts import PlotWhen, save_artifacts
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.crash import RunCrashedError, crash_reason
 from otonav.scenario.judge import Judge
@@ -122,7 +122,7 @@ class JudgedRun:
     judge: Judge
     session: StackSession
     out_dir: Path | None
-    plot: bool
+    plot: PlotWhen
 
 
 def judged_run(

@@ -17,6 +17,7 @@ from otonav.hal.mujoco import MujocoInterface, ViewerHandle
 from otonav.hal.viewer import check_display
 from otonav.runtime import Actor, RealTime, RealTimeClock, System
 from otonav.runtime.timesource import tick_rate
+from otonav.scenario.artifacts import PlotWhen
 from otonav.scenario.assembly import opened_scenario
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
@@ -87,7 +88,7 @@ def run_scenario_realtime(
     *,
     out_dir: Path | None = None,
     record: bool = True,
-    plot: bool = True,
+    plot: PlotWhen = True,
     time: RealTime = RealTime(),
     gui: bool = False,
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,

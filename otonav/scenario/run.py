@@ -16,6 +16,7 @@ from otonav.runtime import (
     Virtual,
     virtual_loop_factory,
 )
+from otonav.scenario.artifacts import PlotWhen
 from otonav.scenario.assembly import opened_scenario
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
@@ -41,7 +42,7 @@ def run_scenario(
     *,
     out_dir: Path | None = None,
     record: bool = True,
-    plot: bool = True,
+    plot: PlotWhen = True,
     wall_ceiling: float | None = 300.0,
     extra_actors: tuple[Actor, ...] = (),
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,

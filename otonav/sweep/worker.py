@@ -130,6 +130,7 @@ def execute(task: RunTask, scratch: Path) -> RunOutcome:
     start = time.perf_counter()
     recording = scratch / RECORDING
     recording.unlink(missing_ok=True)
+    (scratch / PLOT).unlink(missing_ok=True)  # the last run's: this one draws its own
     scenario_json: str | None = None
     labels: dict[str, Any] = {}
     try:
@@ -149,7 +150,9 @@ def execute(task: RunTask, scratch: Path) -> RunOutcome:
             scenario,
             stack,
             out_dir=scratch,
-            plot=False,
+            # A kept run's plot, drawn by the run from its ground truth (as otonav run
+            # draws it); the others draw none (a plot costs about a short run).
+            plot=lambda v: _keeps(task, "passed" if v.passed else "failed"),
             wall_ceiling=task.wall_ceiling_s,
             source=f"scenario {task.scenario!r}",
         )
@@ -196,12 +199,14 @@ def _sha256(path: Path) -> str | None:
 
 
 def _artifacts(recording: Path, png: Path | None) -> dict[str, bytes]:
-    """The recording and, drawn from it, the trajectory plot (only for kept runs: a
-    plot costs about as much as a short run)."""
+    """The recording and the trajectory plot: the run's own (ground truth), or for a run
+    that ended in an error, one drawn from its recording (odometry: all it has)."""
     if not recording.exists():
         return {}
     out = {RECORDING: recording.read_bytes()}
-    if png is not None:
+    if png is not None and png.exists():
+        out[PLOT] = png.read_bytes()
+    elif png is not None:
         from otonav.scenario.replay import plot_recording
 
         with contextlib.suppress(Exception):  # a plot is a convenience; the recording is

@@ -152,6 +152,24 @@ def test_a_failed_generated_world_keeps_its_scenario_for_the_repro_even_with_kee
     assert hashlib.sha256(recording).hexdigest() == record["recording_sha256"]
 
 
+def test_a_kept_failures_plot_is_the_one_otonav_run_draws(tmp_path: Path) -> None:
+    """Issue 39: a sweep's kept plot is drawn by the run from its ground truth, with the
+    title, legend and path label of ``otonav run``'s: the repro's plot, byte for byte
+    (it was redrawn from the recording, labelled "path (odometry)")."""
+    sweep = tmp_path / "gen.yaml"
+    sweep.write_text(
+        "scenarios:\n  - generate: {count: 1, seed: 7, params: {arena: 5, "
+        "obstacle_count: [1, 1], start_goal_distance: [1.0, 1.2]}}\n"
+        "overrides: {nav.tolerance: [1.0]}\nkeep: failures\n"
+    )
+    [record] = run_inline(sweep, tmp_path / "out")
+    assert record["status"] == "failed", record["reason"]
+    kept = (tmp_path / "out" / record["artifacts"] / "trajectory.png").read_bytes()
+    argv = shlex.split(record["repro"])
+    assert main([*argv[1:], "--out", str(tmp_path / "repro")]) == 1
+    assert kept == (tmp_path / "repro" / "trajectory.png").read_bytes()
+
+
 def test_a_warm_worker_frees_each_run_before_the_next(tmp_path: Path) -> None:
     """A run's objects form reference cycles; a warm worker that left them to the cyclic
     collector's own pace had ~10 runs' worlds alive (a 13.6 MB MjData each) and its RSS
