@@ -27,7 +27,15 @@ from otonav.msgs import Header, Message
 from otonav.msgs.flat import FlatLayout
 from otonav.msgs.stand_in import make, new, set_dict, set_extra, set_fields_set, set_private
 from otonav.record.cdr._encode import encode
-from otonav.record.cdr._layout import ENCAPSULATION, Fixed, Var, field_offsets, flatten, run_format
+from otonav.record.cdr._layout import (
+    ENCAPSULATION,
+    Fixed,
+    Var,
+    field_offsets,
+    flatten,
+    run_format,
+    wire_parts,
+)
 from otonav.record.schemas import SEQUENCE, layout_for
 
 __all__ = ("decode", "flat_values")
@@ -149,19 +157,10 @@ def _var(leaf: Var) -> ReadStep:
 
 
 def _compile_steps(message: type[Message]) -> tuple[ReadStep, ...]:
-    steps: list[ReadStep] = []
-    run: list[Fixed] = []
-    for leaf in flatten(message):
-        if isinstance(leaf, Fixed):
-            run.append(leaf)
-            continue
-        if run:
-            steps.append(_fixed_run(run))
-            run = []
-        steps.append(_var(leaf))
-    if run:
-        steps.append(_fixed_run(run))
-    return tuple(steps)
+    return tuple(
+        _fixed_run(part) if isinstance(part, list) else _var(part)
+        for part in wire_parts(flatten(message))
+    )
 
 
 def _compile_builder(message: type[Message]) -> Builder:
@@ -241,11 +240,8 @@ def _compile_decoder(message: type[Message]) -> Decoder:
     lines: list[str] = []
     values: list[str] = []  # flat value index -> its expression
     runs: dict[int, tuple[str, int]] = {}  # flat index -> (run tuple name, index in it)
-    run: list[Fixed] = []
 
-    def flush_run() -> None:
-        if not run:
-            return
+    def read_run(run: list[Fixed]) -> None:
         k = len([n for n in names if n.startswith("_S")])
         structs = tuple(struct.Struct(run_format(run, start)) for start in range(8))
         names[f"_S{k}"] = structs
@@ -258,7 +254,6 @@ def _compile_decoder(message: type[Message]) -> Decoder:
                 runs[len(values)] = (f"t{k}", at)
                 values.append(f"t{k}[{at}]")
                 at += 1
-        run.clear()
 
     leaves = flatten(message)
     stamped = _stamped(message)
@@ -277,11 +272,10 @@ def _compile_decoder(message: type[Message]) -> Decoder:
         ]
     else:
         lines.append("pos = 4")
-    for leaf in leaves:
-        if isinstance(leaf, Fixed):
-            run.append(leaf)
+    for leaf in wire_parts(leaves):
+        if isinstance(leaf, list):
+            read_run(leaf)
             continue
-        flush_run()
         v = f"v{len(values)}"
         if leaf.kind == "string":
             lines += [
@@ -302,7 +296,6 @@ def _compile_decoder(message: type[Message]) -> Decoder:
             names[step] = _var(leaf)
             lines += ["out = []", f"pos = {step}(data, pos, out)", f"{v} = out[0]"]
         values.append(v)
-    flush_run()
 
     made = 0
 

@@ -28,6 +28,7 @@ from otonav.record.cdr._layout import (
     field_offsets,
     flatten,
     run_format,
+    wire_parts,
 )
 from otonav.record.schemas import SEQUENCE
 
@@ -251,20 +252,13 @@ def _compile(message: type[Message], *, top_level: bool) -> Step:
     of messages call their step (an element type has its own generated function).
     Measured against the step-per-run plan it replaces: Odometry 6.0 -> 3.3 us."""
     source = _Source(top_level=top_level)
-    run: list[Fixed] = []
-    for leaf in flatten(message):
-        if isinstance(leaf, Fixed):
-            run.append(leaf)
-            continue
-        if run:
-            source.fixed_run(run)
-            run = []
-        if leaf.kind == "string":
-            source.string(leaf.path)
+    for part in wire_parts(flatten(message)):
+        if isinstance(part, list):
+            source.fixed_run(part)
+        elif part.kind == "string":
+            source.string(part.path)
         else:
-            source.var(leaf)
-    if run:
-        source.fixed_run(run)
+            source.var(part)
     return source.compile(message)
 
 

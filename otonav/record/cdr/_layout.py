@@ -17,6 +17,7 @@ The CDR rules implemented (plain CDR / XCDR1, little endian, as Fast-CDR writes 
 from __future__ import annotations
 
 import struct
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Final
 
@@ -67,6 +68,22 @@ class Var:
 
 
 Leaf = Fixed | Var
+
+
+def wire_parts(leaves: Sequence[Leaf]) -> Iterator[list[Fixed] | Var]:
+    """``leaves`` in wire order, each run of fixed-size fields between two variable-size
+    ones gathered into one list (one struct each, in both directions)."""
+    run: list[Fixed] = []
+    for leaf in leaves:
+        if isinstance(leaf, Fixed):
+            run.append(leaf)
+            continue
+        if run:
+            yield run
+            run = []
+        yield leaf
+    if run:
+        yield run
 
 
 def flatten(message: type[Message], prefix: str = "") -> list[Leaf]:
