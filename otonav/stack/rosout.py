@@ -43,16 +43,7 @@ def attach_rosout(system: System) -> None:
 
     def publish(event: SystemEvent) -> None:
         text = str(event.kind) if not event.detail else f"{event.kind}: {event.detail}"
-        message = Log.fast(
-            stamp=Time.from_seconds(event.sim_time),
-            level=_LEVELS.get(event.kind, Log.INFO),
-            name=event.actor,
-            msg=text,
-            file="",
-            function="",
-            line=0,
-        )
-        with contextlib.suppress(anyio.WouldBlock):
-            publisher.publish_nowait(message)
+        level = _LEVELS.get(event.kind, Log.INFO)
+        log_line(event.sim_time, level, event.actor, text, "", "", 0)
 
     system.add_event_listener(publish)
