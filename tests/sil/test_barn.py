@@ -7,29 +7,19 @@ is finite. The full 300 are a benchmark (benchmarks/barn_bench.py)."""
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
-from pathlib import Path
 from types import ModuleType
 
 import pytest
+from benchmark_module import load_benchmark
 
 from otonav.stack import StackConfig
 
 pytestmark = pytest.mark.sil
 
-BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "barn_bench.py"
-
 
 def _bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("barn_bench_under_test", BENCH)
-    assert spec is not None
-    assert spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
+    return load_benchmark("barn_bench.py")
 
 
 def test_the_converted_worlds_are_barn_s() -> None:

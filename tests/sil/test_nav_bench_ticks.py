@@ -6,26 +6,17 @@ tick of a later run. Each benchmark process now frees a run before the next."""
 from __future__ import annotations
 
 import gc
-import importlib.util
 import sys
-from pathlib import Path
 from types import ModuleType
 
 import pytest
+from benchmark_module import load_benchmark
 
 pytestmark = pytest.mark.sil
 
-BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "nav_bench.py"
-
 
 def _bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("nav_bench_under_test", BENCH)
-    assert spec is not None
-    assert spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
+    return load_benchmark("nav_bench.py")
 
 
 def test_no_run_leaves_its_world_for_a_later_runs_ticks() -> None:
