@@ -12,7 +12,8 @@ from otonav.actors.navigator import GoalNavigator
 from otonav.actors.odom_history import OdomHistory
 from otonav.actors.scan_cache import odom_xy_of, points_of, rays_of
 from otonav.msgs import Header, LaserScan, NavDiagnostics, Time
-from otonav.nav.navigation import Navigation, NavigationParams, NavOutput
+from otonav.nav.navigate import Navigation
+from otonav.nav.navigation import NavigationParams, NavOutput
 from otonav.nav.scan import to_frame
 from otonav.runtime import Output
 
@@ -21,7 +22,7 @@ _AT_REST = frozenset({"idle", "waiting", "reached", "unreachable", "fault"})
 
 class AvoidingNavigator(GoalNavigator):
     """At ``rate_hz``: record each new scan in the map (at the odometry pose of its
-    stamp), then step :class:`~otonav.nav.navigation.Navigation`. Only /odom and /scan
+    stamp), then step :class:`~otonav.nav.navigate.Navigation`. Only /odom and /scan
     are used, never ground truth. With no scan yet, or none for ``scan_timeout`` s of
     sim time, it does not drive (state ``waiting``).
 

@@ -1,0 +1,192 @@
+"""The avoiding navigator's logic, along Nav2's lines: a global planner
+(:mod:`otonav.nav.planner`), a controller (:mod:`otonav.nav.controller`) and a recovery
+ladder (:mod:`otonav.nav.recovery`), each with its own state, tied in one deterministic
+object with no I/O (the actor feeds it and publishes).
+
+Units: m, s of sim time, rad; poses in odom.
+
+Each :meth:`Navigation.step` (at the navigator's rate):
+
+1. no goal: ``idle``; within ``tolerance``: ``reached`` (latched); after giving up:
+   ``unreachable`` (until a new goal);
+2. a running recovery stage commands (``recovering``); when it ends, the robot replans
+   from where it is (a new :class:`~otonav.nav.planner.Plan`);
+3. the planner searches when due. No path, proven (the search exhausted every cell
+   reachable from the goal): first look around (the ``spin`` stage), then, if still
+   none, ``unreachable``: "no path to the goal in the observed map" (proven again
+   after the look-around, on a map that kept only what the scans still show);
+4. progress: when it fails (and a path was found, or a search proved anything), the
+   next rung of the ladder runs;
+5. otherwise the controller commands, toward the path's target.
+
+A new goal is a new plan, a new controller and a new ladder: nothing of the last goal's
+carries over but the map, the observed hull and the counters.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from otonav.nav.controller import Controller
+from otonav.nav.dwa import DwaResult
+from otonav.nav.geometry import wrap_angle
+from otonav.nav.navigation import NavigationParams, NavOutput
+from otonav.nav.planner import GlobalPlanner, Plan
+from otonav.nav.recovery import Points, ProgressChecker, Recovery
+from otonav.nav.scan import ScanRays
+
+__all__ = ("Navigation",)
+
+
+@dataclass(slots=True)
+class Navigation:
+    """The avoiding navigator's state (see the module docstring): the planner, and the
+    goal's plan, controller and recovery ladder.
+
+    ``params`` may be replaced while it runs: each step reads it (the map's size and
+    resolution and the progress checker's settings are taken once, at the start)."""
+
+    params: NavigationParams
+    start: tuple[float, float]
+    planner: GlobalPlanner = field(init=False)
+    plan: Plan | None = None
+    """The goal's plan (None: no goal yet)."""
+    controller: Controller = field(default_factory=Controller)
+    recovery: Recovery = field(init=False)
+
+    def __post_init__(self) -> None:
+        p = self.params
+        self.planner = GlobalPlanner(p, self.start)
+        checker = ProgressChecker(p.progress_distance, p.progress_window, p.goal_progress_window)
+        self.recovery = Recovery(checker)
+
+    def set_goal(self, goal: tuple[float, float]) -> None:
+        """Drive to ``goal`` (the same goal again changes nothing): a new plan, a new
+        controller and a new ladder (its progress checker with the same settings)."""
+        if self.plan is None or goal != self.plan.goal:
+            self.plan = Plan(goal)
+            self.controller = Controller()
+            c = self.recovery.checker
+            self.recovery = Recovery(ProgressChecker(c.distance, c.window, c.goal_window))
+
+    def observe(
+        self,
+        points_odom: NDArray[np.float64] | tuple[NDArray[np.float64], NDArray[np.float64]],
+        rays: ScanRays | Callable[[], ScanRays] | None = None,
+    ) -> int:
+        """A scan, to the planner's map (:meth:`GlobalPlanner.observe`)."""
+        return self.planner.observe(points_odom, rays)
+
+    def step(
+        self,
+        now: float,
+        pose: tuple[float, float, float],
+        v0: float,
+        omega0: float,
+        points: Points,
+    ) -> NavOutput:
+        """One decision. ``points``: the latest scan's returns in the current
+        base_link, or a function that computes them (only boundary following needs
+        them, so the caller's transform is skipped otherwise)."""
+        plan, rec, p = self.plan, self.recovery, self.params
+        if plan is None:
+            return NavOutput(0.0, 0.0, "idle", "no goal", math.inf, 0.0)
+        x, y, yaw = pose
+        gx, gy = plan.goal
+        distance = math.hypot(gx - x, gy - y)
+        heading = wrap_angle(math.atan2(gy - y, gx - x) - yaw)
+        if rec.gave_up is not None:
+            return self._out(0.0, 0.0, "unreachable", rec.gave_up, distance, heading)
+        if self.controller.arrived(distance, p.tolerance):
+            rec.stage = None
+            return self._out(0.0, 0.0, "reached", "within tolerance", distance, heading)
+        if rec.stage is not None:
+            out = self._recover(now, pose, distance, heading, points)
+            if out is not None:
+                return out
+            plan = self.plan = Plan(plan.goal)  # replan from here
+        result = self.planner.update(plan, now, pose, p)
+        if result is not None and not result.found and result.exhausted:
+            if rec.looked_around:
+                rec.gave_up, rec.stage = "no path to the goal in the observed map", None
+                return self._out(0.0, 0.0, "unreachable", rec.gave_up, distance, heading)
+            rec.looked_around = True
+            why = "look-around, no path"
+            return self._begin("spin", now, pose, distance, heading, points, why)
+        to_go = plan.to_go(pose, distance)
+        target = plan.target(pose, v0, p.lookahead)
+        bearing = abs(wrap_angle(math.atan2(target[1] - y, target[0] - x) - yaw))
+        new_path = result is not None and result.found
+        stuck = rec.stuck(now, to_go, bearing, distance, new_path, p)
+        # (while the first search for a path is still running, the robot heads for the
+        # goal and the verdict waits for it: at most max_expansions / expansions_per_tick
+        # steps)
+        if stuck is not None and not (plan.search is not None and plan.path is None):
+            name, why = rec.next_rung(stuck)
+            return self._begin(name, now, pose, distance, heading, points, why)
+        v, omega, state, reason, dwa = self.controller.command(
+            pose, v0, omega0, target, distance, heading, self.planner.map, self.planner.returns, p
+        )
+        return self._out(v, omega, state, reason, distance, heading, dwa)
+
+    def _out(
+        self,
+        v: float,
+        omega: float,
+        state: str,
+        reason: str,
+        distance: float,
+        heading: float,
+        dwa: DwaResult | None = None,
+    ) -> NavOutput:
+        plan, stage = self.plan, self.recovery.stage
+        return NavOutput(
+            v,
+            omega,
+            state,
+            reason,
+            distance,
+            heading,
+            dwa,
+            stage.name if stage is not None else "",
+            plan.length if plan is not None and plan.path is not None else math.nan,
+            self.planner.replans,
+        )
+
+    def _begin(
+        self,
+        name: str,
+        now: float,
+        pose: tuple[float, float, float],
+        distance: float,
+        heading: float,
+        points: Points,
+        why: str,
+    ) -> NavOutput:
+        self.recovery.begin(
+            name, now, pose, distance, heading, points, why, self.planner.map, self.params
+        )
+        out = self._recover(now, pose, distance, heading, points)
+        assert out is not None
+        return out
+
+    def _recover(
+        self,
+        now: float,
+        pose: tuple[float, float, float],
+        distance: float,
+        heading: float,
+        points: Points,
+    ) -> NavOutput | None:
+        stage = self.recovery.stage
+        assert stage is not None
+        command = self.recovery.command(now, pose, distance, points, self.params)
+        if command is None:
+            return None
+        reason = f"{stage.name}: {stage.why}"
+        return self._out(command[0], command[1], "recovering", reason, distance, heading)
