@@ -17,14 +17,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-from numpy.typing import NDArray
-
-from otonav.nav.costmap import ClearanceMap
 from otonav.nav.dwa import ClearanceFn, DwaResult, clear_arc, dwa_step
 from otonav.nav.geometry import wrap_angle
 from otonav.nav.local_clearance import local_clearance, nearby
 from otonav.nav.navigation import NavigationParams
+from otonav.nav.planner import GlobalPlanner
 
 __all__ = ("Command", "Controller")
 
@@ -51,12 +48,11 @@ class Controller:
         target: tuple[float, float],
         distance: float,
         heading: float,
-        clearance_map: ClearanceMap,
-        returns: tuple[NDArray[np.float64], NDArray[np.float64]] | None,
+        planner: GlobalPlanner,
         p: NavigationParams,
     ) -> Command:
         """The command toward ``target`` (``distance``, ``heading``: of the goal)."""
-        dwa = p.dwa
+        dwa, clearance_map = p.dwa, planner.map
         if distance < p.approach_radius:
             # The last centimetres: P-control on distance and heading, in reverse when
             # the goal is behind; the safety layer still checks every command.
@@ -73,9 +69,9 @@ class Controller:
         )
         if result is None:
             clearance: ClearanceFn = clearance_map.clearance
-            if returns is not None:
+            if planner.returns is not None:
                 reach = dwa.max_v * dwa.horizon + dwa.radius + 0.1
-                rx, ry = nearby(*returns, pose[0], pose[1], reach)
+                rx, ry = nearby(*planner.returns, pose[0], pose[1], reach)
                 clearance = local_clearance(clearance, clearance_map.slack, dwa.radius, rx, ry)
             result = dwa_step(pose, v0, omega0, target, distance, clearance, dwa)
         if result.admissible == 0:

@@ -37,7 +37,7 @@ from otonav.nav.dwa import DwaResult
 from otonav.nav.geometry import wrap_angle
 from otonav.nav.navigation import NavigationParams, NavOutput
 from otonav.nav.planner import GlobalPlanner, Plan
-from otonav.nav.recovery import Points, ProgressChecker, Recovery
+from otonav.nav.recovery import Points, Pose, ProgressChecker, Recovery, Stage
 from otonav.nav.scan import ScanRays
 
 __all__ = ("Navigation",)
@@ -82,14 +82,7 @@ class Navigation:
         """A scan, to the planner's map (:meth:`GlobalPlanner.observe`)."""
         return self.planner.observe(points_odom, rays)
 
-    def step(
-        self,
-        now: float,
-        pose: tuple[float, float, float],
-        v0: float,
-        omega0: float,
-        points: Points,
-    ) -> NavOutput:
+    def step(self, now: float, pose: Pose, v0: float, omega0: float, points: Points) -> NavOutput:
         """One decision. ``points``: the latest scan's returns in the current
         base_link, or a function that computes them (only boundary following needs
         them, so the caller's transform is skipped otherwise)."""
@@ -101,92 +94,56 @@ class Navigation:
         distance = math.hypot(gx - x, gy - y)
         heading = wrap_angle(math.atan2(gy - y, gx - x) - yaw)
         if rec.gave_up is not None:
-            return self._out(0.0, 0.0, "unreachable", rec.gave_up, distance, heading)
+            return self._out(distance, heading, 0.0, 0.0, "unreachable", rec.gave_up)
         if self.controller.arrived(distance, p.tolerance):
             rec.stage = None
-            return self._out(0.0, 0.0, "reached", "within tolerance", distance, heading)
+            return self._out(distance, heading, 0.0, 0.0, "reached", "within tolerance")
         if rec.stage is not None:
-            out = self._recover(now, pose, distance, heading, points)
-            if out is not None:
-                return out
+            recovering = rec.command(now, pose, distance, points, p)
+            if recovering is not None:
+                return self._out(distance, heading, *recovering)
             plan = self.plan = Plan(plan.goal)  # replan from here
         result = self.planner.update(plan, now, pose, p)
         if result is not None and not result.found and result.exhausted:
             if rec.looked_around:
                 rec.gave_up, rec.stage = "no path to the goal in the observed map", None
-                return self._out(0.0, 0.0, "unreachable", rec.gave_up, distance, heading)
+                return self._out(distance, heading, 0.0, 0.0, "unreachable", rec.gave_up)
             rec.looked_around = True
-            why = "look-around, no path"
-            return self._begin("spin", now, pose, distance, heading, points, why)
-        to_go = plan.to_go(pose, distance)
-        target = plan.target(pose, v0, p.lookahead)
-        bearing = abs(wrap_angle(math.atan2(target[1] - y, target[0] - x) - yaw))
-        new_path = result is not None and result.found
-        stuck = rec.stuck(now, to_go, bearing, distance, new_path, p)
-        # (while the first search for a path is still running, the robot heads for the
-        # goal and the verdict waits for it: at most max_expansions / expansions_per_tick
-        # steps)
-        if stuck is not None and not (plan.search is not None and plan.path is None):
+            name, why = "spin", "look-around, no path"
+        else:
+            to_go = plan.to_go(pose, distance)
+            target = plan.target(pose, v0, p.lookahead)
+            bearing = abs(wrap_angle(math.atan2(target[1] - y, target[0] - x) - yaw))
+            new_path = result is not None and result.found
+            stuck = rec.stuck(now, to_go, bearing, distance, new_path, p)
+            # (while the first search for a path is still running, the robot heads for
+            # the goal and the verdict waits for it: at most max_expansions /
+            # expansions_per_tick steps)
+            if stuck is None or (plan.search is not None and plan.path is None):
+                command = self.controller.command(
+                    pose, v0, omega0, target, distance, heading, self.planner, p
+                )
+                return self._out(distance, heading, *command)
             name, why = rec.next_rung(stuck)
-            return self._begin(name, now, pose, distance, heading, points, why)
-        v, omega, state, reason, dwa = self.controller.command(
-            pose, v0, omega0, target, distance, heading, self.planner.map, self.planner.returns, p
-        )
-        return self._out(v, omega, state, reason, distance, heading, dwa)
+        side = 1 if heading >= 0 else -1
+        rec.begin(Stage(name, why, now, pose, distance, side), points, heading, self.planner.map, p)
+        recovering = rec.command(now, pose, distance, points, p)
+        assert recovering is not None
+        return self._out(distance, heading, *recovering)
 
     def _out(
         self,
+        distance: float,
+        heading: float,
         v: float,
         omega: float,
         state: str,
         reason: str,
-        distance: float,
-        heading: float,
         dwa: DwaResult | None = None,
     ) -> NavOutput:
         plan, stage = self.plan, self.recovery.stage
+        length = plan.length if plan is not None and plan.path is not None else math.nan
+        name = stage.name if stage is not None else ""
         return NavOutput(
-            v,
-            omega,
-            state,
-            reason,
-            distance,
-            heading,
-            dwa,
-            stage.name if stage is not None else "",
-            plan.length if plan is not None and plan.path is not None else math.nan,
-            self.planner.replans,
+            v, omega, state, reason, distance, heading, dwa, name, length, self.planner.replans
         )
-
-    def _begin(
-        self,
-        name: str,
-        now: float,
-        pose: tuple[float, float, float],
-        distance: float,
-        heading: float,
-        points: Points,
-        why: str,
-    ) -> NavOutput:
-        self.recovery.begin(
-            name, now, pose, distance, heading, points, why, self.planner.map, self.params
-        )
-        out = self._recover(now, pose, distance, heading, points)
-        assert out is not None
-        return out
-
-    def _recover(
-        self,
-        now: float,
-        pose: tuple[float, float, float],
-        distance: float,
-        heading: float,
-        points: Points,
-    ) -> NavOutput | None:
-        stage = self.recovery.stage
-        assert stage is not None
-        command = self.recovery.command(now, pose, distance, points, self.params)
-        if command is None:
-            return None
-        reason = f"{stage.name}: {stage.why}"
-        return self._out(command[0], command[1], "recovering", reason, distance, heading)

@@ -1,17 +1,10 @@
-"""The global planner (Nav2's planner server): the map the scans build, what the robot
-has observed (its hull), the A* search on the map's coarse grid, when to run it, and the
-path it gives. No I/O. Units: m, s of sim time; poses in odom.
-
-The map, the hull and the latest scan outlive a goal (:class:`GlobalPlanner`); the path
-and its search are one goal's (:class:`Plan`): a new goal, or a replan from where a
-recovery left the robot, is a new ``Plan``.
-
-Cells are free when their clearance is at least the centre clearance and, once the goal
-lies inside what the robot has observed, within ``hull_margin`` of that
-(:mod:`otonav.nav.observed_hull`). A plan searches at once, then every
-``replan_period`` s when the path ahead is blocked; before each search, the cells the
-last scan saw through are cleared (ADR 0026). A search spans steps
-(``expansions_per_tick``).
+"""The global planner (Nav2's planner server), no I/O: the map the scans build, what the
+robot has observed (its hull; once the goal lies inside it, A* routes only within
+``hull_margin`` of it, :mod:`otonav.nav.observed_hull`), the A* search on the map's
+coarse grid over cells with at least the centre clearance, and when to run it: at once
+for a new :class:`Plan`, then every ``replan_period`` s if the path ahead is blocked,
+``expansions_per_tick`` cells a step. Before each search the cells the last scan saw
+through are cleared (ADR 0026). Units: m, s of sim time; poses in odom.
 """
 
 from __future__ import annotations
@@ -43,7 +36,8 @@ Pose = tuple[float, float, float]
 
 @dataclass(slots=True)
 class Plan:
-    """One goal's path and the search for it."""
+    """One goal's path and the search for it (a new goal, or a replan from where a
+    recovery left the robot: a new ``Plan``)."""
 
     goal: tuple[float, float]
     path: NDArray[np.float64] | None = None
@@ -88,8 +82,8 @@ class Plan:
 
 
 class GlobalPlanner:
-    """The map, the observed hull and the latest scan (they outlive a goal), and the
-    search that makes a :class:`Plan`'s path.
+    """What outlives a goal (the map, the observed hull, the latest scan, counters), and
+    the search that makes a :class:`Plan`'s path.
 
     Attributes:
         map: the obstacle map with per-cell clearance, around the start.

@@ -30,7 +30,7 @@ from numpy.typing import NDArray
 
 from otonav.nav.costmap import ClearanceMap
 from otonav.nav.geometry import wrap_angle
-from otonav.nav.navigation import NavigationParams
+from otonav.nav.navigation import NavigationParams as Params
 
 __all__ = (
     "LADDER",
@@ -43,6 +43,7 @@ __all__ = (
     "follow_boundary",
 )
 
+Pose = tuple[float, float, float]
 Points = NDArray[np.float64] | Callable[[], NDArray[np.float64]]
 """Scan returns in base_link, ``(N, 2)`` m, or a function that computes them."""
 
@@ -151,28 +152,25 @@ def _resolve(points: Points) -> NDArray[np.float64]:
 
 @dataclass(slots=True)
 class Stage:
-    """A running stage of the ladder: its name, and where, when and why it began."""
+    """A running stage of the ladder: its name, why, and when, where (odom pose) and how
+    far from the goal (m) it began; ``side``: +1 turn or keep the obstacle left."""
 
     name: str
+    why: str
     started: float
-    x: float
-    y: float
-    yaw: float
+    pose: Pose
     goal_distance: float
-    side: int = 1
-    why: str = ""
+    side: int
 
 
 @dataclass(slots=True)
 class Recovery:
-    """One goal's recovery ladder: its progress checker, the next rung, the running
-    stage, and the verdict once a search proved there is no path (a new goal: a new
-    ``Recovery``).
+    """One goal's recovery ladder (a new goal: a new ``Recovery``).
 
     Attributes:
-        checker: the progress check (built once per navigation, reset per goal).
+        checker: the progress check.
         stage: the running stage, or None.
-        gave_up: why the goal is unreachable, or None.
+        gave_up: why the goal is unreachable (a search proved it), or None.
         looked_around: the ``spin`` after a first proof of no path has run.
         rung: the next rung (index into :data:`LADDER`).
         rounds: times the ladder started over without real progress, plus one.
@@ -190,16 +188,10 @@ class Recovery:
     to_go: float | None = None
 
     def stuck(
-        self,
-        now: float,
-        to_go: float,
-        bearing: float,
-        distance: float,
-        new_path: bool,
-        p: NavigationParams,
+        self, now: float, to_go: float, bearing: float, distance: float, new_path: bool, p: Params
     ) -> str | None:
         """Why the robot is not getting anywhere, or None. ``to_go``: along the path,
-        m; ``bearing``: to the path's target off the heading, rad; ``new_path``: the
+        m; ``bearing``: of the path's target off the heading, rad; ``new_path``: the
         plan just changed."""
         # Turning toward the way on counts too (a robot facing away from a new path
         # turns in place first): TURN_CREDIT m per radian of bearing to the target
@@ -232,50 +224,34 @@ class Recovery:
         return name, f"rung {self.rung}/{len(LADDER)}{again}, {stuck}"
 
     def begin(
-        self,
-        name: str,
-        now: float,
-        pose: tuple[float, float, float],
-        distance: float,
-        heading: float,
-        points: Points,
-        why: str,
-        clearance_map: ClearanceMap,
-        p: NavigationParams,
+        self, stage: Stage, points: Points, heading: float, cmap: ClearanceMap, p: Params
     ) -> None:
-        """Start stage ``name`` (``heading``: bearing of the goal, rad)."""
-        if name == "follow":
-            side = boundary_side(_resolve(points), heading)
-        else:
-            side = 1 if heading >= 0 else -1
-        self.stage = Stage(name, now, pose[0], pose[1], pose[2], distance, side, why)
+        """Start ``stage`` (``heading``: the goal's bearing, rad, picks its side)."""
+        if stage.name == "follow":
+            stage.side = boundary_side(_resolve(points), heading)
+        self.stage = stage
         if self.best == math.inf:
-            self.best = distance
-        if name == "spin" and p.clear_radius > 0.0:
+            self.best = stage.goal_distance
+        if stage.name == "spin" and p.clear_radius > 0.0:
             # Nav2's first recovery: forget the map around the robot (a smeared wall,
             # a misread), and look around to see it again.
-            clearance_map.clear_near(pose[0], pose[1], p.clear_radius)
+            cmap.clear_near(stage.pose[0], stage.pose[1], p.clear_radius)
 
     def command(
-        self,
-        now: float,
-        pose: tuple[float, float, float],
-        distance: float,
-        points: Points,
-        p: NavigationParams,
-    ) -> tuple[float, float] | None:
-        """The running stage's (v, omega), or None when it is over (then: replan from
-        here, and progress is judged afresh)."""
+        self, now: float, pose: Pose, distance: float, points: Points, p: Params
+    ) -> tuple[float, float, str, str] | None:
+        """The running stage's (v, omega, "recovering", reason), or None when it is over
+        (then: replan from here, and progress is judged afresh)."""
         st = self.stage
         assert st is not None
         elapsed = now - st.started
         v = omega = 0.0
         if st.name == "spin":
-            turned = abs(wrap_angle(pose[2] - st.yaw))
+            turned = abs(wrap_angle(pose[2] - st.pose[2]))
             done = turned >= p.spin_angle - 0.05 or elapsed > p.spin_angle / p.spin_speed + 0.5
             omega = st.side * p.spin_speed
         elif st.name == "backup":
-            moved = math.hypot(pose[0] - st.x, pose[1] - st.y)
+            moved = math.hypot(pose[0] - st.pose[0], pose[1] - st.pose[1])
             done = moved >= p.backup_distance or elapsed > p.backup_distance / p.backup_speed + 0.5
             v = -p.backup_speed
         else:
@@ -292,4 +268,4 @@ class Recovery:
             self.checker.reset()
             self.to_go = None
             return None
-        return v, omega
+        return v, omega, "recovering", f"{st.name}: {st.why}"

@@ -9,7 +9,7 @@ import pytest
 
 from otonav.nav import Navigation, NavigationParams
 from otonav.nav.planner import GlobalPlanner, Plan
-from otonav.nav.recovery import ProgressChecker, Recovery
+from otonav.nav.recovery import ProgressChecker, Recovery, Stage
 
 pytestmark = pytest.mark.unit
 
@@ -48,7 +48,7 @@ def test_the_ladder_climbs_spin_backup_follow_then_starts_over_and_resets_on_pro
     assert names == ["spin", "backup", "follow", "spin"]
     assert rec.next_rung("stuck")[1] == "rung 2/3 (round 2), stuck"
     clearance_map = GlobalPlanner(p, (0.0, 0.0)).map
-    rec.begin("follow", 0.0, (0.0, 0.0, 0.0), 3.0, 0.0, NONE, "why", clearance_map, p)
+    rec.begin(Stage("follow", "why", 0.0, (0.0, 0.0, 0.0), 3.0, 1), NONE, 0.0, clearance_map, p)
     assert rec.best == 3.0  # where the ladder began
     rec.stage = None
     assert rec.stuck(0.1, 3.0, 0.0, 2.8, False, p) is None  # 0.2 m closer: not enough
@@ -64,8 +64,9 @@ def test_a_stage_ends_and_progress_is_judged_afresh() -> None:
     assert rec.stuck(0.0, 3.0, 0.0, 3.0, False, p) is None
     assert rec.stuck(p.progress_window, 3.0, 0.0, 3.0, False, p) is not None  # no progress
     clearance_map = GlobalPlanner(p, (0.0, 0.0)).map
-    rec.begin("backup", 4.0, (0.0, 0.0, 0.0), 3.0, 0.0, NONE, "stuck", clearance_map, p)
-    assert rec.command(4.1, (-0.01, 0.0, 0.0), 3.0, NONE, p) == (-p.backup_speed, 0.0)
+    rec.begin(Stage("backup", "stuck", 4.0, (0.0, 0.0, 0.0), 3.0, 1), NONE, 0.0, clearance_map, p)
+    command = rec.command(4.1, (-0.01, 0.0, 0.0), 3.0, NONE, p)
+    assert command == (-p.backup_speed, 0.0, "recovering", "backup: stuck")
     assert rec.command(5.0, (-p.backup_distance, 0.0, 0.0), 3.0, NONE, p) is None  # backed up
     assert rec.stage is None
     assert rec.stuck(5.0, 3.0, 0.0, 3.0, False, p) is None  # the window starts again
