@@ -1,26 +1,18 @@
-"""The avoiding navigator's logic, along Nav2's lines: a global planner
-(:mod:`otonav.nav.planner`), a controller (:mod:`otonav.nav.controller`) and a recovery
-ladder (:mod:`otonav.nav.recovery`), each with its own state, tied in one deterministic
-object with no I/O (the actor feeds it and publishes).
+"""The avoiding navigator's logic along Nav2's lines, in one deterministic object with
+no I/O (the actor feeds it and publishes): the global planner (:mod:`otonav.nav.planner`),
+the controller (:mod:`otonav.nav.controller`) and the recovery ladder
+(:mod:`otonav.nav.recovery`), each with its own state. Units: m, s of sim time, rad;
+poses in odom.
 
-Units: m, s of sim time, rad; poses in odom.
-
-Each :meth:`Navigation.step` (at the navigator's rate):
-
-1. no goal: ``idle``; within ``tolerance``: ``reached`` (latched); after giving up:
-   ``unreachable`` (until a new goal);
-2. a running recovery stage commands (``recovering``); when it ends, the robot replans
-   from where it is (a new :class:`~otonav.nav.planner.Plan`);
-3. the planner searches when due. No path, proven (the search exhausted every cell
-   reachable from the goal): first look around (the ``spin`` stage), then, if still
-   none, ``unreachable``: "no path to the goal in the observed map" (proven again
-   after the look-around, on a map that kept only what the scans still show);
-4. progress: when it fails (and a path was found, or a search proved anything), the
-   next rung of the ladder runs;
-5. otherwise the controller commands, toward the path's target.
-
-A new goal is a new plan, a new controller and a new ladder: nothing of the last goal's
-carries over but the map, the observed hull and the counters.
+Each :meth:`Navigation.step`: no goal, ``idle``; after giving up, ``unreachable`` (until
+a new goal); within ``tolerance``, ``reached``; a running recovery stage commands (when
+it ends, the robot replans from where it is: a new :class:`~otonav.nav.planner.Plan`);
+the planner searches when due. No path, proven (the search exhausted every cell
+reachable from the goal): first look around (the ``spin`` stage), then, proven again on
+a map that kept only what the scans still show, ``unreachable``. When progress fails
+(and no first search is still running), the next rung of the ladder; else the
+controller's command. A new goal is a new plan, controller and ladder: only the map,
+the observed hull and the counters carry over.
 """
 
 from __future__ import annotations
@@ -111,8 +103,7 @@ class Navigation:
             rec.looked_around = True
             name, why = "spin", "look-around, no path"
         else:
-            to_go = plan.to_go(pose, distance)
-            target = plan.target(pose, v0, p.lookahead)
+            to_go, target = plan.follow(pose, distance, v0, p.lookahead)
             bearing = abs(wrap_angle(math.atan2(target[1] - y, target[0] - x) - yaw))
             new_path = result is not None and result.found
             stuck = rec.stuck(now, to_go, bearing, distance, new_path, p)

@@ -51,34 +51,27 @@ class Plan:
     checked_at: float = -math.inf
     replan_now: bool = True
 
-    def to_go(self, pose: Pose, distance: float) -> float:
-        """Distance to go, m: along the path from its point nearest the robot, or
-        ``distance`` (straight to the goal) without a path."""
+    def follow(
+        self, pose: Pose, distance: float, v0: float, lookahead: float
+    ) -> tuple[float, tuple[float, float]]:
+        """The distance to go, m (along the path from its point nearest the robot;
+        ``distance`` without a path), and the DWA's target: the first path point at
+        least the lookahead from the robot after that one (the goal when none). The
+        lookahead scales with the speed, like Nav2's Regulated Pure Pursuit:
+        ``LOOKAHEAD_TIME`` s of the current speed, within [``MIN_LOOKAHEAD``,
+        ``lookahead``] m. A slow robot aims at the path near it: in a door at the
+        passable limit it lines up on the path instead of heading for a point beyond
+        the door past its corner (issue 24)."""
         path, remaining = self.path, self.remaining
         if path is None or remaining is None:
-            return distance
-        d = np.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1])
-        i = int(d.argmin())
-        return float(d[i] + remaining[i])
-
-    def target(self, pose: Pose, v0: float, lookahead: float) -> tuple[float, float]:
-        """The first path point at least the lookahead from the robot, after the one
-        nearest it (one distance pass serves both searches). The lookahead scales with
-        the speed, like Nav2's Regulated Pure Pursuit: ``LOOKAHEAD_TIME`` s of the
-        current speed, within [``MIN_LOOKAHEAD``, ``lookahead``] m. A slow robot aims
-        at the path near it: in a door at the passable limit it lines up on the path
-        instead of heading for a point beyond the door past its corner (issue 24)."""
-        path = self.path
-        if path is None:
-            return self.goal
+            return distance, self.goal
         d = np.hypot(path[:, 0] - pose[0], path[:, 1] - pose[1])
         i = int(d.argmin())  # (the array methods: no np.argmin/np.flatnonzero wrappers)
         lookahead = min(max(abs(v0) * LOOKAHEAD_TIME, MIN_LOOKAHEAD), lookahead)
         beyond = d[i:] >= lookahead
         j = i + int(beyond.argmax())  # the first True, or i when there is none
-        if not beyond[j - i]:
-            return self.goal
-        return float(path[j, 0]), float(path[j, 1])
+        target = (float(path[j, 0]), float(path[j, 1])) if beyond[j - i] else self.goal
+        return float(d[i] + remaining[i]), target
 
 
 class GlobalPlanner:

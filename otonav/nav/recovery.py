@@ -1,22 +1,14 @@
-"""Progress checking and the recovery ladder (Nav2's behaviours and the tree that
-runs them in a round-robin): plain decisions on plain numbers, no I/O.
+"""Progress checking and the recovery ladder (Nav2's behaviours and the round-robin that
+runs them), no I/O. Units: m, s (sim time), rad; poses in odom.
 
-Units: m, s (sim time), rad; poses in odom.
-
-* :class:`Recovery`: one goal's ladder. When progress fails, the next stage runs:
-  ``spin`` (turn ``spin_angle`` toward the goal side, the map cleared within
-  ``clear_radius`` first), ``backup`` (reverse ``backup_distance``), ``follow`` (follow
-  the obstacle's boundary on the side that heads closer to the goal, Bug2-style, until
-  ``progress_distance`` m closer to the goal than where it started or ``follow_time``
-  s), then the ladder again (``round 2``, ...): only a search that proved there is no
-  path says ``unreachable`` (issue 42: the ladder alone called 12 of 60 reachable BARN
-  worlds unreachable). Real progress resets it.
-* :class:`ProgressChecker`: "the distance to go along the path shrank by at least
-  ``distance`` m within ``window`` s" (a robot creeping, dithering or oscillating
-  fails it), plus "got ``distance`` m closer to the goal within ``goal_window`` s".
-* :func:`follow_boundary`: Bug2-style wall following from the scan: keep the nearest
-  return at ``distance`` m on the chosen side, drive along its tangent.
-* :func:`boundary_side`: the side whose tangent heads closer to the goal.
+When progress fails (:class:`ProgressChecker`), the next stage of one goal's ladder
+(:class:`Recovery`) runs: ``spin`` (turn ``spin_angle`` toward the goal side, the map
+cleared within ``clear_radius`` first), ``backup`` (reverse ``backup_distance``),
+``follow`` (:func:`follow_boundary` on the side that heads closer to the goal,
+:func:`boundary_side`, Bug2-style, until ``progress_distance`` m closer to the goal than
+where it started or ``follow_time`` s), then the ladder again (``round 2``, ...): only a
+search that proved there is no path says ``unreachable`` (issue 42: the ladder alone
+called 12 of 60 reachable BARN worlds unreachable). Real progress resets it.
 """
 
 from __future__ import annotations

@@ -275,6 +275,6 @@ def test_the_lookahead_scales_with_the_speed_like_regulated_pure_pursuit() -> No
     _settle(nav, (0.0, 0.0, 0.0))
     assert _plan(nav).path is not None
     for v0, want in ((0.0, 0.4), (-0.05, 0.4), (0.25, 0.5), (0.4, 0.8), (0.5, 0.8)):
-        tx, ty = _plan(nav).target((0.0, 0.0, 0.0), v0, params.lookahead)
+        tx, ty = _plan(nav).follow((0.0, 0.0, 0.0), 4.0, v0, params.lookahead)[1]
         assert ty == pytest.approx(0.0, abs=0.06)
         assert want <= tx <= want + 0.15, (v0, tx)
