@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from otonav.nav import Navigation, NavigationParams
+from otonav.nav.controller import Controller
 from otonav.nav.planner import GlobalPlanner, Plan
 from otonav.nav.recovery import ProgressChecker, Recovery, Stage
 
@@ -39,6 +40,34 @@ def test_the_planner_searches_at_once_then_only_for_a_blocked_path_each_period()
         planner.update(plan, 13 * DT, pose, p)
     assert plan.path is not None
     assert np.abs(plan.path[:, 1]).max() > 1.0  # round the wall
+
+
+@pytest.mark.parametrize(
+    ("returns", "v0", "state"),
+    [
+        ("open", 0.2, "driving"),  # the fast path's clear arc
+        ("wall", 0.0, "avoiding"),  # a wall 0.5 m ahead: the sampled arcs pass near it
+        ("ring", 0.4, "blocked"),  # returns 0.45 m all round at 0.4 m/s: no arc can stop
+    ],
+)
+def test_the_controller_names_its_command_by_the_arcs_it_had(
+    returns: str, v0: float, state: str
+) -> None:
+    p = NavigationParams()
+    planner = GlobalPlanner(p, (0.0, 0.0))
+    a = np.linspace(0.0, 2.0 * np.pi, 200)
+    planner.observe(
+        {
+            "open": np.array([[3.0, 3.0]]),
+            "wall": np.stack((np.full(81, 0.5), np.linspace(-0.8, 0.8, 81)), axis=1),
+            "ring": np.stack((0.45 * np.cos(a), 0.45 * np.sin(a)), axis=1),
+        }[returns]
+    )
+    pose, target = (0.0, 0.0, 0.0), (3.5, 0.0)
+    *_, got, _, dwa = Controller().command(pose, v0, 0.0, target, 3.5, 0.0, planner, p)
+    assert got == state
+    assert dwa is not None
+    assert (dwa.admissible == 0) == (state == "blocked")
 
 
 def test_the_ladder_climbs_spin_backup_follow_then_starts_over_and_resets_on_progress() -> None:
