@@ -57,7 +57,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from otonav.nav.navigation import Navigation
+from otonav.nav.navigate import Navigation
 from otonav.scenario import run_scenario
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.generator import (

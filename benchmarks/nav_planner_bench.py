@@ -24,7 +24,7 @@ from collections.abc import Callable
 from typing import Any
 
 from otonav.bench.harness import Case, run_in_children
-from otonav.nav import navigation
+from otonav.nav import navigate, navigation
 from otonav.scenario import GoalSpec, ScenarioConfig, StartSpec, run_scenario
 from otonav.scenario.config import BoxSpec
 
@@ -51,10 +51,10 @@ def step_times() -> None:
     ticks: list[float] = []
     checks: list[float] = []
     pending = [0.0]
-    original_step = navigation.Navigation.step
-    original_observe = navigation.Navigation.observe
+    original_step = navigate.Navigation.step
+    original_observe = navigate.Navigation.observe
 
-    def step(self: navigation.Navigation, *args: Any) -> navigation.NavOutput:
+    def step(self: navigate.Navigation, *args: Any) -> navigation.NavOutput:
         t0 = time.perf_counter()
         out = original_step(self, *args)
         dt = time.perf_counter() - t0
@@ -63,7 +63,7 @@ def step_times() -> None:
         pending[0] = 0.0
         return out
 
-    def observe(self: navigation.Navigation, *args: Any) -> int:
+    def observe(self: navigate.Navigation, *args: Any) -> int:
         t0 = time.perf_counter()
         new = original_observe(self, *args)
         dt = time.perf_counter() - t0
@@ -74,8 +74,8 @@ def step_times() -> None:
     import otonav.actors.safety_layer as layer
 
     original_check = getattr(layer, "safe_command")  # noqa: B009 (patched for timing)
-    setattr(navigation.Navigation, "step", step)  # noqa: B010
-    setattr(navigation.Navigation, "observe", observe)  # noqa: B010
+    setattr(navigate.Navigation, "step", step)  # noqa: B010
+    setattr(navigate.Navigation, "observe", observe)  # noqa: B010
     setattr(layer, "safe_command", _timed(checks, original_check))  # noqa: B010
     scenarios = [
         ScenarioConfig(),
@@ -113,8 +113,8 @@ def step_times() -> None:
                     f"p95 {1e3 * _pct(values, 0.95):6.3f} ms   max {1e3 * max(values):6.2f} ms"
                 )
     finally:
-        setattr(navigation.Navigation, "step", original_step)  # noqa: B010
-        setattr(navigation.Navigation, "observe", original_observe)  # noqa: B010
+        setattr(navigate.Navigation, "step", original_step)  # noqa: B010
+        setattr(navigate.Navigation, "observe", original_observe)  # noqa: B010
         setattr(layer, "safe_command", original_check)  # noqa: B010
 
 

@@ -105,7 +105,7 @@ def _instrument() -> None:
     import otonav.actors.bridge as bridge
     import otonav.control.kinematics as kinematics
     import otonav.control.odometry as odometry
-    import otonav.nav.navigation as navigation
+    import otonav.nav.navigate as navigate
     import otonav.nav.safety as safety
     import otonav.nav.scan as scan
     from otonav.actors.avoiding_navigator import AvoidingNavigator
@@ -124,7 +124,7 @@ def _instrument() -> None:
     ):
         setattr(MujocoInterface, method, _shared(stage, getattr(MujocoInterface, method)))
     for method in ("step", "observe"):
-        cls = navigation.Navigation
+        cls = navigate.Navigation
         setattr(cls, method, _shared("nav/safety/control math", getattr(cls, method)))
     functions = {
         id(f): f

@@ -11,8 +11,9 @@ from otonav.actors import topics
 from otonav.actors.navigator import GoalNavigator
 from otonav.actors.odom_history import OdomHistory
 from otonav.actors.scan_cache import odom_xy_of, points_of, rays_of
-from otonav.msgs import Header, LaserScan, NavDiagnostics, Time
-from otonav.nav.navigation import Navigation, NavigationParams, NavOutput
+from otonav.msgs import LaserScan, NavDiagnostics, Time
+from otonav.nav.navigate import Navigation
+from otonav.nav.navigation import NavigationParams, NavOutput
 from otonav.nav.scan import to_frame
 from otonav.runtime import Output
 
@@ -21,7 +22,7 @@ _AT_REST = frozenset({"idle", "waiting", "reached", "unreachable", "fault"})
 
 class AvoidingNavigator(GoalNavigator):
     """At ``rate_hz``: record each new scan in the map (at the odometry pose of its
-    stamp), then step :class:`~otonav.nav.navigation.Navigation`. Only /odom and /scan
+    stamp), then step :class:`~otonav.nav.navigate.Navigation`. Only /odom and /scan
     are used, never ground truth. With no scan yet, or none for ``scan_timeout`` s of
     sim time, it does not drive (state ``waiting``).
 
@@ -31,9 +32,6 @@ class AvoidingNavigator(GoalNavigator):
     commands zero and its state is ``fault``."""
 
     diagnostics = Output(topics.NAV_DIAGNOSTICS, NavDiagnostics, topics.COMMAND_QOS)
-    frame_id = "odom"
-    """The frame the navigator works in (poses, goal, map): odom here; ``map`` for
-    :class:`~otonav.actors.localized_navigator.LocalizedNavigator`."""
 
     def __init__(
         self,
@@ -55,7 +53,6 @@ class AvoidingNavigator(GoalNavigator):
         self._history = OdomHistory()
         self._scan: LaserScan | None = None
         self._points_pose: tuple[float, float, float] | None = None
-        self._scan_time = -math.inf
         self._last_diag: tuple[str, str] | None = None
 
     live_parameters = frozenset(
@@ -85,22 +82,22 @@ class AvoidingNavigator(GoalNavigator):
         """An odometry pose in :attr:`frame_id` (here: itself)."""
         return pose
 
-    def _take_scan(self, scan: LaserScan) -> None:
+    def _take_scan(self, scan: LaserScan) -> bool:
         pose = self._history.pose_at(scan.header.stamp.to_seconds())
         if pose is None:
-            return
+            return False
         pose = self._in_frame(pose)
         moved = self._points_pose is None or (
             abs(pose[0] - self._points_pose[0]) + abs(pose[1] - self._points_pose[1]) > 1e-3
             or abs(pose[2] - self._points_pose[2]) > 1e-3
         )
         self._scan, self._points_pose = scan, pose
-        self._scan_time = self.clock.now()
         # A static world seen from the same pose marks the same cells: skip the update
         # (and the points: at rest a scan costs nothing here).
         if moved:
             offset = self.laser_offset_x
             self.nav.observe(odom_xy_of(scan, offset, pose), lambda: rays_of(scan, offset, pose))
+        return True
 
     async def _step(self) -> None:
         now = self.clock.now()
@@ -113,7 +110,7 @@ class AvoidingNavigator(GoalNavigator):
         if self._hardware_fault:
             await self._publish(NavOutput(0.0, 0.0, "fault", "hardware fault", math.inf, 0.0))
             return
-        if self._points_pose is None or now - self._scan_time > self.scan_timeout:
+        if self._blind(now):
             out = self.nav.step(now, pose, v0, omega0, np.empty((0, 2)))
             if out.state not in ("idle", "reached", "unreachable"):
                 out = NavOutput(0.0, 0.0, "waiting", "no fresh scan", out.distance, 0.0)
@@ -121,6 +118,7 @@ class AvoidingNavigator(GoalNavigator):
             return
         scan, scan_pose, offset = self._scan, self._points_pose, self.laser_offset_x
         assert scan is not None
+        assert scan_pose is not None
         await self._publish(
             self.nav.step(
                 now,
@@ -132,12 +130,16 @@ class AvoidingNavigator(GoalNavigator):
         )
 
     async def _publish(self, out: NavOutput) -> None:
-        stamp = Time.from_seconds(self.clock.now())
-        header = Header.fast(stamp=stamp, frame_id=self.frame_id)
         dwa = out.dwa
         closest = dwa.clearance if dwa is not None else math.inf
-        await self._publish_command(
-            header, out.v, out.omega, out.state, out.distance, out.heading_error, closest
+        header = await self._publish_command(
+            Time.from_seconds(self.clock.now()),
+            out.v,
+            out.omega,
+            out.state,
+            out.distance,
+            out.heading_error,
+            closest,
         )
         # Diagnostics every step while it moves (driving, avoiding, recovering, blocked);
         # at rest (idle, waiting, reached, unreachable) when the state or reason change.

@@ -39,6 +39,9 @@ class GoalNavigator(Actor):
     :meth:`_step`, which publishes /cmd_vel and /nav/state (:meth:`_publish_command`).
     Subclasses say what each input means to them (the ``_take_*`` hooks)."""
 
+    frame_id = "odom"
+    """The frame the navigator works in (poses, goal; the header of /nav/state)."""
+
     odom = Input(topics.ODOM, Odometry, topics.SENSOR_QOS)
     scan = Input(topics.SCAN, LaserScan, topics.SENSOR_QOS)
     goal_in = Input(topics.GOAL, PoseStamped, topics.LATCHED)
@@ -55,6 +58,7 @@ class GoalNavigator(Actor):
         self.rate_hz = rate_hz
         self.scan_timeout = scan_timeout
         self._hardware_fault = False
+        self._scan_time = -math.inf
         self.refused_goals = 0
         """Goals on /goal it would not drive to (:func:`~otonav.nav.goal_problem`); the
         door refuses them first (``otonav.stack.door``): this is defence in depth."""
@@ -71,8 +75,8 @@ class GoalNavigator(Actor):
             if status is not None:
                 self._hardware_fault = status.faulted
             scan = self.scan.take_latest()
-            if scan is not None:
-                self._take_scan(scan)
+            if scan is not None and self._take_scan(scan):
+                self._scan_time = self.clock.now()
             await self._step()
 
     def _check_goal(self, x: float, y: float) -> None:
@@ -91,22 +95,29 @@ class GoalNavigator(Actor):
     def _take_goal(self, goal: tuple[float, float]) -> None:
         raise NotImplementedError
 
-    def _take_scan(self, scan: LaserScan) -> None:
+    def _take_scan(self, scan: LaserScan) -> bool:
+        """Take ``scan``; False when it could not be used (it does not count as fresh)."""
         raise NotImplementedError
+
+    def _blind(self, now: float) -> bool:
+        """No scan taken yet, or none for ``scan_timeout`` s: the way ahead is unknown."""
+        return now - self._scan_time > self.scan_timeout
 
     async def _step(self) -> None:
         raise NotImplementedError
 
     async def _publish_command(
         self,
-        header: Header,
+        stamp: Time,
         v: float,
         omega: float,
         state: str,
         distance: float,
         heading_error: float,
         closest: float,
-    ) -> None:
+    ) -> Header:
+        """/cmd_vel and /nav/state; the header it stamped them with."""
+        header = Header.fast(stamp=stamp, frame_id=self.frame_id)
         await self.cmd_vel.publish(
             STOP
             if v == 0.0 and omega == 0.0
@@ -124,6 +135,7 @@ class GoalNavigator(Actor):
                 closest_ahead=closest,
             )
         )
+        return header
 
 
 class Navigator(GoalNavigator):
@@ -154,7 +166,6 @@ class Navigator(GoalNavigator):
         self.goal = goal
         self._odom: Odometry | None = None
         self._scan: LaserScan | None = None
-        self._scan_time = -math.inf
         self._ranges: NDArray[np.float32] = np.empty(0, np.float32)
 
     def _take_odometry(self) -> None:
@@ -163,27 +174,26 @@ class Navigator(GoalNavigator):
     def _take_goal(self, goal: tuple[float, float]) -> None:
         self.goal = goal
 
-    def _take_scan(self, scan: LaserScan) -> None:
+    def _take_scan(self, scan: LaserScan) -> bool:
         self._scan = scan
-        self._scan_time = self.clock.now()
         self._ranges = np.asarray(scan.ranges, dtype=np.float32)
+        return True
 
     async def _step(self) -> None:
         odom = self._odom
         stamp = Time.from_seconds(self.clock.now())
         if self._hardware_fault:
-            await self._publish(stamp, 0.0, 0.0, "fault", math.inf, 0.0, math.inf)
+            await self._publish_command(stamp, 0.0, 0.0, "fault", math.inf, 0.0, math.inf)
             return
         if odom is None or self.goal is None:
-            await self._publish(stamp, 0.0, 0.0, "idle", math.inf, 0.0, math.inf)
+            await self._publish_command(stamp, 0.0, 0.0, "idle", math.inf, 0.0, math.inf)
             return
         p = odom.pose.pose
         pose = Pose2D(p.position.x, p.position.y, p.orientation.yaw())
         command = go_to_goal(pose, self.goal[0], self.goal[1], self.params)
         closest = math.inf
         blocked = False
-        # Fail safe: with no scan yet, or none for scan_timeout s, the way ahead is unknown.
-        blind = self._scan is None or self.clock.now() - self._scan_time > self.scan_timeout
+        blind = self._blind(self.clock.now())  # fail safe
         if self._scan is not None:
             blocked, closest = guard_blocked(
                 self._ranges,
@@ -201,19 +211,6 @@ class Navigator(GoalNavigator):
             state, v, omega = "waiting", 0.0, 0.0
         else:
             state, v, omega = "driving", command.v, command.omega
-        await self._publish(
+        await self._publish_command(
             stamp, v, omega, state, command.distance, command.heading_error, closest
         )
-
-    async def _publish(
-        self,
-        stamp: Time,
-        v: float,
-        omega: float,
-        state: str,
-        distance: float,
-        heading_error: float,
-        closest: float,
-    ) -> None:
-        header = Header.fast(stamp=stamp, frame_id="odom")
-        await self._publish_command(header, v, omega, state, distance, heading_error, closest)

@@ -27,7 +27,7 @@ from otonav.control import (
 )
 from otonav.hal import RobotHardwareInterface, WheelSetpoint
 from otonav.nav import GoToGoalParams, GuardParams, go_to_goal, guard_blocked
-from otonav.nav.navigation import Navigation
+from otonav.nav.navigate import Navigation
 from otonav.nav.safety import safe_command, stopping_reach
 from otonav.nav.scan import scan_points, to_frame
 from otonav.stack import BaseConfig, StackConfig

@@ -7,7 +7,8 @@ from otonav.nav.footprint import centre_clearance
 from otonav.nav.geometry import goal_problem, wrap_angle
 from otonav.nav.go_to_goal import GoalCommand, GoToGoalParams, go_to_goal
 from otonav.nav.guard import GuardParams, guard_blocked
-from otonav.nav.navigation import Navigation, NavigationParams, NavOutput
+from otonav.nav.navigate import Navigation
+from otonav.nav.navigation import NavigationParams, NavOutput
 from otonav.nav.safety import SafetyParams, SafetyResult, safe_command
 
 __all__ = (

@@ -126,13 +126,6 @@ class ClearanceMap:
         inside = (col >= 0) & (col < self.size) & (row >= 0) & (row < self.size)
         return row, col, inside
 
-    def centre_of(self, row: int, col: int) -> tuple[float, float]:
-        """The odom (x, y) of a cell's centre, m."""
-        return (
-            self.origin_x + (col + 0.5) * self.resolution,
-            self.origin_y + (row + 0.5) * self.resolution,
-        )
-
     def mark(self, xy: NDArray[np.float64]) -> int:
         """Record returns (``(N, 2)`` odom points); returns how many cells were new.
 

@@ -1,28 +1,53 @@
-"""Progress checking and the recovery behaviours: plain decisions on plain numbers.
+"""Progress checking and the recovery ladder (Nav2's behaviours and the round-robin that
+runs them), no I/O. Units: m, s (sim time), rad; poses in odom.
 
-Units: m, s (sim time), rad; poses in odom. The ladder itself (which behaviour comes
-next, when to give up) lives in :mod:`otonav.nav.navigation`; this module holds the
-pieces it is built from.
-
-* :class:`ProgressChecker`: "the distance to go along the path shrank by at least
-  ``distance`` m within ``window`` s" (a robot creeping, dithering or oscillating
-  fails it), plus "got ``distance`` m closer to the goal within ``goal_window`` s".
-* :func:`follow_boundary`: Bug2-style wall following from the scan: keep the nearest
-  return at ``distance`` m on the chosen side, drive along its tangent.
-* :func:`boundary_side`: the side whose tangent heads closer to the goal.
+When progress fails (:class:`ProgressChecker`), the next stage of one goal's ladder
+(:class:`Recovery`) runs: ``spin`` (turn ``spin_angle`` toward the goal side, the map
+cleared within ``clear_radius`` first), ``backup`` (reverse ``backup_distance``),
+``follow`` (:func:`follow_boundary` on the side that heads closer to the goal,
+:func:`boundary_side`, Bug2-style, until ``progress_distance`` m closer to the goal than
+where it started or ``follow_time`` s), then the ladder again (``round 2``, ...): only a
+search that proved there is no path says ``unreachable`` (issue 42: the ladder alone
+called 12 of 60 reachable BARN worlds unreachable). Real progress resets it.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
+from otonav.nav.costmap import ClearanceMap
 from otonav.nav.geometry import wrap_angle
+from otonav.nav.navigation import NavigationParams as Params
 
-__all__ = ("ProgressChecker", "boundary_side", "follow_boundary")
+__all__ = (
+    "LADDER",
+    "TURN_CREDIT",
+    "Points",
+    "ProgressChecker",
+    "Recovery",
+    "Stage",
+    "boundary_side",
+    "follow_boundary",
+)
+
+Pose = tuple[float, float, float]
+Points = NDArray[np.float64] | Callable[[], NDArray[np.float64]]
+"""Scan returns in base_link, ``(N, 2)`` m, or a function that computes them."""
+
+TURN_CREDIT = 0.4
+"""m of progress per radian turned toward the target while it is more than the DWA's
+``rotate_threshold`` off the heading (a half turn: (pi - 0.6) x 0.4 = 1.0 m). Nearer
+than that the robot is meant to drive: turning does not count (issue 24: at a U
+trap's outer corner the DWA turned ever slower toward a target through the wall, at
+v = 0, and the credit for that turn kept the progress check quiet for 6 s)."""
+
+LADDER = ("spin", "backup", "follow")
+"""The recovery stages, in order."""
 
 
 @dataclass(slots=True)
@@ -111,3 +136,128 @@ def follow_boundary(
     error = wrap_angle(beta - side * math.pi / 2 + side * gain * (float(d[i]) - distance))
     omega = min(max(gain * error, -max_omega), max_omega)
     return speed * max(math.cos(error), 0.0), omega
+
+
+def _resolve(points: Points) -> NDArray[np.float64]:
+    return points() if callable(points) else points
+
+
+@dataclass(slots=True)
+class Stage:
+    """A running stage of the ladder: its name, why, and when, where (odom pose) and how
+    far from the goal (m) it began; ``side``: +1 turn or keep the obstacle left."""
+
+    name: str
+    why: str
+    started: float
+    pose: Pose
+    goal_distance: float
+    side: int
+
+
+@dataclass(slots=True)
+class Recovery:
+    """One goal's recovery ladder (a new goal: a new ``Recovery``).
+
+    Attributes:
+        checker: the progress check.
+        stage: the running stage, or None.
+        gave_up: why the goal is unreachable (a search proved it), or None.
+        looked_around: the ``spin`` after a first proof of no path has run.
+        rung: the next rung (index into :data:`LADDER`).
+        rounds: times the ladder started over without real progress, plus one.
+        best: distance to the goal when the ladder last started over, m.
+        to_go: distance to go along the path then (None: take the next one), m.
+    """
+
+    checker: ProgressChecker
+    stage: Stage | None = None
+    gave_up: str | None = None
+    looked_around: bool = False
+    rung: int = 0
+    rounds: int = 1
+    best: float = math.inf
+    to_go: float | None = None
+
+    def stuck(
+        self, now: float, to_go: float, bearing: float, distance: float, new_path: bool, p: Params
+    ) -> str | None:
+        """Why the robot is not getting anywhere, or None. ``to_go``: along the path,
+        m; ``bearing``: of the path's target off the heading, rad; ``new_path``: the
+        plan just changed."""
+        # Turning toward the way on counts too (a robot facing away from a new path
+        # turns in place first): TURN_CREDIT m per radian of bearing to the target
+        # beyond the DWA's rotate threshold (nearer, it should drive).
+        measure = to_go + TURN_CREDIT * max(bearing - p.dwa.rotate_threshold, 0.0)
+        if new_path:  # new knowledge is not progress, and not a lack of it
+            self.checker.rebase(measure)
+            if self.to_go is not None and to_go > self.to_go:
+                self.to_go = to_go
+        stuck = self.checker.update(now, measure, distance)
+        if self.to_go is None:
+            self.to_go = to_go
+        # The ladder starts over after real progress: a progress distance closer to
+        # the goal than where it began, or three along the path since the last rung.
+        if distance <= self.best - p.progress_distance or (
+            to_go <= self.to_go - 3.0 * p.progress_distance
+        ):
+            self.rung, self.best, self.to_go = 0, distance, to_go
+        return stuck
+
+    def next_rung(self, stuck: str) -> tuple[str, str]:
+        """The next stage and why it runs. A path exists (no search proved otherwise):
+        after the last rung the ladder starts over, from a fresh plan, until the budget
+        ends (issue 42: false ``unreachable``)."""
+        if self.rung >= len(LADDER):
+            self.rung, self.rounds = 0, self.rounds + 1
+        name = LADDER[self.rung]
+        self.rung += 1
+        again = f" (round {self.rounds})" if self.rounds > 1 else ""
+        return name, f"rung {self.rung}/{len(LADDER)}{again}, {stuck}"
+
+    def begin(
+        self, stage: Stage, points: Points, heading: float, cmap: ClearanceMap, p: Params
+    ) -> None:
+        """Start ``stage`` (``heading``: the goal's bearing, rad, picks its side)."""
+        if stage.name == "follow":
+            stage.side = boundary_side(_resolve(points), heading)
+        self.stage = stage
+        if self.best == math.inf:
+            self.best = stage.goal_distance
+        if stage.name == "spin" and p.clear_radius > 0.0:
+            # Nav2's first recovery: forget the map around the robot (a smeared wall,
+            # a misread), and look around to see it again.
+            cmap.clear_near(stage.pose[0], stage.pose[1], p.clear_radius)
+
+    def command(
+        self, now: float, pose: Pose, distance: float, points: Points, p: Params
+    ) -> tuple[float, float, str, str] | None:
+        """The running stage's (v, omega, "recovering", reason), or None when it is over
+        (then: replan from here, and progress is judged afresh)."""
+        st = self.stage
+        assert st is not None
+        elapsed = now - st.started
+        v = omega = 0.0
+        if st.name == "spin":
+            turned = abs(wrap_angle(pose[2] - st.pose[2]))
+            done = turned >= p.spin_angle - 0.05 or elapsed > p.spin_angle / p.spin_speed + 0.5
+            omega = st.side * p.spin_speed
+        elif st.name == "backup":
+            moved = math.hypot(pose[0] - st.pose[0], pose[1] - st.pose[1])
+            done = moved >= p.backup_distance or elapsed > p.backup_distance / p.backup_speed + 0.5
+            v = -p.backup_speed
+        else:
+            done = elapsed > p.follow_time or distance <= st.goal_distance - p.progress_distance
+            v, omega = follow_boundary(
+                _resolve(points),
+                st.side,
+                distance=p.follow_distance,
+                speed=p.follow_speed,
+                max_omega=p.dwa.max_omega,
+            )
+        if done:
+            self.stage = None
+            self.checker.reset()
+            self.to_go = None
+            return None
+        return v, omega, "recovering", f"{st.name}: {st.why}"

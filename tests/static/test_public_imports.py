@@ -83,7 +83,7 @@ def test_examples_and_docs_import_only_the_public_api(source: str) -> None:
     [
         ("from otonav.nav import Navigation", []),
         ("from otonav.errors import UsageError", []),
-        ("from otonav.nav.navigation import Navigation", ["implementation module"]),
+        ("from otonav.nav.navigate import Navigation", ["implementation module"]),
         ("import otonav.runtime.mailbox", ["implementation module"]),
         ("from otonav.stack import files", ["does not export"]),
         ("from otonav.hal.mujoco._lib import mujoco", ["private"]),

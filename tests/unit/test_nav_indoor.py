@@ -9,13 +9,20 @@ import math
 import numpy as np
 import pytest
 
+from otonav.nav import Navigation, NavigationParams
 from otonav.nav.dwa import DwaParams
-from otonav.nav.navigation import Navigation, NavigationParams
+from otonav.nav.planner import Plan
 
 pytestmark = pytest.mark.unit
 
 RADIUS = 0.35  # the stack's centre clearance (nav.clearance)
 NONE = np.empty((0, 2))
+
+
+def _plan(nav: Navigation) -> Plan:
+    """The goal's plan (the tests set a goal first)."""
+    assert nav.plan is not None
+    return nav.plan
 
 
 def _segment(x0: float, y0: float, x1: float, y1: float, step: float = 0.02) -> np.ndarray:
@@ -52,9 +59,9 @@ def test_a_door_at_the_passable_limit_is_planned_through(offset: float) -> None:
     nav.set_goal((3.0, offset))
     nav.observe(_door_wall(1.5 + offset, 0.76, centre=offset))
     _, out = _settle(nav, (0.0, offset, 0.0))
-    assert nav.path is not None, out
-    assert nav.path is not None
-    door = nav.path[np.abs(nav.path[:, 0] - (1.5 + offset)) < 0.2]
+    path = _plan(nav).path
+    assert path is not None, out
+    door = path[np.abs(path[:, 0] - (1.5 + offset)) < 0.2]
     assert door.shape[0] > 0
     # through the door, within a cell of its middle
     assert np.abs(door[:, 1] - offset).max() <= 0.06
@@ -87,8 +94,9 @@ def test_a_gap_under_the_limit_is_not_planned_through() -> None:
     nav.set_goal((3.0, 0.0))
     nav.observe(_door_wall(1.5, 0.64, reach=9.9))
     _settle(nav, (0.0, 0.0, 0.0))
-    if nav.path is not None:
-        door = nav.path[np.abs(nav.path[:, 0] - 1.5) < 0.1]
+    path = _plan(nav).path
+    if path is not None:
+        door = path[np.abs(path[:, 0] - 1.5) < 0.1]
         assert door.shape[0] == 0 or np.abs(door[:, 1]).min() > 0.3
 
 
@@ -136,11 +144,11 @@ def test_proving_no_path_is_spread_over_steps_each_within_its_budget() -> None:
     )
     nav.observe(np.concatenate((box, room)))
     t, steps, out = 0.0, 0, None
-    before = nav.expansions
+    before = nav.planner.expansions
     while steps < 400:
         out = nav.step(t, (0.0, 0.0, 0.0), 0.0, 0.0, NONE)
-        assert nav.expansions - before <= 500
-        before = nav.expansions
+        assert nav.planner.expansions - before <= 500
+        before = nav.planner.expansions
         steps += 1
         t += 0.05
         if out.stage == "spin" or out.state == "unreachable":
@@ -250,11 +258,11 @@ def test_the_spin_rung_clears_the_map_around_the_robot() -> None:
     nav.set_goal((4.0, 0.0))
     nav.observe(_segment(0.6, -0.3, 0.6, 0.3))  # a smear just ahead, and a far wall
     nav.observe(_segment(3.0, 2.0, 3.0, 3.0))
-    far = int(nav.map.occupied.sum())
+    far = int(nav.planner.map.occupied.sum())
     _drive(nav, lambda t: (0.0, 0.0, 0.0), 10.0, lambda out: out.stage == "spin")
-    row, col, _ = nav.map.cell_of(np.array([0.6]), np.array([0.0]))
-    assert not nav.map.occupied[row, col].any()  # the smear is gone
-    assert 0 < int(nav.map.occupied.sum()) < far
+    row, col, _ = nav.planner.map.cell_of(np.array([0.6]), np.array([0.0]))
+    assert not nav.planner.map.occupied[row, col].any()  # the smear is gone
+    assert 0 < int(nav.planner.map.occupied.sum()) < far
 
 
 def test_the_lookahead_scales_with_the_speed_like_regulated_pure_pursuit() -> None:
@@ -265,8 +273,8 @@ def test_the_lookahead_scales_with_the_speed_like_regulated_pure_pursuit() -> No
     nav = Navigation(params, (0.0, 0.0))
     nav.set_goal((4.0, 0.0))
     _settle(nav, (0.0, 0.0, 0.0))
-    assert nav.path is not None
+    assert _plan(nav).path is not None
     for v0, want in ((0.0, 0.4), (-0.05, 0.4), (0.25, 0.5), (0.4, 0.8), (0.5, 0.8)):
-        tx, ty = nav._target((0.0, 0.0, 0.0), v0)
+        tx, ty = _plan(nav).follow((0.0, 0.0, 0.0), 4.0, v0, params.lookahead)[1]
         assert ty == pytest.approx(0.0, abs=0.06)
         assert want <= tx <= want + 0.15, (v0, tx)

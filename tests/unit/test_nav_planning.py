@@ -13,15 +13,22 @@ from dwa_model import dwa_reference
 
 from otonav.hal import RobotGeometry
 from otonav.hal.mujoco import MujocoInterface
+from otonav.nav import Navigation, NavigationParams
 from otonav.nav.costmap import ClearanceMap
 from otonav.nav.dwa import DwaParams, clear_arc, dwa_step
 from otonav.nav.footprint import centre_clearance
 from otonav.nav.global_path import astar
-from otonav.nav.navigation import Navigation, NavigationParams
+from otonav.nav.planner import Plan
 from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
 from otonav.nav.scan import ScanRays, nearest_return, scan_in_frame, scan_points, to_frame
 
 pytestmark = pytest.mark.unit
+
+
+def _plan(nav: Navigation) -> Plan:
+    """The goal's plan (the tests set a goal first)."""
+    assert nav.plan is not None
+    return nav.plan
 
 
 def _wall(x: float, y0: float, y1: float, step: float = 0.02) -> np.ndarray:
@@ -229,21 +236,21 @@ def test_navigation_replans_through_a_phantom_once_a_scan_sees_through_it() -> N
     nav.observe(wall, _seen(wall))
     t = 0.0
     nav.step(t, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
-    while nav.searching:  # a search spans steps (expansions_per_tick)
+    while _plan(nav).search is not None:  # a search spans steps (expansions_per_tick)
         t += 0.05
         nav.step(t, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
-    assert nav.path is not None
-    detour = nav.path_length
+    assert _plan(nav).path is not None
+    detour = _plan(nav).length
     assert detour > 4.0
     nav.observe(np.empty((0, 2)), _rays(np.full(360, np.inf)))  # the wall is gone
-    nav.path = None  # the next check replans (as after a blocked-path check)
+    _plan(nav).path = None  # the next check replans (as after a blocked-path check)
     t += 0.5
     nav.step(t, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
-    while nav.searching:
+    while _plan(nav).search is not None:
         t += 0.05
         nav.step(t, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
-    assert nav.map.cleared > 0
-    assert nav.path_length == pytest.approx(3.0, abs=0.2)
+    assert nav.planner.map.cleared > 0
+    assert _plan(nav).length == pytest.approx(3.0, abs=0.2)
 
 
 # -- A* --------------------------------------------------------------------------------
@@ -546,9 +553,10 @@ def test_navigation_plans_around_a_box_and_reports_reached() -> None:
     nav.observe(box, _seen(box))
     out = nav.step(0.0, (0.0, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
     assert out.state in ("driving", "avoiding")
-    assert nav.path is not None
+    path = _plan(nav).path
+    assert path is not None
     assert out.path_length > 3.0  # around the box, not through it
-    assert np.abs(nav.path[:, 1]).max() > 0.6
+    assert np.abs(path[:, 1]).max() > 0.6
     done = nav.step(1.0, (2.95, 0.0, 0.0), 0.0, 0.0, np.empty((0, 2)))
     assert done.state == "reached"
     assert (done.v, done.omega) == (0.0, 0.0)
@@ -587,7 +595,7 @@ def test_navigating_imports_nothing_more_than_its_modules() -> None:
     script = (
         "import sys\n"
         "import numpy as np\n"
-        "from otonav.nav.navigation import Navigation, NavigationParams\n"
+        "from otonav.nav import Navigation, NavigationParams\n"
         "nav = Navigation(NavigationParams(), (0.0, 0.0))\n"
         "nav.set_goal((3.0, 0.0))\n"
         "before = set(sys.modules)\n"

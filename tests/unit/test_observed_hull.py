@@ -11,14 +11,21 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from otonav.nav import Navigation, NavigationParams
 from otonav.nav.dwa import DwaParams
-from otonav.nav.navigation import Navigation, NavigationParams
 from otonav.nav.observed_hull import ObservedHull, convex_hull, free_ends
+from otonav.nav.planner import Plan
 from otonav.nav.scan import ScanRays
 
 pytestmark = pytest.mark.unit
 
 NONE = np.empty((0, 2))
+
+
+def _plan(nav: Navigation) -> Plan:
+    """The goal's plan (the tests set a goal first)."""
+    assert nav.plan is not None
+    return nav.plan
 
 
 def _segment(x0: float, y0: float, x1: float, y1: float, step: float = 0.02) -> np.ndarray:
@@ -152,7 +159,7 @@ def _prove(nav: Navigation, pose: tuple[float, float, float]) -> str:
     """Step at rest until the search ends; the state then (the look-around spin
     that precedes ``unreachable`` is what a proof of "no path" starts)."""
     t, out = 0.0, nav.step(0.0, pose, 0.0, 0.0, NONE)
-    while nav.searching:
+    while _plan(nav).search is not None:
         t += 0.05
         out = nav.step(t, pose, 0.0, 0.0, NONE)
     return "no path" if out.stage == "spin" and "no path" in out.reason else out.state
@@ -204,8 +211,9 @@ def test_a_way_round_a_wall_into_space_seen_empty_is_still_planned() -> None:
     nav.set_goal((3.0, 0.0))
     nav.observe(points, rays)
     assert _prove(nav, (0.0, 0.0, 0.0)) in ("driving", "avoiding")
-    assert nav.path is not None
-    assert np.abs(nav.path[:, 1]).max() > 2.3  # round an end of the wall
+    path = _plan(nav).path
+    assert path is not None
+    assert np.abs(path[:, 1]).max() > 2.3  # round an end of the wall
 
 
 def test_a_goal_beyond_everything_observed_is_not_bounded_by_it() -> None:
@@ -228,5 +236,5 @@ def test_a_goal_beyond_everything_observed_is_not_bounded_by_it() -> None:
     nav.set_goal((-2.0, -3.5))
     nav.observe(np.concatenate((top_room, seen_below)))
     assert _prove(nav, (-1.0, 3.3, 0.0)) in ("driving", "avoiding")
-    assert nav.path is not None
-    assert not nav.hull.contains(-2.0, -3.5)
+    assert _plan(nav).path is not None
+    assert not nav.planner.hull.contains(-2.0, -3.5)
