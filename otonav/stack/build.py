@@ -19,18 +19,22 @@ from otonav.actors import (
     topics,
 )
 from otonav.actors.localized_navigator import LocalizedNavigator
-from otonav.actors.localizer import Localizer, LocalizerParams
+from otonav.actors.localizer import Localizer
 from otonav.actors.odometry_error import OdometryError
 from otonav.control import DiffDriveGeometry
 from otonav.hal import BoxObstacle, RobotGeometry, RobotHardwareInterface
 from otonav.hal.mujoco import MujocoInterface
 from otonav.hal.types import Reach
-from otonav.nav import GoToGoalParams, GuardParams
-from otonav.nav.dwa import DwaParams
 from otonav.nav.footprint import centre_clearance
-from otonav.nav.navigation import NavigationParams
-from otonav.nav.safety import SafetyParams
-from otonav.nav.scan_match import MatchParams
+from otonav.params import (
+    DwaParams,
+    GoToGoalParams,
+    GuardParams,
+    LocalizerParams,
+    MatchParams,
+    NavigationParams,
+    SafetyParams,
+)
 from otonav.runtime import Actor
 from otonav.stack.config import StackConfig
 from otonav.stack.files import ConfigFileError

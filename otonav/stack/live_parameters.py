@@ -28,11 +28,9 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, TypeAdapter, ValidationError
 
-from otonav.nav import GoToGoalParams, NavigationParams
-from otonav.nav.dwa import DwaParams
-from otonav.nav.safety import SafetyParams
+from otonav.params import DwaConfig, DwaParams, GoToGoalParams, NavigationParams, SafetyParams
 from otonav.runtime import Actor
-from otonav.stack.config import DwaConfig, StackConfig
+from otonav.stack.config import StackConfig
 
 __all__ = ("CONFIG_KEYS", "ActorParameters", "ParameterError")
 
