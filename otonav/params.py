@@ -22,6 +22,7 @@ from pydantic import BaseModel, ConfigDict, Field, PositiveFloat
 from otonav import limits
 
 __all__ = (
+    "CONFIG_KEYS",
     "BaseConfig",
     "DwaConfig",
     "DwaParams",
@@ -564,3 +565,36 @@ class NavConfig(Section):
     map: MapConfig = MapConfig()
     recovery: RecoveryConfig = RecoveryConfig()
     localization: LocalizationConfig = LocalizationConfig()
+
+
+_SPEEDS = {name: f"base.{name}" for name in ("max_v", "max_omega")}
+_ACCELERATIONS = {name: f"base.{name}" for name in ("max_accel", "max_alpha")}
+CONFIG_KEYS: dict[type, dict[str, str]] = {
+    GoToGoalParams: {
+        **{name: f"nav.{name}" for name in ("kp_lin", "kp_ang", "tolerance")},
+        "turn_in_place_threshold": "nav.turn_in_place_threshold",
+        **_SPEEDS,
+    },
+    DwaParams: {
+        **{name: f"nav.dwa.{name}" for name in DwaConfig.model_fields},
+        "rotate_threshold": "nav.turn_in_place_threshold",
+        **_SPEEDS,
+        **_ACCELERATIONS,
+    },
+    SafetyParams: {"radius": "safety.clearance", "scales": "safety.scales", **_ACCELERATIONS},
+    NavigationParams: {
+        **{name: f"nav.{name}" for name in ("tolerance", "approach_radius", "kp_lin", "kp_ang")},
+        # nav.map.half_size and .resolution are map_half_size and map_resolution here
+        **{
+            f"map_{name}" if name in ("half_size", "resolution") else name: f"nav.map.{name}"
+            for name in MapConfig.model_fields
+        },
+        **{name: f"nav.recovery.{name}" for name in RecoveryConfig.model_fields},
+    },
+}
+"""Per nav dataclass, field -> the config key that sets it, or for one capped by the
+robot's base (a speed, an acceleration) the base's key; the safety radius, a centre
+clearance, has ``safety.clearance``'s. ``stack.build`` reads each field it does not
+derive from its key; a value set while the robot runs must pass that key's bounds
+(``otonav.stack.live_parameters``). A field with no key (a period or a latency derived
+from several keys) is read-only while the robot runs."""

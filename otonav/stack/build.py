@@ -5,7 +5,8 @@ from __future__ import annotations
 import itertools
 import warnings
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from functools import reduce
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from otonav.actors import (
     EXTERNAL_COMMAND_WAIT,
@@ -27,6 +28,7 @@ from otonav.hal.mujoco import MujocoInterface
 from otonav.hal.types import Reach
 from otonav.nav.footprint import centre_clearance
 from otonav.params import (
+    CONFIG_KEYS,
     DwaParams,
     GoToGoalParams,
     GuardParams,
@@ -51,6 +53,8 @@ from otonav.stack.robot import (
 
 if TYPE_CHECKING:
     from otonav.hal.can import CanBusInterface
+
+P = TypeVar("P")
 
 _VIRTUAL_BUSES = itertools.count()
 """Each stack's virtual CAN channel is private: concurrent stacks never hear each other."""
@@ -216,13 +220,11 @@ def build_actors(
         if nav.planner == "stop":
             actors.append(
                 Navigator(
-                    GoToGoalParams(
-                        kp_lin=nav.kp_lin,
-                        kp_ang=nav.kp_ang,
+                    _from_config(
+                        GoToGoalParams,
+                        config,
                         max_v=nav_speeds(config)[0],
                         max_omega=nav_speeds(config)[1],
-                        tolerance=nav.tolerance,
-                        turn_in_place_threshold=nav.turn_in_place_threshold,
                     ),
                     GuardParams(guard.sector_half_angle, guard.stop_distance),
                     rate_hz=nav.rate_hz,
@@ -271,17 +273,21 @@ def external_planner(config: StackConfig) -> StackConfig:
     return config.model_copy(update={"nav": config.nav.model_copy(update={"planner": "external"})})
 
 
-_MAP_NAMES = {"half_size": "map_half_size", "resolution": "map_resolution"}
-"""``nav.map`` fields whose NavigationParams name says "map" (the others match)."""
+def _from_config(cls: type[P], config: StackConfig, **derived: Any) -> P:
+    """``cls`` with each field its config key sets (:data:`otonav.params.CONFIG_KEYS`)
+    read from ``config``, but those ``derived`` here."""
+    keys = CONFIG_KEYS[cls].items()
+    read = {name: reduce(getattr, key.split("."), config) for name, key in keys}
+    return cls(**{**read, **derived})
 
 
 def navigation_params(
     config: StackConfig, geometry: RobotGeometry, reach: Reach | None = None
 ) -> NavigationParams:
     """The avoiding navigator's settings from ``nav.*`` and the base's limits: the
-    ``nav.dwa``, ``nav.map`` and ``nav.recovery`` sections pass through by name (their
-    defaults are NavigationParams' and DwaParams', ADR 0054); what depends on the base
-    or the footprint is derived here. ``reach``: what the robot really reaches (ADR
+    ``nav.dwa``, ``nav.map`` and ``nav.recovery`` sections pass through by their keys
+    (``otonav.params.CONFIG_KEYS``); what depends on the base or the footprint is
+    derived here. ``reach``: what the robot really reaches (ADR
     0066): the DWA's window grows by the accelerations it really has, and a robot slower
     than asked gets a progress window as much longer as it is slower. The window's top
     stays the asked speed: a servo short of its setpoint reaches most when asked most."""
@@ -293,30 +299,25 @@ def navigation_params(
     accel, alpha = base.max_accel, base.max_alpha
     if reach is not None:
         accel, alpha = min(accel, reach.accel), min(alpha, reach.alpha)
-    dwa = DwaParams(
-        **nav.dwa.model_dump(),
+    dwa = _from_config(
+        DwaParams,
+        config,
         max_v=fastest_v,
         max_omega=fastest_omega,
         max_accel=accel,
         max_alpha=alpha,
         period=1.0 / nav.rate_hz,
         radius=radius,
-        rotate_threshold=nav.turn_in_place_threshold,
     )
-    grid = {_MAP_NAMES.get(k, k): v for k, v in nav.map.model_dump().items()}
-    recovery = nav.recovery.model_dump()
-    recovery["progress_window"] /= slower(reach)
-    for name in ("backup_speed", "follow_speed"):
-        recovery[name] = min(recovery[name], fastest_v)
-    recovery["spin_speed"] = min(recovery["spin_speed"], fastest_omega)
-    return NavigationParams(
+    recovery = nav.recovery
+    return _from_config(
+        NavigationParams,
+        config,
         dwa=dwa,
-        tolerance=nav.tolerance,
-        approach_radius=nav.approach_radius,
-        kp_lin=nav.kp_lin,
-        kp_ang=nav.kp_ang,
-        **grid,
-        **recovery,
+        progress_window=recovery.progress_window / slower(reach),
+        backup_speed=min(recovery.backup_speed, fastest_v),
+        follow_speed=min(recovery.follow_speed, fastest_v),
+        spin_speed=min(recovery.spin_speed, fastest_omega),
     )
 
 
@@ -350,13 +351,12 @@ def localizer_params(config: StackConfig) -> LocalizerParams:
 
 def safety_params(config: StackConfig, geometry: RobotGeometry) -> SafetyParams:
     """The safety layer's settings from ``safety.*``, the base's limits and rates."""
-    safety, base = config.safety, robot_base(config)
-    return SafetyParams(
+    safety, base = config.safety, config.base
+    return _from_config(
+        SafetyParams,
+        config,
         radius=centre_clearance(
             safety.clearance, geometry.footprint_radius, safety.footprint_padding
         ),
-        max_accel=base.max_accel,
-        max_alpha=base.max_alpha,
         latency=1.0 / safety.rate_hz + 1.0 / base.rate_hz + safety.drive_lag,
-        scales=safety.scales,
     )
