@@ -69,6 +69,24 @@ class BaseConfig(Section):
 _BASE = BaseConfig()
 
 
+def _finite(params: object, low: str, *names: str) -> None:
+    """Each field ``names`` of ``params`` is finite and ``low`` ("> 0" or ">= 0")."""
+    for name in names:
+        value = getattr(params, name)
+        if not (math.isfinite(value) and (value > 0.0 if low == "> 0" else value >= 0.0)):
+            kind = type(params).__name__
+            raise ValueError(f"{kind}.{name} must be finite and {low}, got {value!r}")
+
+
+def _integer(params: object, low: int, *names: str) -> None:
+    """Each field ``names`` of ``params`` is an integer >= ``low``."""
+    for name in names:
+        value = getattr(params, name)
+        if not (isinstance(value, int) and value >= low):
+            kind = type(params).__name__
+            raise ValueError(f"{kind}.{name} must be an integer >= {low}, got {value!r}")
+
+
 @dataclass(frozen=True, slots=True)
 class GoToGoalParams:
     """Gains and limits of the go-to-goal controller.
@@ -92,10 +110,7 @@ class GoToGoalParams:
     turn_in_place_threshold: float = 0.6
 
     def __post_init__(self) -> None:
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ValueError(f"GoToGoalParams.{f.name} must be finite and >= 0, got {value!r}")
+        _finite(self, ">= 0", *(f.name for f in fields(self)))
 
 
 _GOAL = GoToGoalParams()
@@ -120,15 +135,13 @@ class GuardParams:
             raise ValueError(
                 f"GuardParams.sector_half_angle must be in [0, pi], got {self.sector_half_angle!r}"
             )
-        if not (math.isfinite(self.stop_distance) and self.stop_distance >= 0.0):
-            raise ValueError(
-                f"GuardParams.stop_distance must be finite and >= 0, got {self.stop_distance!r}"
-            )
+        _finite(self, ">= 0", "stop_distance")
 
 
 @dataclass(frozen=True, slots=True)
 class DwaParams:
-    """Settings of :func:`~otonav.nav.dwa.dwa_step`.
+    """Settings of :func:`~otonav.nav.dwa.dwa_step`. A field ``nav.dwa.*`` sets means
+    what that key says (:class:`DwaConfig`), and:
 
     Attributes:
         max_v: forward speed limit, m/s (> 0).
@@ -136,19 +149,10 @@ class DwaParams:
         max_accel: linear acceleration limit (the base's), m/s^2 (> 0).
         max_alpha: angular acceleration limit (the base's), rad/s^2 (> 0).
         period: control period: the window is what the limits reach in it, s (> 0).
-        horizon: rollout length, s (> 0).
-        dt: rollout pose spacing, s (> 0, <= horizon).
-        v_samples: speed samples across the window (>= 1).
-        omega_samples: yaw-rate samples across the window (>= 1).
         radius: centre clearance to keep (footprint.centre_clearance), m (>= 0).
-        latency: command delay before braking starts, s (>= 0).
-        clearance_cap: clearance beyond which more is not better, m (> 0).
-        w_heading, w_progress, w_clearance, w_speed: score weights (>= 0).
         rotate_threshold: with the target farther off the heading than this, rad, the
             window's speeds shrink to its lowest (slow down and turn toward it first,
             like Nav2's rotation shim) (>= 0).
-        fast_path: try :func:`~otonav.nav.dwa.clear_arc` before sampling (module docstring).
-        fast_margin: clearance beyond ``radius`` the fast path's arc keeps, m (>= 0).
     """
 
     max_v: float = 0.4
@@ -172,22 +176,13 @@ class DwaParams:
     fast_margin: float = 0.2
 
     def __post_init__(self) -> None:
-        positive: tuple[str, ...] = ("max_v", "max_omega", "max_accel", "max_alpha")
-        positive += ("period", "horizon", "dt", "clearance_cap")
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if f.name == "fast_path":
-                if not isinstance(value, bool):
-                    raise ValueError(f"DwaParams.fast_path must be a bool, got {value!r}")
-                continue
-            if f.name in ("v_samples", "omega_samples"):
-                if not (isinstance(value, int) and value >= 1):
-                    raise ValueError(f"DwaParams.{f.name} must be an integer >= 1, got {value!r}")
-                continue
-            low_ok = value > 0.0 if f.name in positive else value >= 0.0
-            if not (math.isfinite(value) and low_ok):
-                bound = "> 0" if f.name in positive else ">= 0"
-                raise ValueError(f"DwaParams.{f.name} must be finite and {bound}, got {value!r}")
+        _finite(self, "> 0", "max_v", "max_omega", "max_accel", "max_alpha", "period")
+        _finite(self, "> 0", "horizon", "dt", "clearance_cap")
+        _integer(self, 1, "v_samples", "omega_samples")
+        _finite(self, ">= 0", "radius", "latency", "w_heading", "w_progress", "w_clearance")
+        _finite(self, ">= 0", "w_speed", "rotate_threshold", "fast_margin")
+        if not isinstance(self.fast_path, bool):
+            raise ValueError(f"DwaParams.fast_path must be a bool, got {self.fast_path!r}")
         if self.dt > self.horizon:
             raise ValueError(f"DwaParams.dt ({self.dt} s) must be <= horizon ({self.horizon} s)")
 
@@ -216,16 +211,9 @@ class SafetyParams:
     scales: int = 6
 
     def __post_init__(self) -> None:
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if f.name == "scales":
-                if not (isinstance(value, int) and value >= 2):
-                    raise ValueError(f"SafetyParams.scales must be an integer >= 2, got {value!r}")
-                continue
-            ok = value >= 0.0 if f.name == "latency" else value > 0.0
-            if not (math.isfinite(value) and ok):
-                bound = ">= 0" if f.name == "latency" else "> 0"
-                raise ValueError(f"SafetyParams.{f.name} must be finite and {bound}, got {value!r}")
+        _finite(self, "> 0", "radius", "max_accel", "max_alpha", "dt")
+        _finite(self, ">= 0", "latency")
+        _integer(self, 2, "scales")
 
 
 @dataclass(frozen=True, slots=True)
@@ -257,16 +245,9 @@ class MatchParams:
     min_inliers: float = 0.3
 
     def __post_init__(self) -> None:
-        for name in ("linear_window", "angular_window", "prior", "yaw_scale"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ValueError(f"MatchParams.{name} must be finite and >= 0, got {value!r}")
-        for name in ("linear_step", "angular_step", "max_distance"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0.0):
-                raise ValueError(f"MatchParams.{name} must be finite and > 0, got {value!r}")
-        if self.iterations < 0:
-            raise ValueError(f"MatchParams.iterations must be >= 0, got {self.iterations}")
+        _finite(self, ">= 0", "linear_window", "angular_window", "prior", "yaw_scale")
+        _finite(self, "> 0", "linear_step", "angular_step", "max_distance")
+        _integer(self, 0, "iterations")
         if not 0.0 <= self.min_inliers <= 1.0:
             raise ValueError(f"MatchParams.min_inliers must be in [0, 1], got {self.min_inliers}")
 
@@ -296,46 +277,15 @@ class LocalizerParams:
 
 @dataclass(frozen=True, slots=True)
 class NavigationParams:
-    """Settings of :class:`~otonav.nav.navigation.Navigation` (units in the names' docs,
-    stack config ``nav.*``).
+    """Settings of :class:`~otonav.nav.navigation.Navigation`. Each field means what the
+    config key that sets it says (:data:`CONFIG_KEYS`: ``nav.map.*``, ``nav.recovery.*``,
+    ``nav.tolerance``, ...), and:
 
     Attributes:
         dwa: the local planner's settings (its ``radius`` is the centre clearance).
-        tolerance: goal reached within this distance, m.
-        map_half_size: the map spans this far from the start in x and y, m.
-        map_resolution: map cell, m.
-        plan_resolution: global planner cell, m (a multiple of ``map_resolution``).
-        plan_penalty: extra cost per cell near obstacles (0: shortest path).
-        replan_period: blocked-path check period, s.
-        lookahead: the DWA's target is at most this far along the path (at full
-            speed; nearer when slower, see ``otonav.nav.navigation.LOOKAHEAD_TIME``), m.
-        max_expansions: A* gives up (no proof either way) after this many cells.
-        expansions_per_tick: A* expands at most this many cells per step; a search
-            that needs more goes on at the next step (the robot follows the previous
-            path, or heads for the goal, meanwhile; the DWA keeps it clear).
-        clear_range: before a replan, occupied cells within this distance of the laser
-            that the last observed scan saw through are cleared (ADR 0026), m; 0: the
-            map never clears.
         hull_margin: once the goal lies inside the convex hull of what the robot has
             observed (returns, free beam ends, laser positions), A* routes only within
             this distance of it, m (:mod:`otonav.nav.observed_hull`).
-        progress_distance: progress that counts, m.
-        progress_window: time to shrink the distance to go (along the path) by
-            ``progress_distance``, s (:class:`~otonav.nav.recovery.ProgressChecker`).
-        goal_progress_window: time to get ``progress_distance`` closer to the goal, s.
-        clear_radius: the spin rung first clears the map within this distance of the
-            robot, m (0: never).
-        spin_angle: the look-around turn, rad.
-        spin_speed: its yaw rate, rad/s.
-        backup_distance: the back-up distance, m.
-        backup_speed: its speed, m/s.
-        follow_time: the longest boundary following, s.
-        follow_speed: its speed, m/s.
-        follow_distance: centre-to-boundary distance while following, m.
-        approach_radius: within this distance of the goal a proportional controller
-            finishes (forward or in reverse, whichever faces the goal), m.
-        kp_lin: its speed per metre of distance, 1/s.
-        kp_ang: its yaw rate per radian of heading error, 1/s.
     """
 
     dwa: DwaParams = field(default_factory=DwaParams)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import itertools
 import warnings
 from collections.abc import Sequence
+from dataclasses import fields
 from functools import reduce
 from typing import TYPE_CHECKING, Any, TypeVar
 
@@ -136,17 +137,8 @@ def _can_world(config: StackConfig, world: MujocoInterface) -> CanBusInterface:
                 seed=sim.seed,
                 schedule=fault_plan(sim.faults),
             )
-        limits = MonitorLimits(
-            startup_timeout=can.startup_timeout,
-            heartbeat_timeout=can.heartbeat_timeout,
-            encoder_timeout=can.encoder_timeout,
-            encoder_period=can.encoder_period,
-            max_frame_loss=can.max_frame_loss,
-            loss_window=can.loss_window,
-            recovery_delay=can.recovery_delay,
-            max_recovery_attempts=can.max_recovery_attempts,
-            recovery_reset=can.recovery_reset,
-        )
+        # hal.can's fault-detection keys are MonitorLimits' fields, by name.
+        limits = MonitorLimits(**{f.name: getattr(can, f.name) for f in fields(MonitorLimits)})
         return CanBusInterface(
             host,
             world,
@@ -183,10 +175,7 @@ def build_actors(
     actors: list[Actor] = [
         Bridge(
             hal,
-            clock_hz=rates.clock_hz,
-            odom_hz=rates.odom_hz,
-            imu_hz=rates.imu_hz,
-            scan_hz=rates.scan_hz,
+            **rates.model_dump(),
             initial_pose=initial_pose,
             odometry_error=odometry_error(config),
             frames=robot_frames(config.robot),
