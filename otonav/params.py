@@ -43,6 +43,8 @@ __all__ = (
 
 
 class Section(BaseModel):
+    """A section of the stack config: frozen, no unknown keys, strict, finite."""
+
     # strict: "yes" is not 1.0 and "3" is not 3 (a number in YAML is still a number).
     # allow_inf_nan=False: '.inf' is a YAML float, and an infinite rate is a zero period.
     model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
