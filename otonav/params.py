@@ -1,14 +1,8 @@
-"""The parameter models, every default written once (issue 36): the settings the nav
-math takes (frozen dataclasses: ``DwaParams``, ``SafetyParams``, ...) and the stack
-config's sections that set them (pydantic: ``NavConfig``, ``SafetyConfig``, ...,
-with their bounds, units and YAML names). A leaf: pydantic and the standard library
-only, no numpy, so reading a config stays cheap (``import otonav.stack``).
-
-A default lives in one place and everything else refers to it: a section's field
-takes the dataclass's default (``stack.build`` passes each section's fields through
-by name, ADR 0054), a dataclass field the base sets takes ``BaseConfig``'s, an actor's
-keyword its section's. ``tests/static/test_defaults_once.py`` fails on a default
-literal written twice.
+"""The parameter models, each default written once (ADR 0085): the dataclasses the nav
+math takes (``DwaParams``, ...) and the config sections that set them (``NavConfig``,
+...: bounds, units, YAML names). A leaf (pydantic and the standard library): reading a
+config loads no numpy. Everything else refers to a default's one home; the static test
+``test_defaults_once`` fails on a literal written twice.
 """
 
 from __future__ import annotations
@@ -256,18 +250,9 @@ class MatchParams:
 
 @dataclass(frozen=True, slots=True)
 class LocalizerParams:
-    """Settings of :class:`~otonav.actors.localizer.Localizer` (stack config
-    ``nav.localization.*``).
-
-    Attributes:
-        match: the scan matcher's settings.
-        resolution: map cell, m.
-        half_size: the map spans this far from the start in x and y, m.
-        update_distance: a scan is added to the map after the robot moved this far
-            since the last one added, m ...
-        update_angle: ... or turned this much, rad.
-        map_period: /map at most this often, s of sim time (when the map changed).
-    """
+    """Settings of :class:`~otonav.actors.localizer.Localizer`: ``match``, the scan
+    matcher's; each other field means what ``nav.localization.*`` of its name says
+    (:class:`LocalizationConfig`)."""
 
     match: MatchParams = field(default_factory=MatchParams)
     resolution: float = 0.05

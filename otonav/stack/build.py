@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import itertools
-import warnings
 from collections.abc import Sequence
 from dataclasses import fields
 from functools import reduce
@@ -160,16 +159,12 @@ def build_actors(
     config: StackConfig,
     hal: RobotHardwareInterface,
     *,
-    navigator: bool = True,
     goal: tuple[float, float] | None = None,
     initial_pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
 ) -> list[Actor]:
     """bridge + base controller, the planner ``nav.planner`` names and the safety layer
     (``safety.enabled``) for ``hal``. ``initial_pose`` is where odometry starts (the known
-    start pose: odom is then the world frame). ``navigator=False``: deprecated spelling
-    of ``nav.planner: external`` (the safety layer stays; ADR 0055)."""
-    if not navigator:
-        config, navigator = external_planner(config), True
+    start pose: odom is then the world frame)."""
     geometry = hal.geometry
     rates, base, nav, guard = config.rates, robot_base(config), config.nav, config.guard
     actors: list[Actor] = [
@@ -204,62 +199,49 @@ def build_actors(
                 start=(initial_pose[0], initial_pose[1]),
             )
         )
-    if navigator:
-        remap = {topics.CMD_VEL: topics.CMD_VEL_NAV} if config.safety.enabled else None
-        if nav.planner == "stop":
-            actors.append(
-                Navigator(
-                    _from_config(
-                        GoToGoalParams,
-                        config,
-                        max_v=nav_speeds(config)[0],
-                        max_omega=nav_speeds(config)[1],
-                    ),
-                    GuardParams(guard.sector_half_angle, guard.stop_distance),
-                    rate_hz=nav.rate_hz,
-                    goal=goal,
-                    remap=remap,
-                )
+    remap = {topics.CMD_VEL: topics.CMD_VEL_NAV} if config.safety.enabled else None
+    if nav.planner == "stop":
+        actors.append(
+            Navigator(
+                _from_config(
+                    GoToGoalParams,
+                    config,
+                    max_v=nav_speeds(config)[0],
+                    max_omega=nav_speeds(config)[1],
+                ),
+                GuardParams(guard.sector_half_angle, guard.stop_distance),
+                rate_hz=nav.rate_hz,
+                goal=goal,
+                remap=remap,
             )
-        elif nav.planner == "dwa":
-            navigator_class = LocalizedNavigator if nav.localization.enabled else AvoidingNavigator
-            actors.append(
-                navigator_class(
-                    navigation_params(config, geometry, reached(config, hal)),
-                    laser_offset_x=geometry.laser_offset_x,
-                    start=(initial_pose[0], initial_pose[1]),
-                    rate_hz=nav.rate_hz,
-                    goal=goal,
-                    remap=remap,
-                )
+        )
+    elif nav.planner == "dwa":
+        navigator_class = LocalizedNavigator if nav.localization.enabled else AvoidingNavigator
+        actors.append(
+            navigator_class(
+                navigation_params(config, geometry, reached(config, hal)),
+                laser_offset_x=geometry.laser_offset_x,
+                start=(initial_pose[0], initial_pose[1]),
+                rate_hz=nav.rate_hz,
+                goal=goal,
+                remap=remap,
             )
-        if config.safety.enabled:
-            actors.append(
-                SafetyLayer(
-                    safety_params(config, geometry),
-                    laser_offset_x=geometry.laser_offset_x,
-                    rate_hz=config.safety.rate_hz,
-                    cmd_timeout=config.safety.cmd_timeout,
-                    scan_timeout=config.safety.scan_timeout,
-                )
+        )
+    if config.safety.enabled:
+        actors.append(
+            SafetyLayer(
+                safety_params(config, geometry),
+                laser_offset_x=geometry.laser_offset_x,
+                rate_hz=config.safety.rate_hz,
+                cmd_timeout=config.safety.cmd_timeout,
+                scan_timeout=config.safety.scan_timeout,
             )
-        if nav.planner == "external":
-            # Nobody may be publishing the planner's commands: say so early.
-            topic = topics.CMD_VEL_NAV if config.safety.enabled else topics.CMD_VEL
-            actors.append(CommandWatch(topic, within=EXTERNAL_COMMAND_WAIT))
+        )
+    if nav.planner == "external":
+        # Nobody may be publishing the planner's commands: say so early.
+        topic = topics.CMD_VEL_NAV if config.safety.enabled else topics.CMD_VEL
+        actors.append(CommandWatch(topic, within=EXTERNAL_COMMAND_WAIT))
     return launch(actors, config.actors)
-
-
-def external_planner(config: StackConfig) -> StackConfig:
-    """``config`` with ``nav.planner: external`` (what ``navigator=False`` means), with a
-    DeprecationWarning for that spelling."""
-    warnings.warn(
-        "navigator=False is deprecated: set nav.planner: external in the stack config (the "
-        "safety layer stays unless safety.enabled: false)",
-        DeprecationWarning,
-        stacklevel=3,
-    )
-    return config.model_copy(update={"nav": config.nav.model_copy(update={"planner": "external"})})
 
 
 def _from_config(cls: type[P], config: StackConfig, **derived: Any) -> P:
@@ -315,9 +297,7 @@ def odometry_error(config: StackConfig) -> OdometryError | None:
     error = config.world.odometry_error
     if not error.enabled:
         return None
-    return OdometryError(
-        scale=error.scale, gyro_bias=error.gyro_bias, gyro_noise=error.gyro_noise, seed=error.seed
-    )
+    return OdometryError(**error.model_dump())
 
 
 def localizer_params(config: StackConfig) -> LocalizerParams:
