@@ -34,6 +34,7 @@ SCAN_TIMEOUT = 0.5
 """s of sim time without /scan before a navigator stops driving forward (blind)."""
 NAME = "nav"
 """The navigator's node name: the stack's ``nav`` actor."""
+
 STOP = Twist.fast(
     linear=Vector3.fast(x=0.0, y=0.0, z=0.0), angular=Vector3.fast(x=0.0, y=0.0, z=0.0)
 )
