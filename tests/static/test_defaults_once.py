@@ -2,12 +2,13 @@
 stack's config loads no numpy.
 
 The finder walks every module of otonav/ (AST, nothing imported): the literal defaults
-of class fields (dataclass and pydantic fields, ``Field(default, ...)`` too) and of
-function parameters, grouped by the name they set (``ALIASES``: one parameter, two
-names). A name with the same literal default in two places is one parameter written
-twice: the next change moves one and not the other. Neutral values (0, "", True,
-False, None) are not knowledge and are left out. A default that refers to another
-(``max_accel: float = _BASE.max_accel``) is not a literal: that is the fix.
+of class fields (dataclass and pydantic fields, ``Field(default, ...)`` and
+``field(default=...)`` too) and of function parameters, grouped by the name they set
+(``ALIASES``: one parameter, two names). A name with the same literal default in two
+places is one parameter written twice: the next change moves one and not the other.
+Neutral values (0, "", True, False, None) are not knowledge and are left out. A default
+that refers to another (``max_accel: float = _BASE.max_accel``) is not a literal: that
+is the fix.
 
 ``KNOWN`` lists what is still written twice, by file, each in a part of otonav that
 issue 36's other items change in parallel (hal/, the bridge, scenario/, sweep/,
@@ -86,7 +87,7 @@ Default = tuple[str, object, str]
 
 def _literal(node: ast.expr | None) -> object:
     """The default ``node`` writes as a literal (None: not a literal, or neutral)."""
-    if isinstance(node, ast.Call) and getattr(node.func, "id", "") == "Field":
+    if isinstance(node, ast.Call) and getattr(node.func, "id", "") in ("Field", "field"):
         given = [k.value for k in node.keywords if k.arg == "default"]
         node = node.args[0] if node.args else (given[0] if given else None)
     if node is None:
@@ -149,7 +150,8 @@ def test_the_finder_finds_a_default_written_twice(tmp_path: Path) -> None:
         "    enabled: bool = False\n"
     )
     (tmp_path / "dwa.py").write_text(
-        "class DwaParams:\n    rotate_threshold: float = 0.6\n    enabled: bool = False\n"
+        "class DwaParams:\n    rotate_threshold: float = field(default=0.6)\n"
+        "    enabled: bool = False\n"
     )
     (tmp_path / "actor.py").write_text(
         "def start(period, *, turn_in_place_threshold=0.6, rate_hz=_NAV.rate_hz): ...\n"
