@@ -80,7 +80,8 @@ KNOWN: dict[tuple[str, object], str] = {
     ("wall_ceiling", 600.0): "replay/runner.py",
     ("watchdog_timeout", 0.2): "hal/sim/odrive.py stack/config.py",
 }
-"""(name, default) -> the files (under otonav/) that still write it, as they do today."""
+"""(name, default) -> the files (under otonav/, a private ``_`` dropped) that still write
+it, as they do today."""
 
 Default = tuple[str, object, str]
 
@@ -127,7 +128,10 @@ def duplicated_defaults(package: Path) -> dict[tuple[str, object], str]:
     """(name, default) -> the files writing it, for each written in two places or more."""
     places: dict[tuple[str, object], list[str]] = defaultdict(list)
     for path in sorted(package.rglob("*.py")):
-        for name, value, label in _defaults(path, path.relative_to(package).as_posix()):
+        # A module renamed private (``_dwa.py``) is the same place.
+        parts = path.relative_to(package).parts
+        where = "/".join(p if p.startswith("__") else p.removeprefix("_") for p in parts)
+        for name, value, label in _defaults(path, where):
             places[name, value].append(label)
     return {key: " ".join(sorted(set(at))) for key, at in places.items() if len(at) > 1}
 
