@@ -23,7 +23,8 @@ Layers, top to bottom; imports point down only (import-linter contracts in pypro
     nav, control         pure math: planning, the safety limit, diff-drive kinematics
     msgs, runtime        ROS 2-shaped messages; virtual-time loop, actors, topics, QoS, waits
     errors               OtonavError and UsageError (bad input: one line, exit 2)
-Beside them: bench (the stack's own benchmarks), limits (every bound and why).
+Beside them: bench (the stack's own benchmarks), limits (every bound and why), params
+(the parameter models: every default once; numpy-free, the config and the nav math read it).
 """
 
 from otonav._version import __version__

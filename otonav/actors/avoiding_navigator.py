@@ -8,13 +8,14 @@ import math
 import numpy as np
 
 from otonav.actors import topics
-from otonav.actors.navigator import GoalNavigator
+from otonav.actors.navigator import NAME, RATE_HZ, SCAN_TIMEOUT, GoalNavigator
 from otonav.actors.odom_history import OdomHistory
 from otonav.actors.scan_cache import odom_xy_of, points_of, rays_of
 from otonav.msgs import LaserScan, NavDiagnostics, Time
 from otonav.nav.navigate import Navigation
-from otonav.nav.navigation import NavigationParams, NavOutput
+from otonav.nav.navigation import NavOutput
 from otonav.nav.scan import to_frame
+from otonav.params import NavigationParams
 from otonav.runtime import Output
 
 _AT_REST = frozenset({"idle", "waiting", "reached", "unreachable", "fault"})
@@ -39,10 +40,10 @@ class AvoidingNavigator(GoalNavigator):
         *,
         laser_offset_x: float,
         start: tuple[float, float] = (0.0, 0.0),
-        rate_hz: float = 20.0,
+        rate_hz: float = RATE_HZ,
         goal: tuple[float, float] | None = None,
-        scan_timeout: float = 0.5,
-        name: str = "nav",
+        scan_timeout: float = SCAN_TIMEOUT,
+        name: str = NAME,
         remap: dict[str, str] | None = None,
     ) -> None:
         super().__init__(rate_hz=rate_hz, scan_timeout=scan_timeout, name=name, remap=remap)

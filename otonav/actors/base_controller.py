@@ -13,7 +13,10 @@ from otonav.control import DiffDriveGeometry, limit_twist, twist_to_wheels
 from otonav.msgs import HardwareStatus, Header, Log, Time, Twist, WheelCommand
 from otonav.msgs.flat import FlatLayout
 from otonav.msgs.std import split_seconds
+from otonav.params import BaseConfig
 from otonav.runtime import Actor, Input, Output
+
+_DEFAULT = BaseConfig()
 
 WHEEL_COMMAND = FlatLayout(
     WheelCommand.fast(
@@ -30,10 +33,10 @@ WHEEL_COMMAND = FlatLayout(
 class BaseLimits:
     """Velocity (m/s, rad/s) and acceleration (m/s², rad/s²) limits."""
 
-    max_v: float = 0.5
-    max_omega: float = 1.5
-    max_accel: float = 1.0
-    max_alpha: float = 3.0
+    max_v: float = _DEFAULT.max_v
+    max_omega: float = _DEFAULT.max_omega
+    max_accel: float = _DEFAULT.max_accel
+    max_alpha: float = _DEFAULT.max_alpha
 
 
 class BaseController(Actor):
@@ -63,8 +66,8 @@ class BaseController(Actor):
         geometry: DiffDriveGeometry,
         limits: BaseLimits = BaseLimits(),
         *,
-        rate_hz: float = 50.0,
-        cmd_timeout: float = 0.5,
+        rate_hz: float = _DEFAULT.rate_hz,
+        cmd_timeout: float = _DEFAULT.cmd_timeout,
         deadband: float = 0.0,
         name: str = "base",
     ) -> None:

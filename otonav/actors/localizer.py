@@ -9,7 +9,6 @@ base_link)``."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,35 +33,14 @@ from otonav.msgs import (
 )
 from otonav.nav.geometry import wrap_angle
 from otonav.nav.scan_map import ScanMap
-from otonav.nav.scan_match import MatchParams, MatchResult, compose, inverse, match_scan, transform
+from otonav.nav.scan_match import MatchResult, compose, inverse, match_scan, transform
+from otonav.params import LocalizerParams
 from otonav.runtime import Actor, Input, Output
 
 __all__ = ("Localizer", "LocalizerParams")
 
 MAP_FRAME = "map"
 ODOM_FRAME = "odom"
-
-
-@dataclass(frozen=True, slots=True)
-class LocalizerParams:
-    """Settings of :class:`Localizer` (stack config ``nav.localization.*``).
-
-    Attributes:
-        match: the scan matcher's settings.
-        resolution: map cell, m.
-        half_size: the map spans this far from the start in x and y, m.
-        update_distance: a scan is added to the map after the robot moved this far
-            since the last one added, m ...
-        update_angle: ... or turned this much, rad.
-        map_period: /map at most this often, s of sim time (when the map changed).
-    """
-
-    match: MatchParams = field(default_factory=MatchParams)
-    resolution: float = 0.05
-    half_size: float = 10.0
-    update_distance: float = 0.1
-    update_angle: float = 0.1
-    map_period: float = 5.0
 
 
 class Localizer(Actor):

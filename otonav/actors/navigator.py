@@ -23,9 +23,17 @@ from otonav.msgs import (
     Vector3,
 )
 from otonav.nav import GoToGoalParams, GuardParams, go_to_goal, goal_problem, guard_blocked
+from otonav.params import NavConfig
 from otonav.runtime import Actor, Input, Output
 
 _log = logging.getLogger(__name__)
+
+RATE_HZ = NavConfig().rate_hz
+"""A navigator's default rate (``nav.rate_hz``'s), Hz."""
+SCAN_TIMEOUT = 0.5
+"""s of sim time without /scan before a navigator stops driving forward (blind)."""
+NAME = "nav"
+"""The navigator's node name: the stack's ``nav`` actor."""
 
 STOP = Twist.fast(
     linear=Vector3.fast(x=0.0, y=0.0, z=0.0), angular=Vector3.fast(x=0.0, y=0.0, z=0.0)
@@ -154,10 +162,10 @@ class Navigator(GoalNavigator):
         params: GoToGoalParams = GoToGoalParams(),
         guard: GuardParams = GuardParams(),
         *,
-        rate_hz: float = 20.0,
+        rate_hz: float = RATE_HZ,
         goal: tuple[float, float] | None = None,
-        scan_timeout: float = 0.5,
-        name: str = "nav",
+        scan_timeout: float = SCAN_TIMEOUT,
+        name: str = NAME,
         remap: dict[str, str] | None = None,
     ) -> None:
         super().__init__(rate_hz=rate_hz, scan_timeout=scan_timeout, name=name, remap=remap)

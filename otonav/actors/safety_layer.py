@@ -11,9 +11,12 @@ from otonav.actors import topics
 from otonav.actors.odom_history import OdomHistory
 from otonav.actors.scan_cache import nearest_bound_of, nearest_of, points_of
 from otonav.msgs import Header, LaserScan, Odometry, SafetyState, Time, Twist, Vector3
-from otonav.nav.safety import SafetyParams, safe_command, stopping_reach
+from otonav.nav.safety import safe_command, stopping_reach
 from otonav.nav.scan import to_frame
+from otonav.params import SafetyConfig, SafetyParams
 from otonav.runtime import Actor, Input, Output
+
+_DEFAULT = SafetyConfig()
 
 _STOP = Twist.fast(
     linear=Vector3.fast(x=0.0, y=0.0, z=0.0), angular=Vector3.fast(x=0.0, y=0.0, z=0.0)
@@ -41,9 +44,9 @@ class SafetyLayer(Actor):
         params: SafetyParams,
         *,
         laser_offset_x: float,
-        rate_hz: float = 20.0,
-        cmd_timeout: float = 0.25,
-        scan_timeout: float = 0.35,
+        rate_hz: float = _DEFAULT.rate_hz,
+        cmd_timeout: float = _DEFAULT.cmd_timeout,
+        scan_timeout: float = _DEFAULT.scan_timeout,
         name: str = "safety",
     ) -> None:
         super().__init__(name)

@@ -8,8 +8,9 @@ from otonav.nav.geometry import goal_problem, wrap_angle
 from otonav.nav.go_to_goal import GoalCommand, GoToGoalParams, go_to_goal
 from otonav.nav.guard import GuardParams, guard_blocked
 from otonav.nav.navigate import Navigation
-from otonav.nav.navigation import NavigationParams, NavOutput
+from otonav.nav.navigation import NavOutput
 from otonav.nav.safety import SafetyParams, SafetyResult, safe_command
+from otonav.params import NavigationParams
 
 __all__ = (
     "DwaParams",

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 from otonav.nav.dwa import ClearanceFn, DwaResult, clear_arc, dwa_step
 from otonav.nav.geometry import wrap_angle
 from otonav.nav.local_clearance import local_clearance, nearby
-from otonav.nav.navigation import NavigationParams
 from otonav.nav.planner import GlobalPlanner
+from otonav.params import NavigationParams
 
 __all__ = ("Command", "Controller")
 

@@ -34,6 +34,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from otonav.nav.scan import ScanRays
+from otonav.params import NavigationParams
+
+_NAV = NavigationParams()
 
 __all__ = ("ClearanceMap", "GridFrame", "square_grid")
 
@@ -79,8 +82,8 @@ class ClearanceMap:
         centre_x: float,
         centre_y: float,
         *,
-        half_size: float = 10.0,
-        resolution: float = 0.05,
+        half_size: float = _NAV.map_half_size,
+        resolution: float = _NAV.map_resolution,
         max_distance: float = 0.6,
     ) -> None:
         frame = square_grid("ClearanceMap", centre_x, centre_y, half_size, resolution, max_distance)

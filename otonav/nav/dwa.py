@@ -60,12 +60,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, fields
 from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
+
+from otonav.params import DwaParams
 
 __all__ = ("ClearanceFn", "DwaParams", "DwaResult", "PointClearanceFn", "clear_arc", "dwa_step")
 
@@ -74,72 +75,6 @@ ClearanceFn = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.fl
 
 PointClearanceFn = Callable[[float, float], float]
 """One point (x, y) in odom -> distance to the nearest return, m (as :data:`ClearanceFn`)."""
-
-
-@dataclass(frozen=True, slots=True)
-class DwaParams:
-    """Settings of :func:`dwa_step`.
-
-    Attributes:
-        max_v: forward speed limit, m/s (> 0).
-        max_omega: yaw-rate limit, rad/s (> 0).
-        max_accel: linear acceleration limit (the base's), m/s^2 (> 0).
-        max_alpha: angular acceleration limit (the base's), rad/s^2 (> 0).
-        period: control period: the window is what the limits reach in it, s (> 0).
-        horizon: rollout length, s (> 0).
-        dt: rollout pose spacing, s (> 0, <= horizon).
-        v_samples: speed samples across the window (>= 1).
-        omega_samples: yaw-rate samples across the window (>= 1).
-        radius: centre clearance to keep (footprint.centre_clearance), m (>= 0).
-        latency: command delay before braking starts, s (>= 0).
-        clearance_cap: clearance beyond which more is not better, m (> 0).
-        w_heading, w_progress, w_clearance, w_speed: score weights (>= 0).
-        rotate_threshold: with the target farther off the heading than this, rad, the
-            window's speeds shrink to its lowest (slow down and turn toward it first,
-            like Nav2's rotation shim) (>= 0).
-        fast_path: try :func:`clear_arc` before sampling (module docstring).
-        fast_margin: clearance beyond ``radius`` the fast path's arc keeps, m (>= 0).
-    """
-
-    max_v: float = 0.4
-    max_omega: float = 1.2
-    max_accel: float = 1.0
-    max_alpha: float = 3.0
-    period: float = 0.05
-    horizon: float = 1.6
-    dt: float = 0.2
-    v_samples: int = 5
-    omega_samples: int = 13
-    radius: float = 0.33
-    latency: float = 0.1
-    clearance_cap: float = 0.25
-    w_heading: float = 1.0
-    w_progress: float = 2.0
-    w_clearance: float = 0.6
-    w_speed: float = 0.3
-    rotate_threshold: float = 0.6
-    fast_path: bool = True
-    fast_margin: float = 0.2
-
-    def __post_init__(self) -> None:
-        positive: tuple[str, ...] = ("max_v", "max_omega", "max_accel", "max_alpha")
-        positive += ("period", "horizon", "dt", "clearance_cap")
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if f.name == "fast_path":
-                if not isinstance(value, bool):
-                    raise ValueError(f"DwaParams.fast_path must be a bool, got {value!r}")
-                continue
-            if f.name in ("v_samples", "omega_samples"):
-                if not (isinstance(value, int) and value >= 1):
-                    raise ValueError(f"DwaParams.{f.name} must be an integer >= 1, got {value!r}")
-                continue
-            low_ok = value > 0.0 if f.name in positive else value >= 0.0
-            if not (math.isfinite(value) and low_ok):
-                bound = "> 0" if f.name in positive else ">= 0"
-                raise ValueError(f"DwaParams.{f.name} must be finite and {bound}, got {value!r}")
-        if self.dt > self.horizon:
-            raise ValueError(f"DwaParams.dt ({self.dt} s) must be <= horizon ({self.horizon} s)")
 
 
 class DwaResult(NamedTuple):

@@ -47,13 +47,17 @@ class GridPath:
         return bool(self.cells)
 
 
+MAX_EXPANSIONS = 200_000
+"""Cells a search expands at most before it gives up (no proof either way)."""
+
+
 def astar(
     free: NDArray[np.bool_],
     penalty: NDArray[np.floating[Any]],
     start: tuple[int, int],
     goal: tuple[int, int],
     *,
-    max_expansions: int = 200_000,
+    max_expansions: int = MAX_EXPANSIONS,
 ) -> GridPath:
     """Shortest 8-connected path of free cells from ``start`` to ``goal``, in one call
     (:class:`AstarSearch` run to the end).
@@ -89,7 +93,7 @@ class AstarSearch:
         start: tuple[int, int],
         goal: tuple[int, int],
         *,
-        max_expansions: int = 200_000,
+        max_expansions: int = MAX_EXPANSIONS,
     ) -> None:
         if free.shape != penalty.shape or free.ndim != 2:
             raise ValueError(f"free {free.shape} and penalty {penalty.shape} must be one 2-D shape")

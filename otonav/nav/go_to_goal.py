@@ -7,43 +7,13 @@ the output is a body twist for ``base_link`` (x forward, yaw CCW), m/s and rad/s
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 from otonav.control.kinematics import Pose2D
 from otonav.nav.geometry import wrap_angle
+from otonav.params import GoToGoalParams
 
 __all__ = ("GoToGoalParams", "GoalCommand", "go_to_goal")
-
-
-@dataclass(frozen=True, slots=True)
-class GoToGoalParams:
-    """Gains and limits of the go-to-goal controller.
-
-    Attributes:
-        kp_lin: forward speed per metre of distance to goal, 1/s (>= 0).
-        kp_ang: yaw rate per radian of heading error, 1/s (>= 0).
-        max_v: forward speed limit, m/s (>= 0).
-        max_omega: yaw-rate limit, rad/s (>= 0).
-        tolerance: goal counts as reached at or below this distance, m (>= 0).
-        turn_in_place_threshold: above this absolute heading error, rad, the robot
-            turns in place (v = 0); at or below it, it drives with v scaled by
-            cos(heading error).
-    """
-
-    kp_lin: float = 0.8
-    kp_ang: float = 2.0
-    max_v: float = 0.5
-    max_omega: float = 1.5
-    tolerance: float = 0.1
-    turn_in_place_threshold: float = 0.6
-
-    def __post_init__(self) -> None:
-        for field in fields(self):
-            value = getattr(self, field.name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ValueError(
-                    f"GoToGoalParams.{field.name} must be finite and >= 0, got {value!r}"
-                )
 
 
 @dataclass(frozen=True, slots=True)

@@ -8,39 +8,15 @@ x; ranges are in m.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from functools import lru_cache
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from otonav.params import GuardParams
+
 __all__ = ("GuardParams", "guard_blocked")
-
-
-@dataclass(frozen=True, slots=True)
-class GuardParams:
-    """Obstacle guard settings.
-
-    Attributes:
-        sector_half_angle: half-width of the guarded sector around straight ahead,
-            rad, in [0, pi].
-        stop_distance: blocked when a valid return in the sector is at or below this
-            range, m (>= 0).
-    """
-
-    sector_half_angle: float = 0.5
-    stop_distance: float = 0.35
-
-    def __post_init__(self) -> None:
-        if not (math.isfinite(self.sector_half_angle) and 0.0 <= self.sector_half_angle <= math.pi):
-            raise ValueError(
-                f"GuardParams.sector_half_angle must be in [0, pi], got {self.sector_half_angle!r}"
-            )
-        if not (math.isfinite(self.stop_distance) and self.stop_distance >= 0.0):
-            raise ValueError(
-                f"GuardParams.stop_distance must be finite and >= 0, got {self.stop_distance!r}"
-            )
 
 
 @lru_cache(maxsize=16)

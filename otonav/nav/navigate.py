@@ -27,10 +27,11 @@ from numpy.typing import NDArray
 from otonav.nav.controller import Controller
 from otonav.nav.dwa import DwaResult
 from otonav.nav.geometry import wrap_angle
-from otonav.nav.navigation import NavigationParams, NavOutput
+from otonav.nav.navigation import NavOutput
 from otonav.nav.planner import GlobalPlanner, Plan
 from otonav.nav.recovery import Points, Pose, ProgressChecker, Recovery, Stage
 from otonav.nav.scan import ScanRays
+from otonav.params import NavigationParams
 
 __all__ = ("Navigation",)
 

@@ -18,10 +18,10 @@ from numpy.typing import NDArray
 
 from otonav.nav.costmap import ClearanceMap
 from otonav.nav.global_path import AstarSearch, GridPath
-from otonav.nav.navigation import NavigationParams
 from otonav.nav.observed_hull import ObservedHull, free_ends
 from otonav.nav.plan_grid import best_points, free_threshold, pooled
 from otonav.nav.scan import ScanRays
+from otonav.params import NavigationParams
 
 __all__ = ("LOOKAHEAD_TIME", "MIN_LOOKAHEAD", "GlobalPlanner", "Plan")
 

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from otonav.nav.costmap import ClearanceMap
 from otonav.nav.geometry import wrap_angle
-from otonav.nav.navigation import NavigationParams as Params
+from otonav.params import NavigationParams as Params
 
 __all__ = (
     "LADDER",

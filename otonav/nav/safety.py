@@ -25,45 +25,14 @@ cannot matter and are skipped (the common case costs one distance per return).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
+from otonav.params import SafetyParams
+
 __all__ = ("SafetyParams", "SafetyResult", "safe_command", "stopping_reach")
-
-
-@dataclass(frozen=True, slots=True)
-class SafetyParams:
-    """Settings of :func:`safe_command`.
-
-    Attributes:
-        radius: centre clearance to keep (footprint.centre_clearance), m (> 0).
-        max_accel: the base's linear acceleration/deceleration limit, m/s^2 (> 0).
-        max_alpha: the base's angular acceleration limit, rad/s^2 (> 0).
-        latency: delay before braking starts, s (>= 0).
-        dt: integration step of the stopping path, s (> 0).
-        scales: forward-speed scales tried, from 1 down to 0 (>= 2).
-    """
-
-    radius: float = 0.33
-    max_accel: float = 1.0
-    max_alpha: float = 3.0
-    latency: float = 0.12
-    dt: float = 0.02
-    scales: int = 6
-
-    def __post_init__(self) -> None:
-        for f in fields(self):
-            value = getattr(self, f.name)
-            if f.name == "scales":
-                if not (isinstance(value, int) and value >= 2):
-                    raise ValueError(f"SafetyParams.scales must be an integer >= 2, got {value!r}")
-                continue
-            ok = value >= 0.0 if f.name == "latency" else value > 0.0
-            if not (math.isfinite(value) and ok):
-                bound = ">= 0" if f.name == "latency" else "> 0"
-                raise ValueError(f"SafetyParams.{f.name} must be finite and {bound}, got {value!r}")
 
 
 @dataclass(frozen=True, slots=True)

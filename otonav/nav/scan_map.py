@@ -27,6 +27,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from otonav.nav.costmap import square_grid
+from otonav.params import LocalizerParams
+
+_LOC = LocalizerParams()
 
 __all__ = ("CLAMP", "HIT", "MISS", "ScanMap", "normals")
 
@@ -72,9 +75,9 @@ class ScanMap:
         centre_x: float,
         centre_y: float,
         *,
-        half_size: float = 10.0,
-        resolution: float = 0.05,
-        max_distance: float = 0.3,
+        half_size: float = _LOC.half_size,
+        resolution: float = _LOC.resolution,
+        max_distance: float = _LOC.match.max_distance,
     ) -> None:
         frame = square_grid("ScanMap", centre_x, centre_y, half_size, resolution, max_distance)
         self.resolution = resolution

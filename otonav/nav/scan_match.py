@@ -34,7 +34,6 @@ A match is trusted (``ok``) when at least ``min_inliers`` of the points lie with
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -42,6 +41,7 @@ from numpy.typing import NDArray
 
 from otonav.nav.geometry import wrap_angle
 from otonav.nav.scan_map import ScanMap
+from otonav.params import MatchParams
 
 __all__ = (
     "MatchParams",
@@ -57,49 +57,6 @@ __all__ = (
 
 Pose = tuple[float, float, float]
 Array = NDArray[np.float64]
-
-
-@dataclass(frozen=True, slots=True)
-class MatchParams:
-    """Settings of :func:`match_scan` (stack config ``nav.localization.*``).
-
-    Attributes:
-        linear_window: the correlative search spans +- this in x and y, m.
-        linear_step: its spacing in x and y, m.
-        angular_window: it spans +- this in yaw, rad.
-        angular_step: its spacing in yaw, rad.
-        max_distance: a point this far or farther from the map is not matched, m.
-        prior: weight of the pull toward the prediction, per m^2 (the scan's own
-            term is a sum of squared metres over its points). With 0, a scan that
-            constrains nothing leaves the refinement where it started.
-        yaw_scale: m of the prior per rad of yaw.
-        iterations: Gauss-Newton steps at most.
-        min_inliers: fraction of the points that must lie within ``max_distance``.
-    """
-
-    linear_window: float = 0.1
-    linear_step: float = 0.05
-    angular_window: float = 0.06
-    angular_step: float = 0.02
-    max_distance: float = 0.3
-    prior: float = 1.0
-    yaw_scale: float = 1.0
-    iterations: int = 10
-    min_inliers: float = 0.3
-
-    def __post_init__(self) -> None:
-        for name in ("linear_window", "angular_window", "prior", "yaw_scale"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0.0):
-                raise ValueError(f"MatchParams.{name} must be finite and >= 0, got {value!r}")
-        for name in ("linear_step", "angular_step", "max_distance"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0.0):
-                raise ValueError(f"MatchParams.{name} must be finite and > 0, got {value!r}")
-        if self.iterations < 0:
-            raise ValueError(f"MatchParams.iterations must be >= 0, got {self.iterations}")
-        if not 0.0 <= self.min_inliers <= 1.0:
-            raise ValueError(f"MatchParams.min_inliers must be in [0, 1], got {self.min_inliers}")
 
 
 class MatchResult(NamedTuple):

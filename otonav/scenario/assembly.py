@@ -11,6 +11,7 @@ from typing import Any
 from otonav import limits
 from otonav.hal import RobotHardwareInterface
 from otonav.hal.types import Reach
+from otonav.params import NavConfig
 from otonav.record.outlock import lock_output
 from otonav.runtime import (
     Actor,
@@ -23,7 +24,6 @@ from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
 from otonav.scenario.validate import check_cost, check_goal
 from otonav.stack import StackConfig, build_actors, build_world
-from otonav.stack.config import NavConfig
 from otonav.stack.robot import describe_robot, reached, slower
 from otonav.stack.session import StackSession
 

@@ -10,16 +10,8 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING
 
-from otonav.stack.config import (
-    BaseConfig,
-    DwaConfig,
-    GuardConfig,
-    NavConfig,
-    RatesConfig,
-    SafetyConfig,
-    StackConfig,
-    WorldConfig,
-)
+from otonav.params import BaseConfig, DwaConfig, GuardConfig, NavConfig, SafetyConfig
+from otonav.stack.config import RatesConfig, StackConfig, WorldConfig
 from otonav.stack.files import ConfigFileError, describe_validation_error, to_json
 from otonav.stack.overrides import apply_overrides
 

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import itertools
-import warnings
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from dataclasses import fields
+from functools import reduce
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from otonav.actors import (
     EXTERNAL_COMMAND_WAIT,
@@ -19,18 +20,23 @@ from otonav.actors import (
     topics,
 )
 from otonav.actors.localized_navigator import LocalizedNavigator
-from otonav.actors.localizer import Localizer, LocalizerParams
+from otonav.actors.localizer import Localizer
 from otonav.actors.odometry_error import OdometryError
 from otonav.control import DiffDriveGeometry
 from otonav.hal import BoxObstacle, RobotGeometry, RobotHardwareInterface
 from otonav.hal.mujoco import MujocoInterface
 from otonav.hal.types import Reach
-from otonav.nav import GoToGoalParams, GuardParams
-from otonav.nav.dwa import DwaParams
 from otonav.nav.footprint import centre_clearance
-from otonav.nav.navigation import NavigationParams
-from otonav.nav.safety import SafetyParams
-from otonav.nav.scan_match import MatchParams
+from otonav.params import (
+    CONFIG_KEYS,
+    DwaParams,
+    GoToGoalParams,
+    GuardParams,
+    LocalizerParams,
+    MatchParams,
+    NavigationParams,
+    SafetyParams,
+)
 from otonav.runtime import Actor
 from otonav.stack.config import StackConfig
 from otonav.stack.files import ConfigFileError
@@ -47,6 +53,8 @@ from otonav.stack.robot import (
 
 if TYPE_CHECKING:
     from otonav.hal.can import CanBusInterface
+
+P = TypeVar("P")
 
 _VIRTUAL_BUSES = itertools.count()
 """Each stack's virtual CAN channel is private: concurrent stacks never hear each other."""
@@ -128,17 +136,8 @@ def _can_world(config: StackConfig, world: MujocoInterface) -> CanBusInterface:
                 seed=sim.seed,
                 schedule=fault_plan(sim.faults),
             )
-        limits = MonitorLimits(
-            startup_timeout=can.startup_timeout,
-            heartbeat_timeout=can.heartbeat_timeout,
-            encoder_timeout=can.encoder_timeout,
-            encoder_period=can.encoder_period,
-            max_frame_loss=can.max_frame_loss,
-            loss_window=can.loss_window,
-            recovery_delay=can.recovery_delay,
-            max_recovery_attempts=can.max_recovery_attempts,
-            recovery_reset=can.recovery_reset,
-        )
+        # hal.can's fault-detection keys are MonitorLimits' fields, by name.
+        limits = MonitorLimits(**{f.name: getattr(can, f.name) for f in fields(MonitorLimits)})
         return CanBusInterface(
             host,
             world,
@@ -160,25 +159,18 @@ def build_actors(
     config: StackConfig,
     hal: RobotHardwareInterface,
     *,
-    navigator: bool = True,
     goal: tuple[float, float] | None = None,
     initial_pose: tuple[float, float, float] = (0.0, 0.0, 0.0),
 ) -> list[Actor]:
     """bridge + base controller, the planner ``nav.planner`` names and the safety layer
     (``safety.enabled``) for ``hal``. ``initial_pose`` is where odometry starts (the known
-    start pose: odom is then the world frame). ``navigator=False``: deprecated spelling
-    of ``nav.planner: external`` (the safety layer stays; ADR 0055)."""
-    if not navigator:
-        config, navigator = external_planner(config), True
+    start pose: odom is then the world frame)."""
     geometry = hal.geometry
     rates, base, nav, guard = config.rates, robot_base(config), config.nav, config.guard
     actors: list[Actor] = [
         Bridge(
             hal,
-            clock_hz=rates.clock_hz,
-            odom_hz=rates.odom_hz,
-            imu_hz=rates.imu_hz,
-            scan_hz=rates.scan_hz,
+            **rates.model_dump(),
             initial_pose=initial_pose,
             odometry_error=odometry_error(config),
             frames=robot_frames(config.robot),
@@ -207,77 +199,66 @@ def build_actors(
                 start=(initial_pose[0], initial_pose[1]),
             )
         )
-    if navigator:
-        remap = {topics.CMD_VEL: topics.CMD_VEL_NAV} if config.safety.enabled else None
-        if nav.planner == "stop":
-            actors.append(
-                Navigator(
-                    GoToGoalParams(
-                        kp_lin=nav.kp_lin,
-                        kp_ang=nav.kp_ang,
-                        max_v=nav_speeds(config)[0],
-                        max_omega=nav_speeds(config)[1],
-                        tolerance=nav.tolerance,
-                        turn_in_place_threshold=nav.turn_in_place_threshold,
-                    ),
-                    GuardParams(guard.sector_half_angle, guard.stop_distance),
-                    rate_hz=nav.rate_hz,
-                    goal=goal,
-                    remap=remap,
-                )
+    remap = {topics.CMD_VEL: topics.CMD_VEL_NAV} if config.safety.enabled else None
+    if nav.planner == "stop":
+        actors.append(
+            Navigator(
+                _from_config(
+                    GoToGoalParams,
+                    config,
+                    max_v=nav_speeds(config)[0],
+                    max_omega=nav_speeds(config)[1],
+                ),
+                GuardParams(guard.sector_half_angle, guard.stop_distance),
+                rate_hz=nav.rate_hz,
+                goal=goal,
+                remap=remap,
             )
-        elif nav.planner == "dwa":
-            navigator_class = LocalizedNavigator if nav.localization.enabled else AvoidingNavigator
-            actors.append(
-                navigator_class(
-                    navigation_params(config, geometry, reached(config, hal)),
-                    laser_offset_x=geometry.laser_offset_x,
-                    start=(initial_pose[0], initial_pose[1]),
-                    rate_hz=nav.rate_hz,
-                    goal=goal,
-                    remap=remap,
-                )
+        )
+    elif nav.planner == "dwa":
+        navigator_class = LocalizedNavigator if nav.localization.enabled else AvoidingNavigator
+        actors.append(
+            navigator_class(
+                navigation_params(config, geometry, reached(config, hal)),
+                laser_offset_x=geometry.laser_offset_x,
+                start=(initial_pose[0], initial_pose[1]),
+                rate_hz=nav.rate_hz,
+                goal=goal,
+                remap=remap,
             )
-        if config.safety.enabled:
-            actors.append(
-                SafetyLayer(
-                    safety_params(config, geometry),
-                    laser_offset_x=geometry.laser_offset_x,
-                    rate_hz=config.safety.rate_hz,
-                    cmd_timeout=config.safety.cmd_timeout,
-                    scan_timeout=config.safety.scan_timeout,
-                )
+        )
+    if config.safety.enabled:
+        actors.append(
+            SafetyLayer(
+                safety_params(config, geometry),
+                laser_offset_x=geometry.laser_offset_x,
+                rate_hz=config.safety.rate_hz,
+                cmd_timeout=config.safety.cmd_timeout,
+                scan_timeout=config.safety.scan_timeout,
             )
-        if nav.planner == "external":
-            # Nobody may be publishing the planner's commands: say so early.
-            topic = topics.CMD_VEL_NAV if config.safety.enabled else topics.CMD_VEL
-            actors.append(CommandWatch(topic, within=EXTERNAL_COMMAND_WAIT))
+        )
+    if nav.planner == "external":
+        # Nobody may be publishing the planner's commands: say so early.
+        topic = topics.CMD_VEL_NAV if config.safety.enabled else topics.CMD_VEL
+        actors.append(CommandWatch(topic, within=EXTERNAL_COMMAND_WAIT))
     return launch(actors, config.actors)
 
 
-def external_planner(config: StackConfig) -> StackConfig:
-    """``config`` with ``nav.planner: external`` (what ``navigator=False`` means), with a
-    DeprecationWarning for that spelling."""
-    warnings.warn(
-        "navigator=False is deprecated: set nav.planner: external in the stack config (the "
-        "safety layer stays unless safety.enabled: false)",
-        DeprecationWarning,
-        stacklevel=3,
-    )
-    return config.model_copy(update={"nav": config.nav.model_copy(update={"planner": "external"})})
-
-
-_MAP_NAMES = {"half_size": "map_half_size", "resolution": "map_resolution"}
-"""``nav.map`` fields whose NavigationParams name says "map" (the others match)."""
+def _from_config(cls: type[P], config: StackConfig, **derived: Any) -> P:
+    """``cls`` with each field its config key sets (:data:`otonav.params.CONFIG_KEYS`)
+    read from ``config``, but those ``derived`` here."""
+    keys = CONFIG_KEYS[cls].items()
+    read = {name: reduce(getattr, key.split("."), config) for name, key in keys}
+    return cls(**{**read, **derived})
 
 
 def navigation_params(
     config: StackConfig, geometry: RobotGeometry, reach: Reach | None = None
 ) -> NavigationParams:
     """The avoiding navigator's settings from ``nav.*`` and the base's limits: the
-    ``nav.dwa``, ``nav.map`` and ``nav.recovery`` sections pass through by name (their
-    defaults are NavigationParams' and DwaParams', ADR 0054); what depends on the base
-    or the footprint is derived here. ``reach``: what the robot really reaches (ADR
+    ``nav.dwa``, ``nav.map`` and ``nav.recovery`` sections pass through by their keys
+    (``otonav.params.CONFIG_KEYS``); what depends on the base or the footprint is
+    derived here. ``reach``: what the robot really reaches (ADR
     0066): the DWA's window grows by the accelerations it really has, and a robot slower
     than asked gets a progress window as much longer as it is slower. The window's top
     stays the asked speed: a servo short of its setpoint reaches most when asked most."""
@@ -289,30 +270,25 @@ def navigation_params(
     accel, alpha = base.max_accel, base.max_alpha
     if reach is not None:
         accel, alpha = min(accel, reach.accel), min(alpha, reach.alpha)
-    dwa = DwaParams(
-        **nav.dwa.model_dump(),
+    dwa = _from_config(
+        DwaParams,
+        config,
         max_v=fastest_v,
         max_omega=fastest_omega,
         max_accel=accel,
         max_alpha=alpha,
         period=1.0 / nav.rate_hz,
         radius=radius,
-        rotate_threshold=nav.turn_in_place_threshold,
     )
-    grid = {_MAP_NAMES.get(k, k): v for k, v in nav.map.model_dump().items()}
-    recovery = nav.recovery.model_dump()
-    recovery["progress_window"] /= slower(reach)
-    for name in ("backup_speed", "follow_speed"):
-        recovery[name] = min(recovery[name], fastest_v)
-    recovery["spin_speed"] = min(recovery["spin_speed"], fastest_omega)
-    return NavigationParams(
+    recovery = nav.recovery
+    return _from_config(
+        NavigationParams,
+        config,
         dwa=dwa,
-        tolerance=nav.tolerance,
-        approach_radius=nav.approach_radius,
-        kp_lin=nav.kp_lin,
-        kp_ang=nav.kp_ang,
-        **grid,
-        **recovery,
+        progress_window=recovery.progress_window / slower(reach),
+        backup_speed=min(recovery.backup_speed, fastest_v),
+        follow_speed=min(recovery.follow_speed, fastest_v),
+        spin_speed=min(recovery.spin_speed, fastest_omega),
     )
 
 
@@ -321,9 +297,7 @@ def odometry_error(config: StackConfig) -> OdometryError | None:
     error = config.world.odometry_error
     if not error.enabled:
         return None
-    return OdometryError(
-        scale=error.scale, gyro_bias=error.gyro_bias, gyro_noise=error.gyro_noise, seed=error.seed
-    )
+    return OdometryError(**error.model_dump())
 
 
 def localizer_params(config: StackConfig) -> LocalizerParams:
@@ -346,13 +320,12 @@ def localizer_params(config: StackConfig) -> LocalizerParams:
 
 def safety_params(config: StackConfig, geometry: RobotGeometry) -> SafetyParams:
     """The safety layer's settings from ``safety.*``, the base's limits and rates."""
-    safety, base = config.safety, robot_base(config)
-    return SafetyParams(
+    safety, base = config.safety, config.base
+    return _from_config(
+        SafetyParams,
+        config,
         radius=centre_clearance(
             safety.clearance, geometry.footprint_radius, safety.footprint_padding
         ),
-        max_accel=base.max_accel,
-        max_alpha=base.max_alpha,
         latency=1.0 / safety.rate_hz + 1.0 / base.rate_hz + safety.drive_lag,
-        scales=safety.scales,
     )

@@ -1,5 +1,7 @@
-"""The launch file as data: pydantic models are the schema, defaults live here (an
-installed wheel runs with no checkout); YAML files in ``config/`` override them."""
+"""The launch file as data: pydantic models are the schema, defaults live in them (an
+installed wheel runs with no checkout); YAML files in ``config/`` override them. The
+sections that set the robot's base, the navigator, the guard and the safety layer are
+the parameter models' (:mod:`otonav.params`, numpy-free)."""
 
 from __future__ import annotations
 
@@ -8,7 +10,6 @@ from typing import Annotated, Any, Literal
 
 from pydantic import (
     AfterValidator,
-    BaseModel,
     ConfigDict,
     Field,
     PositiveFloat,
@@ -17,22 +18,7 @@ from pydantic import (
 )
 
 from otonav import limits
-from otonav.nav.dwa import DwaParams
-from otonav.nav.navigation import NavigationParams
-from otonav.nav.safety import SafetyParams
-
-# The nav settings' defaults have one home: the nav parameter dataclasses (issue 31,
-# ADR 0054). The sections below carry the bounds, the units and the YAML names;
-# stack.build passes each section's fields through by name.
-_DWA = DwaParams()
-_NAV = NavigationParams()
-_SAFETY = SafetyParams()
-
-
-class _Section(BaseModel):
-    # strict: "yes" is not 1.0 and "3" is not 3 (a number in YAML is still a number).
-    # allow_inf_nan=False: '.inf' is a YAML float, and an infinite rate is a zero period.
-    model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
+from otonav.params import BaseConfig, GuardConfig, NavConfig, SafetyConfig, Section
 
 
 def _within(lo: float, hi: float, unit: str = "", *, open_low: bool = False) -> AfterValidator:
@@ -57,7 +43,7 @@ _NodeId = Annotated[int, _within(0, 63)]
 """An ODrive CAN Simple node id: 6 bits."""
 
 
-class OdometryErrorConfig(_Section):
+class OdometryErrorConfig(Section):
     """A deterministic odometry error model for simulation (all zero: off): what a
     mis-calibrated wheel radius and a biased, noisy gyro do to the bridge's /odom (and
     /tf odom -> base_link). /imu and ground truth are untouched."""
@@ -79,7 +65,7 @@ class OdometryErrorConfig(_Section):
         return self.scale != 0.0 or self.gyro_bias != 0.0 or self.gyro_noise != 0.0
 
 
-class WorldConfig(_Section):
+class WorldConfig(Section):
     """The simulated world (``otonav.hal.mujoco``)."""
 
     scene: str = Field("obstacles", min_length=1, max_length=limits.MAX_PATH_CHARS)
@@ -101,7 +87,7 @@ class WorldConfig(_Section):
     """Simulated odometry drift (off by default): see :class:`OdometryErrorConfig`."""
 
 
-class RatesConfig(_Section):
+class RatesConfig(Section):
     """Bridge publishing rates, Hz. Each at most the physics tick rate (1 / timestep):
     a timer cannot fire more often than the world ticks."""
 
@@ -111,215 +97,7 @@ class RatesConfig(_Section):
     scan_hz: PositiveFloat = 10.0
 
 
-class BaseConfig(_Section):
-    """Base controller: rate, watchdog, velocity and acceleration limits."""
-
-    rate_hz: PositiveFloat = 50.0
-    cmd_timeout: PositiveFloat = 0.5
-    """s of sim time without a valid /cmd_vel before the wheels stop (watchdog)."""
-    # Bounded so that wheel speeds stay finite and the limits still limit (limits.py).
-    max_v: PositiveFloat = Field(0.5, le=limits.MAX_BASE_V)
-    """m/s, the fastest the base drives, whatever /cmd_vel asks (``robot.max_v``, when
-    stated, sets it)."""
-    max_omega: PositiveFloat = Field(1.5, le=limits.MAX_BASE_OMEGA)
-    """rad/s, the fastest the base turns."""
-    max_accel: PositiveFloat = Field(1.0, le=limits.MAX_BASE_ACCEL)
-    """m/s², linear acceleration limit."""
-    max_alpha: PositiveFloat = Field(3.0, le=limits.MAX_BASE_ALPHA)
-    """rad/s², angular acceleration limit."""
-
-
-class DwaConfig(_Section):
-    """The DWA local planner (``nav.planner = dwa``; otonav.nav.dwa). Its window is
-    what the base's ``max_accel`` / ``max_alpha`` reach in one nav period."""
-
-    horizon: float = Field(_DWA.horizon, gt=0.0, le=10.0)
-    """s, rollout length, in (0, 10]."""
-    dt: float = Field(_DWA.dt, gt=0.0, le=1.0)
-    """s, spacing of the rollout poses, in (0, 1] and <= horizon."""
-    v_samples: int = Field(_DWA.v_samples, ge=1, le=50)
-    """speed samples across the window, in [1, 50]."""
-    omega_samples: int = Field(_DWA.omega_samples, ge=1, le=100)
-    """yaw-rate samples across the window, in [1, 100]."""
-    latency: float = Field(_DWA.latency, ge=0.0, le=2.0)
-    """s, command delay assumed before braking (admissibility), in [0, 2]."""
-    clearance_cap: float = Field(_DWA.clearance_cap, gt=0.0, le=5.0)
-    """m, clearance beyond the centre clearance that stops scoring, in (0, 5]."""
-    w_heading: float = Field(_DWA.w_heading, ge=0.0, le=100.0)
-    """score weight of heading to the target at the rollout's end, in [0, 100]."""
-    w_progress: float = Field(_DWA.w_progress, ge=0.0, le=100.0)
-    """score weight of distance gained toward the target, in [0, 100]."""
-    w_clearance: float = Field(_DWA.w_clearance, ge=0.0, le=100.0)
-    """score weight of clearance along the rollout, in [0, 100]."""
-    w_speed: float = Field(_DWA.w_speed, ge=0.0, le=100.0)
-    """score weight of forward speed, in [0, 100]."""
-    fast_path: bool = _DWA.fast_path
-    """try the pure-pursuit arc to the target first and skip the sampling when it
-    provably keeps ``fast_margin`` beyond the centre clearance (otonav.nav.dwa)."""
-    fast_margin: float = Field(_DWA.fast_margin, ge=0.0, le=5.0)
-    """m, clearance beyond the centre clearance the fast path's arc keeps, in [0, 5]."""
-
-
-class MapConfig(_Section):
-    """The navigator's map of the scans and its global planner (A*)."""
-
-    half_size: float = Field(_NAV.map_half_size, gt=0.0, le=100.0)
-    """m, the map spans this far from the start pose in x and y, in (0, 100]."""
-    resolution: float = Field(_NAV.map_resolution, ge=0.005, le=0.2)
-    """m, map cell, in [0.005, 0.2]. Clearances read from the map are lower bounds,
-    short by up to resolution * sqrt(2); 5 cm marks 4x fewer kernel cells per return
-    than 2.5 cm (the map update was the planner's largest cost)."""
-    plan_resolution: float = Field(_NAV.plan_resolution, ge=0.005, le=1.0)
-    """m, global planner cell (a multiple of ``resolution``), in [0.005, 1]."""
-    plan_penalty: float = Field(_NAV.plan_penalty, ge=0.0, le=100.0)
-    """extra path cost per cell near obstacles (0: shortest path), in [0, 100]."""
-    replan_period: float = Field(_NAV.replan_period, gt=0.0, le=60.0)
-    """s, how often the path ahead is checked for new obstacles, in (0, 60]."""
-    lookahead: float = Field(_NAV.lookahead, gt=0.0, le=10.0)
-    """m, the DWA heads for the path point this far ahead at full speed (2 s of the
-    current speed when slower, at least 0.4 m: Nav2 RPP's scaled lookahead), in (0, 10]."""
-    max_expansions: int = Field(_NAV.max_expansions, ge=100, le=10_000_000)
-    """A* gives up (no proof either way) after this many cells, in [100, 1e7]."""
-    expansions_per_tick: int = Field(_NAV.expansions_per_tick, ge=10, le=10_000_000)
-    """A* expands at most this many cells per navigator step; a longer search goes on
-    at the next step (bounded tick time, ADR 0043), in [10, 1e7]."""
-    clear_range: float = Field(_NAV.clear_range, ge=0.0, le=100.0)
-    """m, before a replan the map frees the cells within this range that the last
-    scan saw through (a moved obstacle, a misread); 0: never, in [0, 100]."""
-
-
-class RecoveryConfig(_Section):
-    """Progress checker and recovery ladder (spin, backup, follow, then unreachable):
-    with the defaults the whole ladder, stuck robot to ``unreachable``, takes at most
-    4 x 3.5 s of windows + 2.1 + 2.5 + 5 s of rungs = 23.6 s of sim time."""
-
-    progress_distance: float = Field(_NAV.progress_distance, gt=0.0, le=10.0)
-    """m, progress that counts, in (0, 10]."""
-    progress_window: float = Field(_NAV.progress_window, gt=0.0, le=600.0)
-    """s of sim time to shrink the distance to go along the path by
-    ``progress_distance`` (what the robot does, not what the planner says), in (0, 600]."""
-    goal_progress_window: float = Field(_NAV.goal_progress_window, gt=0.0, le=3600.0)
-    """s of sim time to get ``progress_distance`` closer to the goal, in (0, 3600]."""
-    spin_angle: float = Field(_NAV.spin_angle, gt=0.0, le=2 * math.pi)
-    """rad, the look-around turn, in (0, 2 pi]."""
-    spin_speed: float = Field(_NAV.spin_speed, gt=0.0, le=10.0)
-    """rad/s, in (0, 10]."""
-    backup_distance: float = Field(_NAV.backup_distance, gt=0.0, le=5.0)
-    """m, in (0, 5]."""
-    backup_speed: float = Field(_NAV.backup_speed, gt=0.0, le=2.0)
-    """m/s, in (0, 2]."""
-    follow_time: float = Field(_NAV.follow_time, gt=0.0, le=600.0)
-    """s, the longest boundary following, in (0, 600]."""
-    follow_speed: float = Field(_NAV.follow_speed, gt=0.0, le=2.0)
-    """m/s, in (0, 2]."""
-    follow_distance: float = Field(_NAV.follow_distance, gt=0.0, le=5.0)
-    """m, robot centre to the boundary while following, in (0, 5]."""
-    clear_radius: float = Field(_NAV.clear_radius, ge=0.0, le=20.0)
-    """m, the spin rung first clears the map within this distance of the robot (0:
-    never), in [0, 20]."""
-
-
-class LocalizationConfig(_Section):
-    """Scan-to-map localization (``otonav.actors.localizer``, ADR 0053): a map built
-    from the scans at their corrected poses, each scan matched to it; publishes
-    ``map -> odom`` on /tf and the map on /map; the ``dwa`` navigator then works in the
-    map frame (its ``reached`` is judged on the localized pose)."""
-
-    enabled: bool = False
-    """Run the localizer and navigate on its pose (false: odometry alone)."""
-    resolution: float = Field(0.05, ge=0.01, le=0.2)
-    """m, the map's cell, in [0.01, 0.2]."""
-    half_size: float = Field(10.0, gt=0.0, le=100.0)
-    """m, the map spans this far from the start pose in x and y, in (0, 100]."""
-    linear_window: float = Field(0.1, ge=0.0, le=1.0)
-    """m, the correlative search spans +- this in x and y around the odometry's
-    prediction, in [0, 1]."""
-    angular_window: float = Field(0.06, ge=0.0, le=0.5)
-    """rad, it spans +- this in yaw, in [0, 0.5]."""
-    max_distance: float = Field(0.3, gt=0.0, le=2.0)
-    """m, a return farther than this from the map is not matched (new ground), in
-    (0, 2]."""
-    update_distance: float = Field(0.1, ge=0.0, le=5.0)
-    """m the robot moves before a scan is added to the map, in [0, 5]."""
-    update_angle: float = Field(0.1, ge=0.0, le=math.pi)
-    """rad it turns before a scan is added to the map, in [0, pi]."""
-    map_period: float = Field(5.0, gt=0.0, le=600.0)
-    """s of sim time between /map messages (only when the map changed), in (0, 600]."""
-
-
-class NavConfig(_Section):
-    """Navigator: which planner, go-to-goal gains (``stop``), limits, footprint,
-    clearance, and the avoiding planner's sections."""
-
-    planner: Literal["stop", "dwa", "external"] = "dwa"
-    """``dwa``: map + A* + DWA + recovery (avoids obstacles); ``stop``: go-to-goal that
-    stops in front of an obstacle (the original behaviour); ``external``: no planner
-    actor, your own node publishes /cmd_vel_nav (behind the safety layer)."""
-    rate_hz: PositiveFloat = 20.0
-    kp_lin: float = Field(_NAV.kp_lin, ge=0.0)
-    """Proportional gain on the distance to the goal (``stop`` planner, and the final
-    approach of ``dwa``), 1/s."""
-    kp_ang: float = Field(_NAV.kp_ang, ge=0.0)
-    """Proportional gain on the heading error, 1/s."""
-    max_v: PositiveFloat = _NAV.dwa.max_v
-    """m/s, the fastest the navigator asks for (``robot.max_v``, when stated, sets it)."""
-    max_omega: PositiveFloat = _NAV.dwa.max_omega
-    """rad/s, the fastest turn the navigator asks for."""
-    tolerance: PositiveFloat = _NAV.tolerance
-    """m: the navigator stops within this distance of the goal (by odometry)."""
-    turn_in_place_threshold: PositiveFloat = _NAV.dwa.rotate_threshold
-    """rad of heading error above which the robot turns in place first."""
-    clearance: float = Field(0.35, ge=0.0, le=5.0)
-    """m, robot centre (base_link, the judged point) to any return: what the planner
-    keeps, in [0, 5]; at least ``safety.clearance``."""
-    approach_radius: float = Field(_NAV.approach_radius, ge=0.0, le=5.0)
-    """m (dwa planner): within this distance of the goal a proportional controller
-    (``kp_lin``, ``kp_ang``) finishes, in reverse if the goal is behind, in [0, 5]."""
-    footprint_padding: float = Field(0.03, ge=0.0, le=1.0)
-    """m, gap kept between the footprint (read from the MJCF) and any return, in [0, 1].
-    The planner keeps its centre max(clearance, footprint radius + padding) away. The
-    safety layer's by default (issue 42: 0.05 m, more than the layer that guarantees the
-    stop, refused BARN passages a Jackal-sized robot passes; Nav2's is 0.01 m)."""
-    dwa: DwaConfig = DwaConfig()
-    map: MapConfig = MapConfig()
-    recovery: RecoveryConfig = RecoveryConfig()
-    localization: LocalizationConfig = LocalizationConfig()
-
-
-class SafetyConfig(_Section):
-    """The safety layer between the planner (/cmd_vel_nav) and the base (/cmd_vel)."""
-
-    enabled: bool = True
-    """False: the planner drives /cmd_vel directly (nothing checks it)."""
-    rate_hz: float = Field(20.0, ge=1.0, le=1000.0)
-    """Hz, how often the command is checked and sent, in [1, 1000]."""
-    clearance: float = Field(0.32, gt=0.0, le=5.0)
-    """m, robot centre (base_link) to any return: the robot can always stop before
-    coming closer, in (0, 5]. Keep it above the judge's min_clearance."""
-    footprint_padding: float = Field(0.03, ge=0.0, le=1.0)
-    """m, gap kept between the footprint and any return, in [0, 1]: the centre keeps
-    max(clearance, footprint radius + padding)."""
-    drive_lag: float = Field(0.05, ge=0.0, le=2.0)
-    """s, the drives' lag behind the base's command; the braking delay assumed is
-    1/rate_hz + 1/base.rate_hz + drive_lag, in [0, 2]."""
-    cmd_timeout: float = Field(0.25, gt=0.0, le=10.0)
-    """s without /cmd_vel_nav before the command counts as zero, in (0, 10]."""
-    scan_timeout: float = Field(0.35, gt=0.0, le=10.0)
-    """s without /scan (or /odom) before the layer stops the robot (blind), in (0, 10]."""
-    scales: int = Field(_SAFETY.scales, ge=2, le=100)
-    """forward-speed scales tried from 1 down to 0, in [2, 100]."""
-
-
-class GuardConfig(_Section):
-    """Obstacle guard: front sector half-angle (rad) and stop distance (m)."""
-
-    sector_half_angle: float = Field(0.5, gt=0.0, le=math.pi)
-    """rad either side of straight ahead that the guard watches."""
-    stop_distance: PositiveFloat = 0.35
-    """m: stop when a valid return in the sector is this close."""
-
-
-class CanAxisConfig(_Section):
+class CanAxisConfig(Section):
     """One wheel's drive as the host sees it: CAN node id, direction sign, gearing."""
 
     node_id: _NodeId = 0
@@ -329,7 +107,7 @@ class CanAxisConfig(_Section):
     """Motor turns per wheel revolution (wheel rad = sign * 2 pi * turns / gear_ratio)."""
 
 
-class CanConfig(_Section):
+class CanConfig(Section):
     """The wheel bus (``hal.kind: can``): python-can interface and channel, the two
     ODrive axes, and the fault-detection limits (s of sim time). Every number is
     bounded (``otonav.limits``, ADR 0019); the error names the valid range."""
@@ -378,7 +156,7 @@ _FaultTime = Annotated[float, _within(0.0, limits.MAX_SIM_BUDGET_S, " s")]
 """s of sim time at which a fault starts or ends."""
 
 
-class _Timed(_Section):
+class _Timed(Section):
     at: _FaultTime = 0.0
     """s of sim time the fault starts."""
     until: _FaultTime | None = None
@@ -407,7 +185,7 @@ class DelayFault(_Timed):
     """s, up to this much more, uniform."""
 
 
-class AxisErrorFault(_Section):
+class AxisErrorFault(Section):
     """A drive reports an axis error and disarms, until the host clears it."""
 
     node_id: _NodeId | None = None
@@ -417,7 +195,7 @@ class AxisErrorFault(_Section):
     at: _FaultTime = 0.0
 
 
-class BusOffFault(_Section):
+class BusOffFault(Section):
     """The bus goes bus-off (nothing passes) and restarts."""
 
     at: _FaultTime | None = None
@@ -440,7 +218,7 @@ class HeartbeatFault(_Timed):
     """the drive (null: off)."""
 
 
-class FaultsConfig(_Section):
+class FaultsConfig(Section):
     """Faults the emulated drives and bus inject, each from a time of the run (ADR 0046):
     e.g. ``--set hal.sim.faults.drop.rate=0.5 --set hal.sim.faults.drop.at=2``."""
 
@@ -451,7 +229,7 @@ class FaultsConfig(_Section):
     heartbeat: HeartbeatFault = HeartbeatFault()
 
 
-class DriveSimConfig(_Section):
+class DriveSimConfig(Section):
     """The emulated drives (``otonav.hal.sim``): how they are configured, which can
     differ from what the host expects (a wrong node id, a slower heartbeat: faults to
     detect, not configs to refuse)."""
@@ -477,7 +255,7 @@ class DriveSimConfig(_Section):
     """Faults to inject, on a timetable (nothing by default)."""
 
 
-class HalConfig(_Section):
+class HalConfig(Section):
     """Which hardware is under the HAL: the MuJoCo world directly, or the wheels over a
     CAN bus (drives emulated on MuJoCo's wheels, or real drives)."""
 
@@ -497,7 +275,7 @@ _Name = Annotated[
 _Vec3 = tuple[float, float, float]
 
 
-class MountConfig(_Section):
+class MountConfig(Section):
     """Where a sensor sits: a site the model already has, or a point on a body (metres,
     in the body's frame; the sensor's axes are the robot base's)."""
 
@@ -517,7 +295,7 @@ class MountConfig(_Section):
         return self
 
 
-class FramesConfig(_Section):
+class FramesConfig(Section):
     """The frame ids of the robot's links in /odom, /tf, /tf_static, /scan and /imu, as
     its URDF names them (REP 105); ``odom`` stays ``odom``. Unset: the model's names (the
     base body, the lidar's and the IMU's site or body), ``base_link``, ``laser`` and
@@ -532,7 +310,7 @@ class FramesConfig(_Section):
     """The IMU's frame (/imu's ``frame_id``)."""
 
 
-class RobotConfig(_Section):
+class RobotConfig(Section):
     """The robot description (``otonav.hal.description``): a built-in robot or the
     user's MJCF/URDF, the names of its base and wheels, where its sensors sit. Wheel
     radius and separation, footprint and sensor offsets are derived from the model; a
@@ -566,7 +344,7 @@ class RobotConfig(_Section):
     """The frame ids otonav stamps its messages with (``--set robot.frames.base=...``)."""
 
 
-class ActorConfig(_Section):
+class ActorConfig(Section):
     """One node of the launch: a class (``package.module:Class`` on ``sys.path``, in the
     current directory or the config file's, or ``path/to/file.py:Class`` relative to the
     config file) with its parameters and topic remaps. An entry named like a built-in
@@ -598,7 +376,7 @@ class ActorConfig(_Section):
 _TOPIC_NAME = r"^(/[A-Za-z_][A-Za-z0-9_]*)+$"
 
 
-class LockstepAnswer(_Section):
+class LockstepAnswer(Section):
     """One thing your ROS 2 nodes answer with in lockstep (ADR 0065): ``topic`` is
     published once every ``period`` s of sim time, after the node's /clock reaches it."""
 
@@ -608,7 +386,7 @@ class LockstepAnswer(_Section):
     """s of sim time between two answers (the node's timer: 0.05 for 20 Hz), in (0, 60]."""
 
 
-class Ros2Config(_Section):
+class Ros2Config(Section):
     """ROS 2 over DDS (``otonav run --ros2``, the extra ``otonav[ros2]``; ADR 0047)."""
 
     enabled: bool = False
@@ -632,7 +410,7 @@ class Ros2Config(_Section):
     (``--ros2-wait``; null: do not wait, or 30 s in lockstep), in (0, 3600]."""
 
 
-class FoxgloveConfig(_Section):
+class FoxgloveConfig(Section):
     """The Foxglove live view (``otonav run --foxglove``, the extra ``otonav[foxglove]``;
     ADR 0031): every topic served over the Foxglove WebSocket protocol."""
 
@@ -649,7 +427,7 @@ class FoxgloveConfig(_Section):
     (``--foxglove-wait``; null: do not wait), in (0, 3600]."""
 
 
-class StackConfig(_Section):
+class StackConfig(Section):
     """Everything needed to bring the robot stack up."""
 
     world: WorldConfig = WorldConfig()

@@ -10,8 +10,9 @@
   runtime-safe ones. An actor whose ``params`` are partly read once (the navigator's map
   size) names the ones it reads every step in ``live_parameters`` (paths under
   ``params``, a trailing ``.`` for a whole nested dataclass); the others are read-only.
-  Settable only where a config key sets it (:data:`CONFIG_KEYS`): a new value passes
-  that key's bounds, exactly as ``--set KEY=VALUE`` does (issue 41: a client set
+  Settable only where a config key sets it (:data:`otonav.params.CONFIG_KEYS`, which
+  ``stack.build`` builds them from): a new value passes that key's bounds, exactly as
+  ``--set KEY=VALUE`` does (issue 41: a client set
   ``safety.params.scales`` to 1e8, which ``--set`` caps at 100, and the safety layer
   ran out of memory), then the dataclass's own check: a change builds a new dataclass
   with ``dataclasses.replace`` (each one on the way). A refused value leaves the old one.
@@ -28,38 +29,13 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, TypeAdapter, ValidationError
 
-from otonav.nav import GoToGoalParams, NavigationParams
-from otonav.nav.dwa import DwaParams
-from otonav.nav.safety import SafetyParams
+from otonav.params import CONFIG_KEYS
 from otonav.runtime import Actor
-from otonav.stack.config import DwaConfig, StackConfig
+from otonav.stack.config import StackConfig
 
-__all__ = ("CONFIG_KEYS", "ActorParameters", "ParameterError")
+__all__ = ("ActorParameters", "ParameterError")
 
 _SCALARS = (bool, int, float, str)
-
-_BASE = {name: f"base.{name}" for name in ("max_v", "max_omega", "max_accel", "max_alpha")}
-CONFIG_KEYS: dict[type, dict[str, str]] = {
-    GoToGoalParams: {
-        **{name: f"nav.{name}" for name in ("kp_lin", "kp_ang", "tolerance")},
-        "turn_in_place_threshold": "nav.turn_in_place_threshold",
-        "max_v": "base.max_v",
-        "max_omega": "base.max_omega",
-    },
-    NavigationParams: {"tolerance": "nav.tolerance"},
-    DwaParams: {**{name: f"nav.dwa.{name}" for name in DwaConfig.model_fields}, **_BASE},
-    SafetyParams: {
-        "radius": "safety.clearance",
-        "scales": "safety.scales",
-        "max_accel": "base.max_accel",
-        "max_alpha": "base.max_alpha",
-    },
-}
-"""Per params dataclass, field -> the config key whose bounds a live value must meet:
-the key it is built from (``otonav.stack.build``), or for one capped by the robot's base
-(a speed, an acceleration) the base's key; the safety radius, a centre clearance, has
-``safety.clearance``'s. A field with no key here (a period or a latency derived from
-several keys, a user node's ``params``) is read-only while the robot runs."""
 
 
 class ParameterError(ValueError):

@@ -12,7 +12,8 @@ from otonav.actors.topics import FRAMES, Frames
 from otonav.hal.description import BUILTIN_ROBOTS, Mount, RobotDescription, builtin_robot
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.types import Reach
-from otonav.stack.config import BaseConfig, MountConfig, NavConfig, RobotConfig, StackConfig
+from otonav.params import BaseConfig, NavConfig
+from otonav.stack.config import MountConfig, RobotConfig, StackConfig
 from otonav.stack.files import ConfigFileError
 
 __all__ = [

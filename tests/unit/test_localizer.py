@@ -17,8 +17,8 @@ from otonav.actors.localizer import Localizer, LocalizerParams
 from otonav.actors.odometry_error import OdometryError
 from otonav.hal import FakeHardware
 from otonav.msgs import OccupancyGrid, Odometry, Time, WheelCommand
-from otonav.nav.navigation import NavigationParams
 from otonav.nav.scan_match import compose, inverse
+from otonav.params import NavigationParams
 from otonav.record.cdr import decode, encode
 from otonav.runtime import QoS, Reliability, System, virtual_loop_factory
 

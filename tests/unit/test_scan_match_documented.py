@@ -16,7 +16,7 @@ import pytest
 
 from otonav.nav.scan_map import ScanMap
 from otonav.nav.scan_match import MatchParams, correlative_search, match_scan, refine
-from otonav.stack.config import LocalizationConfig
+from otonav.params import LocalizationConfig
 
 pytestmark = pytest.mark.unit
 

@@ -193,7 +193,7 @@ def test_match_params_bounds_name_the_field() -> None:
             MatchParams(**{name: 0.0})  # type: ignore[arg-type]
         with pytest.raises(ValueError, match=rf"MatchParams\.{name}"):
             MatchParams(**{name: math.nan})  # type: ignore[arg-type]
-    with pytest.raises(ValueError, match="iterations must be >= 0, got -1"):
+    with pytest.raises(ValueError, match="iterations must be an integer >= 0, got -1"):
         MatchParams(iterations=-1)
     for bad in (-0.01, 1.01):
         with pytest.raises(ValueError, match=r"min_inliers must be in \[0, 1\]"):

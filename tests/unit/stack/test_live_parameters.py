@@ -11,9 +11,10 @@ import pytest
 
 from otonav.actors import AvoidingNavigator, Navigator, SafetyLayer
 from otonav.nav import GoToGoalParams, NavigationParams, SafetyParams
+from otonav.params import CONFIG_KEYS
 from otonav.stack import StackConfig
 from otonav.stack.files import ConfigFileError
-from otonav.stack.live_parameters import CONFIG_KEYS, ActorParameters, ParameterError
+from otonav.stack.live_parameters import ActorParameters, ParameterError
 from otonav.stack.overrides import apply_overrides
 
 pytestmark = pytest.mark.unit
