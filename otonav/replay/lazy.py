@@ -29,13 +29,8 @@ from typing import Any, TypeVar
 
 from otonav.msgs import Header, Message
 from otonav.msgs.flat import FlatLayout
-from otonav.msgs.stand_in import become, stand_in_class
+from otonav.msgs.stand_in import become, make, stand_in_class
 from otonav.msgs.stand_in import get as _get
-from otonav.msgs.stand_in import new as _new
-from otonav.msgs.stand_in import set_dict as _set_dict
-from otonav.msgs.stand_in import set_extra as _set_extra
-from otonav.msgs.stand_in import set_fields_set as _set_fields_set
-from otonav.msgs.stand_in import set_private as _set_private
 from otonav.record.cdr import decode, flat_values
 from otonav.record.schemas import layout_for
 
@@ -107,13 +102,7 @@ def _lazy_class(real: type[Message]) -> type[Message]:
 def lazy(message_type: type[M], data: bytes) -> M:
     """A ``message_type`` message that decodes ``data`` (CDR with its encapsulation
     header) the first time it is used. Bad data raises ``ValueError`` then."""
-    cls = _LAZY.get(message_type) or _lazy_class(message_type)
-    message: M = message_type.__new__(cls)  # type: ignore[assignment]
-    _set_dict(message, {_KEY: data})
-    _set_fields_set(message, message_type._otonav_fields)
-    _set_extra(message, None)
-    _set_private(message, None)
-    return message
+    return lazy_maker(message_type)(data)
 
 
 def lazy_maker(message_type: type[M]) -> Callable[[bytes], M]:
@@ -122,15 +111,11 @@ def lazy_maker(message_type: type[M]) -> Callable[[bytes], M]:
     cls = _LAZY.get(message_type) or _lazy_class(message_type)
     fields = message_type._otonav_fields
 
-    def make(data: bytes) -> M:
-        message: M = _new(cls)  # type: ignore[assignment]
-        _set_dict(message, {_KEY: data})
-        _set_fields_set(message, fields)
-        _set_extra(message, None)
-        _set_private(message, None)
+    def make_lazy(data: bytes) -> M:
+        message: M = make(cls, {_KEY: data}, fields)  # type: ignore[assignment]
         return message
 
-    return make
+    return make_lazy
 
 
 def input_maker(

@@ -25,7 +25,7 @@ from typing import Any, Final, TypeVar
 
 from otonav.msgs import Header, Message
 from otonav.msgs.flat import FlatLayout
-from otonav.msgs.stand_in import make, new, set_dict, set_extra, set_fields_set, set_private
+from otonav.msgs.stand_in import make as _make
 from otonav.record.cdr._encode import encode
 from otonav.record.cdr._layout import (
     ENCAPSULATION,
@@ -197,13 +197,6 @@ def _compile_builder(message: type[Message]) -> Builder:
     return build
 
 
-# The slot setters of a message built without pydantic's constructor (Message.fast's way),
-# shared with the stand-in messages; the generated decoders call them directly.
-_make = make
-_new, _set_dict, _set_fields_set = new, set_dict, set_fields_set
-_set_extra, _set_private = set_extra, set_private
-
-
 _PLANS: dict[type[Message], tuple[tuple[ReadStep, ...], Builder]] = {}
 
 
@@ -222,21 +215,13 @@ a stamped message, its Header if already decoded); returns it and where it ended
 def _compile_decoder(message: type[Message]) -> Decoder:
     """One generated function per class, straight-line: each fixed run one
     ``unpack_from`` into a tuple, each string read inline, the other variable parts
-    through their read steps; then every message built bottom-up with ``_new`` and the
-    slot setters, no call per message and no flat list: an Odometry 6.3 -> 5.0 us, a
+    through their read steps; then every message built bottom-up with ``_make``
+    (``otonav.msgs._base.make``), no flat list: an Odometry 6.3 -> 5.0 us, a
     360-beam LaserScan 6.5 -> 5.9 us (the navigator's replay decodes ~860 inputs). The
     same values and objects as the steps and builder above (which nested message arrays
     still use); ``tests/unit/record/test_cdr.py`` checks every message type, and strings
     of every length mod 4 before each field, against the original."""
-    names: dict[str, object] = {
-        "_new": _new,
-        "_sd": _set_dict,
-        "_sf": _set_fields_set,
-        "_se": _set_extra,
-        "_sp": _set_private,
-        "_U32": _U32,
-        "_len": len,
-    }
+    names: dict[str, object] = {"_make": _make, "_U32": _U32, "_len": len}
     lines: list[str] = []
     values: list[str] = []  # flat value index -> its expression
     runs: dict[int, tuple[str, int]] = {}  # flat index -> (run tuple name, index in it)
@@ -325,15 +310,7 @@ def _compile_decoder(message: type[Message]) -> Decoder:
             else:  # one value: a scalar, a string, a sequence, an array of messages/strings
                 code, i = values[i], i + 1
             parts.append(f"{field.name!r}: {code}")
-        lines.extend(
-            [
-                f"{name} = _new({cls})",
-                f"_sd({name}, {{{', '.join(parts)}}})",
-                f"_sf({name}, {cls}_fields)",
-                f"_se({name}, None)",
-                f"_sp({name}, None)",
-            ]
-        )
+        lines.append(f"{name} = _make({cls}, {{{', '.join(parts)}}}, {cls}_fields)")
         return name, i
 
     top, used = build(message, 0)
