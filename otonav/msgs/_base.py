@@ -30,9 +30,17 @@ def set_state(message: Message, fields: dict[str, Any], fields_set: set[str]) ->
 
 
 def make(cls: type[M], fields: dict[str, Any], fields_set: set[str]) -> M:
-    """A ``cls`` message holding ``fields`` (:func:`set_state`)."""
+    """A ``cls`` message holding ``fields`` (:func:`set_state`, inlined)."""
     message: M = _new(cls)
-    set_state(message, fields, fields_set)
+    _setstate(
+        message,
+        {
+            "__dict__": fields,
+            "__pydantic_fields_set__": fields_set,
+            "__pydantic_extra__": None,
+            "__pydantic_private__": None,
+        },
+    )
     return message
 
 
@@ -60,4 +68,14 @@ class Message(BaseModel):
         ``model_construct`` fills defaults and fields_set for each call, 3.5x the cost;
         this is the same object (:func:`make`).
         """
-        return make(cls, values, cls._otonav_fields)
+        message = _new(cls)
+        _setstate(  # make(), inlined: 0.2 us of a Twist's 1.5
+            message,
+            {
+                "__dict__": values,
+                "__pydantic_fields_set__": cls._otonav_fields,
+                "__pydantic_extra__": None,
+                "__pydantic_private__": None,
+            },
+        )
+        return message
