@@ -120,11 +120,17 @@ def construction() -> dict[str, Callable[[], object]]:
             },
         )
 
+    def vector(make: Callable[[Any, dict[str, Any]], Any]) -> Callable[[], object]:
+        return lambda: make(Vector3, {"x": 1.0, "y": 2.0, "z": 3.0})
+
+    def odom(make: Callable[[Any, dict[str, Any]], Any]) -> Callable[[], object]:
+        return lambda: odometry(make)
+
     ways = {"slots": slots, "setstate": state, "construct": construct, "validated": validated}
     cases: dict[str, Callable[[], object]] = {}
     for name, make in ways.items():
-        cases[f"Vector3 {name}"] = lambda make=make: make(Vector3, {"x": 1.0, "y": 2.0, "z": 3.0})
-        cases[f"Odometry {name}"] = lambda make=make: odometry(make)
+        cases[f"Vector3 {name}"] = vector(make)
+        cases[f"Odometry {name}"] = odom(make)
     return cases
 
 
@@ -226,7 +232,7 @@ def main() -> None:
             runs[name].append(_per_call(fn))
     print(f"construction, us per message, median of {args.rounds} interleaved rounds of {N}:")
     for name, values in runs.items():
-        kind, way = name.split()
+        kind = name.split()[0]
         ratio = statistics.median(values) / statistics.median(runs[f"{kind} slots"])
         print(f"  {name:<22} {statistics.median(values):7.2f} us   / slots {ratio:5.2f}")
     mine: list[dict[str, float]] = []

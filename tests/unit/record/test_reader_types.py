@@ -34,10 +34,10 @@ def _recording(path: Path) -> Path:
             channels[topic] = (writer.register_channel(topic, "cdr", schema), encode(message))
         schema = writer.register_schema("sensor_msgs/msg/BatteryState", "ros2msg", b"float32 v")
         battery = writer.register_channel(FOREIGN, "cdr", schema)
-        for topic, (channel, data) in channels.items():
+        for channel, data in channels.values():
             writer.add_message(channel, 10**9, data, 10**9)
         writer.add_message(battery, 10**9, ENCAPSULATION + b"\0\0\x80?", 10**9)
-        writer.finish()
+        writer.finish()  # type: ignore[no-untyped-call]
     return path
 
 
