@@ -16,8 +16,8 @@ def set_state(message: Message, fields: dict[str, Any], fields_set: set[str]) ->
     """Give ``message`` (made with ``object.__new__``) its pydantic state: ``fields`` as
     they are (trusted, already typed), no constructor run. Through the pickle protocol
     (``__setstate__``, how pickle and ``copy`` rebuild a model), the fastest of
-    pydantic's public ways: a Vector3 in 1.4 us against 5.0 with ``model_construct`` and
-    2.4 validated (ADR 0086, ``benchmarks/message_bench.py``)."""
+    pydantic's public ways: a Vector3 in 1.7 us against 4.4 with ``model_construct`` and
+    2.1 validated (ADR 0086, ``benchmarks/message_bench.py``)."""
     _setstate(
         message,
         {
@@ -65,11 +65,11 @@ class Message(BaseModel):
     def fast(cls, **values: Any) -> Self:
         """Build from trusted, already-typed values, giving EVERY field: no validation,
         no defaults. The stack's hot path (~280 messages per sim second):
-        ``model_construct`` fills defaults and fields_set for each call, 3.5x the cost;
-        this is the same object (:func:`make`).
+        ``model_construct`` walks every field's aliases and defaults for each call, 2.6x
+        the cost; this is the same object (:func:`make`).
         """
         message = _new(cls)
-        _setstate(  # make(), inlined: 0.2 us of a Twist's 1.5
+        _setstate(  # make(), inlined: a call less on the hot path
             message,
             {
                 "__dict__": values,
