@@ -51,7 +51,7 @@ _KEY = "\0flat"
 """Where a flat message keeps ``(layout, values)`` in its ``__dict__``: no field can
 have this name, so every field lookup misses and reaches ``__getattribute__``."""
 
-_get, _make = get, make
+_get, _make, _new = get, make, object.__new__
 
 _FLAT: dict[type[Message], type[Message]] = {}
 """message class -> its flat subclass"""
@@ -146,7 +146,11 @@ class FlatLayout(Generic[M]):
 
     def __call__(self, *values: Any) -> M:
         """A message of this layout with ``values`` at ``paths`` (not checked)."""
-        message: M = _make(self._cls, {_KEY: (self, values)}, self._fields_set)  # type: ignore[assignment]
+        message: M = _new(self._cls)  # type: ignore[assignment]  # its flat subclass
+        # Its pydantic state comes when it is built (materialize): until then every access
+        # goes through its __getattribute__, and its own __dict__ (made on first touch)
+        # holds only this. 0.15 us, against 0.55 with the state set now.
+        _get(message, "__dict__")[_KEY] = (self, values)
         return message
 
     def index(self, path: str) -> int:

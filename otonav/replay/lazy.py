@@ -29,12 +29,14 @@ from typing import Any, TypeVar
 
 from otonav.msgs import Header, Message
 from otonav.msgs.flat import FlatLayout
-from otonav.msgs.stand_in import become, make, stand_in_class
+from otonav.msgs.stand_in import become, stand_in_class
 from otonav.msgs.stand_in import get as _get
 from otonav.record.cdr import decode, flat_values
 from otonav.record.schemas import layout_for
 
 __all__ = ("input_maker", "is_lazy", "lazy", "lazy_maker", "materialize")
+
+_new = object.__new__
 
 M = TypeVar("M", bound=Message)
 
@@ -109,10 +111,10 @@ def lazy_maker(message_type: type[M]) -> Callable[[bytes], M]:
     """``lambda data: lazy(message_type, data)``, with the class looked up once (the
     replay's feeder makes one per recorded input)."""
     cls = _LAZY.get(message_type) or _lazy_class(message_type)
-    fields = message_type._otonav_fields
 
     def make_lazy(data: bytes) -> M:
-        message: M = make(cls, {_KEY: data}, fields)  # type: ignore[assignment]
+        message: M = _new(cls)  # type: ignore[assignment]
+        _get(message, "__dict__")[_KEY] = data  # its state: when decoded (as a flat one's)
         return message
 
     return make_lazy
