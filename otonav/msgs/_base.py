@@ -30,17 +30,9 @@ def set_state(message: Message, fields: dict[str, Any], fields_set: set[str]) ->
 
 
 def make(cls: type[M], fields: dict[str, Any], fields_set: set[str]) -> M:
-    """A ``cls`` message holding ``fields`` (:func:`set_state`, inlined)."""
+    """A ``cls`` message holding ``fields`` (:func:`set_state`)."""
     message: M = _new(cls)
-    _setstate(
-        message,
-        {
-            "__dict__": fields,
-            "__pydantic_fields_set__": fields_set,
-            "__pydantic_extra__": None,
-            "__pydantic_private__": None,
-        },
-    )
+    set_state(message, fields, fields_set)
     return message
 
 
