@@ -4,7 +4,6 @@ replay's are), and the cut-off case (no footer: the process was killed)."""
 
 from __future__ import annotations
 
-import functools
 import warnings
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
@@ -16,7 +15,6 @@ from mcap.reader import NonSeekingReader, make_reader
 from mcap.records import Channel, Metadata, Schema
 from mcap.records import Message as Message_
 
-from otonav import msgs
 from otonav.errors import UsageError
 from otonav.msgs import Message
 from otonav.record.cdr import decode
@@ -254,7 +252,8 @@ def read_messages(
     """Yield ``(topic, sim_time_s, message)`` in log-time order, for ``topics`` (every
     topic otonav has a message type for when None; a named topic of another type is a
     :class:`RecordingError`) with ``start <= t < end`` (seconds of sim time). Each
-    message is the :mod:`otonav.msgs` type its schema names, decoded by otonav's own
+    message is the :mod:`otonav.msgs` type its schema names (or a user's own
+    :class:`~otonav.msgs.Message` subclass of that ``ros_type``), decoded by otonav's own
     CDR decoder (:func:`otonav.record.cdr.decode`, as replay's inputs are). A cut-off
     file yields the messages of its complete chunks, in file order.
 
@@ -302,11 +301,19 @@ def read_messages(
             yield channel.topic, message.log_time / 1e9, _decode(path, channel, kind, message)
 
 
-@functools.cache
 def _message_types() -> dict[str, type[Message]]:
-    """ROS type name -> the otonav message class that stands for it."""
-    kinds: list[type[Message]] = [getattr(msgs, name) for name in msgs.__all__]
-    return {kind.ros_type: kind for kind in kinds if kind is not Message}
+    """ROS type name -> the message class that stands for it: otonav's and any a user
+    defined (every subclass of Message), the first defined for a name (a flat or lazy
+    stand-in subclasses its message class and is not another type)."""
+    found: dict[str, type[Message]] = {}
+    todo = Message.__subclasses__()
+    while todo:
+        kind = todo.pop(0)
+        todo += kind.__subclasses__()
+        name = getattr(kind, "ros_type", None)
+        if isinstance(name, str):
+            found.setdefault(name, kind)
+    return found
 
 
 def _type_of(
@@ -329,7 +336,7 @@ def _type_of(
             return None
         raise RecordingError(
             f"{path}: {channel.topic} holds {what}, which otonav has no message type for "
-            "(it reads the CDR of the types in otonav.msgs)"
+            "(it reads the types of otonav.msgs and of any Message subclass imported)"
         )
     return kind
 

@@ -5,15 +5,17 @@ every topic is read (as ``ros2 bag play`` skips a type it does not know)."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import ClassVar
 
 import pytest
 from mcap.writer import Writer
 
 from otonav.cli import main
-from otonav.msgs import Clock, Frame, Header, Time
+from otonav.msgs import Clock, Frame, Header, Message, Time
 from otonav.record.cdr import ENCAPSULATION, encode
 from otonav.record.reader import RecordingError, read_messages
 from otonav.record.schemas import schema_for
+from otonav.record.writer import RecordingWriter
 
 pytestmark = pytest.mark.unit
 
@@ -68,3 +70,20 @@ def test_every_topic_skips_an_unknown_type_with_a_warning(tmp_path: Path) -> Non
     with pytest.warns(UserWarning, match=r"skipping /battery"):
         topics = [topic for topic, _t, _m in read_messages(path)]
     assert sorted(topics) == ["/can", "/clock"]
+
+
+class Charge(Message):
+    """A user's own message type (not in otonav.msgs)."""
+
+    ros_type: ClassVar[str] = "my_msgs/msg/Charge"
+    volts: float = 0.0
+    cells: tuple[int, ...] = ()
+
+
+def test_a_users_own_message_type_reads_back_as_itself(tmp_path: Path) -> None:
+    path = tmp_path / "user.mcap"
+    with RecordingWriter(path) as writer:
+        writer.write("/charge", Charge(volts=24.5, cells=(3, 4)), 0.5)
+    ((topic, t, charge),) = read_messages(path)
+    assert (topic, t, type(charge)) == ("/charge", 0.5, Charge)
+    assert charge == Charge(volts=24.5, cells=(3, 4))
