@@ -37,16 +37,12 @@ def add_parser(commands: Any) -> None:
 
 
 def plain(value: Any) -> Any:
-    """A decoded message as YAML-ready data: fields in their order, arrays as lists."""
-    slots = getattr(type(value), "__slots__", None)
-    if slots is not None and hasattr(value, "__dict__"):
-        return {name: plain(getattr(value, name)) for name in slots}
+    """A message as YAML-ready data: fields in their order, arrays as lists."""
+    fields = getattr(type(value), "model_fields", None)
+    if fields is not None:
+        return {name: plain(getattr(value, name)) for name in fields}
     if isinstance(value, list | tuple):
         return [plain(item) for item in value]
-    if isinstance(value, bytes | bytearray | memoryview):
-        return list(bytes(value))
-    if hasattr(value, "tolist"):  # a numpy array or scalar
-        return value.tolist()
     return value
 
 
@@ -56,9 +52,10 @@ def field_of(message: Any, path: str) -> Any:
 
     value = message
     for part in path.split("."):
-        if not hasattr(value, part) or part.startswith("_"):
-            fields = ", ".join(getattr(type(value), "__slots__", ())) or "none, it is a value"
-            raise UsageError(f"--field {path}: no field {part!r} (fields there: {fields})")
+        fields = getattr(type(value), "model_fields", {})
+        if part not in fields:
+            there = ", ".join(fields) or "none, it is a value"
+            raise UsageError(f"--field {path}: no field {part!r} (fields there: {there})")
         value = getattr(value, part)
     return value
 

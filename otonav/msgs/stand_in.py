@@ -4,9 +4,10 @@ A stand-in is an instance of a subclass of a message class that holds only what 
 to become the message (a fixed layout's values, or CDR bytes) under a key no field can
 have. On first use it builds the message's fields in place and switches its class to the
 message class: from then on it *is* that message. This module has the pieces both kinds
-use: the stand-in class itself, the slot setters that make a message without pydantic's
-constructor, the switch, and the operators that build the message before comparing,
-hashing or printing it.
+use: the stand-in class itself, the switch, and the operators that build the message
+before comparing, hashing or printing it. A stand-in gets its pydantic state as every
+message built without validation does (:func:`~otonav.msgs._base.make`: pydantic's
+``__setstate__``); nothing here touches BaseModel's slots (ADR 0086).
 """
 
 from __future__ import annotations
@@ -14,37 +15,27 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from pydantic import BaseModel
+from otonav.msgs._base import Message, make, set_state
 
-from otonav.msgs._base import Message
+__all__ = ("become", "get", "make", "operators", "stand_in_class")
 
 get = object.__getattribute__
-new = object.__new__
-set_class = object.__setattr__
-# BaseModel's slots, set through their descriptors (see Message.fast).
-set_dict = BaseModel.__dict__["__dict__"].__set__
-set_fields_set = BaseModel.__dict__["__pydantic_fields_set__"].__set__
-set_extra = BaseModel.__dict__["__pydantic_extra__"].__set__
-set_private = BaseModel.__dict__["__pydantic_private__"].__set__
+"""A stand-in's own attributes (its ``__dict__``), past its ``__getattribute__``."""
+_set_class = object.__setattr__
 
 
-def make(cls: type[Message], fields: dict[str, Any], fields_set: set[str]) -> Message:
-    """A message of ``cls`` (a message class or a stand-in class) with these ``__dict__``
-    entries, built as :meth:`Message.fast` does."""
-    message: Message = new(cls)
-    set_dict(message, fields)
-    set_fields_set(message, fields_set)
-    set_extra(message, None)
-    set_private(message, None)
-    return message
-
-
-def become(message: Message, real: type[Message], fields: dict[str, Any] | None) -> None:
-    """Make the stand-in ``message`` the ``real`` message with ``fields`` (``None``: it
-    has its fields already, e.g. a copy of one that was built)."""
+def become(
+    message: Message,
+    real: type[Message],
+    fields: dict[str, Any] | None,
+    fields_set: set[str] | None = None,
+) -> None:
+    """Make the stand-in ``message`` the ``real`` message holding ``fields`` (``None``:
+    it has its state already, e.g. a copy of one that was built), then switch its class
+    (the same layout: a stand-in class has ``__slots__ = ()``)."""
     if fields is not None:
-        set_dict(message, fields)
-    set_class(message, "__class__", real)
+        set_state(message, fields, real._otonav_fields if fields_set is None else fields_set)
+    _set_class(message, "__class__", real)
 
 
 def operators(materialize: Callable[[Any], Message]) -> dict[str, Any]:

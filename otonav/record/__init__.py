@@ -3,7 +3,7 @@ summarised, salvaged after a cut-off, and laid out as a rosbag2 bag directory.
 
 - write: :class:`RecordingWriter` (one file), :class:`RotatingRecordingWriter` (a new
   file every N bytes, for long-lived services); the stack's recorder actor uses them;
-- read: :func:`read_messages` (typed messages in log-time order),
+- read: :func:`read_messages` (:mod:`otonav.msgs` messages in log-time order),
   :func:`summarize_recording` (``otonav info``); a damaged file is a :class:`DamagedRecordingError`;
 - repair: :func:`salvage` (what a killed writer left, as a readable, indexed copy);
 - ROS 2: :func:`write_bag_directory` (``metadata.yaml`` beside the file, for

@@ -1,8 +1,10 @@
-"""Reading recordings back: a summary (like ``ros2 bag info``), decoded messages of a
-topic in a time range, and the cut-off case (no footer: the process was killed)."""
+"""Reading recordings back: a summary (like ``ros2 bag info``), the messages of a topic
+in a time range as otonav's own message types (decoded by otonav's CDR decoder, as
+replay's are), and the cut-off case (no footer: the process was killed)."""
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -10,10 +12,12 @@ from typing import Any
 
 from mcap.exceptions import McapError
 from mcap.reader import NonSeekingReader, make_reader
-from mcap.records import Channel, Message, Metadata, Schema
-from mcap_ros2.decoder import DecoderFactory
+from mcap.records import Channel, Metadata, Schema
+from mcap.records import Message as Message_
 
 from otonav.errors import UsageError
+from otonav.msgs import Message
+from otonav.record.cdr import decode
 from otonav.record.verify import (
     CUT_OFF_ERRORS,
     MAGIC,
@@ -135,7 +139,7 @@ def summarize(path: str | Path) -> RecordingSummary:
     # (the index alone would not notice a damaged chunk).
     damage: list[Damage] = []
     for record in iter_readable(path, damage):
-        if isinstance(record, Message) and record.channel_id in of_channel:
+        if isinstance(record, Message_) and record.channel_id in of_channel:
             t = of_channel[record.channel_id]
             if t.first_ns is None or record.log_time < t.first_ns:
                 t.first_ns = record.log_time
@@ -156,7 +160,7 @@ def summarize(path: str | Path) -> RecordingSummary:
 
 def iter_readable(
     path: Path, damage: list[Damage] | None = None
-) -> Iterator[Schema | Channel | Message | Metadata]:
+) -> Iterator[Schema | Channel | Message_ | Metadata]:
     """The schema, channel, message and metadata records of ``path`` in file order, up to
     where it was cut off (a cut-off file ends mid-record: the rest is not readable).
     Works on a complete file too (it is read front to back, index ignored). Every chunk
@@ -245,9 +249,13 @@ def read_messages(
     end: float | None = None,
     damage: list[Damage] | None = None,
 ) -> Iterator[tuple[str, float, Any]]:
-    """Yield ``(topic, sim_time_s, decoded_message)`` in log-time order, for ``topics``
-    (all when None) with ``start <= t < end`` (seconds of sim time). A cut-off file
-    yields the messages of its complete chunks, in file order.
+    """Yield ``(topic, sim_time_s, message)`` in log-time order, for ``topics`` (every
+    topic otonav has a message type for when None; a named topic of another type is a
+    :class:`RecordingError`) with ``start <= t < end`` (seconds of sim time). Each
+    message is the :mod:`otonav.msgs` type its schema names (or a user's own
+    :class:`~otonav.msgs.Message` subclass of that ``ros_type``), decoded by otonav's own
+    CDR decoder (:func:`otonav.record.cdr.decode`, as replay's inputs are). A cut-off
+    file yields the messages of its complete chunks, in file order.
 
     Every chunk read is checked against its CRC: a damaged one raises
     :class:`DamagedRecordingError`, or, given a ``damage`` list, is skipped and appended
@@ -258,49 +266,89 @@ def read_messages(
         yield from _read_cut_off(path, topics, start, end, damage)
         return
     with path.open("rb") as f:
-        reader = make_reader(f, validate_crcs=True, decoder_factories=[DecoderFactory()])
+        reader = make_reader(f, validate_crcs=True)
         try:
-            indexed = reader.get_summary() is not None and summary_damage(path) is None
+            summary = reader.get_summary()
+            indexed = summary is not None and summary_damage(path) is None
         except CUT_OFF_ERRORS:
             indexed = False
         if not indexed:  # cut off, or a damaged index: the chunks, front to back
             yield from _read_cut_off(path, topics, start, end)
             return
-        messages = reader.iter_decoded_messages(
-            topics=list(topics) if topics is not None else None,
+        assert summary is not None
+        types = {
+            ch.id: _type_of(path, ch, summary.schemas, topics) for ch in summary.channels.values()
+        }
+        messages = reader.iter_messages(
+            topics=[summary.channels[i].topic for i, t in types.items() if t is not None],
             starting_at=None if start is None else round(start * 1e9),
             ending_before=None if end is None else round(end * 1e9),
         )
         while True:
             try:
-                _schema, channel, message, decoded = next(messages)
+                _schema, channel, message = next(messages)
             except StopIteration:
                 return
-            except Exception as exc:  # a chunk that does not verify or decode: say which
+            except Exception as exc:  # a chunk that does not verify: say which
                 found: list[Damage] = []
                 for _record in iter_verified(path, found):
                     pass
                 if found:
                     raise DamagedRecordingError(describe_damage(path, found)) from None
                 raise DamagedRecordingError(f"{path}: unreadable ({_one_line(exc)})") from None
-            yield channel.topic, message.log_time / 1e9, decoded
+            kind = types[channel.id]
+            assert kind is not None
+            yield channel.topic, message.log_time / 1e9, _decode(path, channel, kind, message)
 
 
-def _decoder(
-    path: Path, factory: DecoderFactory, channel: Channel, schemas: dict[int, Schema]
-) -> Any:
-    """The decoder of ``channel``'s messages; one line if its schema does not parse."""
+def _message_types() -> dict[str, type[Message]]:
+    """ROS type name -> the message class that stands for it: otonav's and any a user
+    defined (every subclass of Message), the first defined for a name (a flat or lazy
+    stand-in subclasses its message class and is not another type)."""
+    found: dict[str, type[Message]] = {}
+    todo = Message.__subclasses__()
+    while todo:
+        kind = todo.pop(0)
+        todo += kind.__subclasses__()
+        name = getattr(kind, "ros_type", None)
+        if isinstance(name, str):
+            found.setdefault(name, kind)
+    return found
+
+
+def _type_of(
+    path: Path, channel: Channel, schemas: dict[int, Schema], topics: Sequence[str] | None
+) -> type[Message] | None:
+    """The message class of ``channel``'s messages; None when its topic is not wanted,
+    or (every topic wanted) otonav has no class for its type, which it then skips with a
+    warning as ``ros2 bag play`` does; a named topic of such a type is a RecordingError."""
+    if topics is not None and channel.topic not in topics:
+        return None
     schema = schemas.get(channel.schema_id)
+    name = schema.name if schema is not None else "?"
+    kind = _message_types().get(name)
+    if kind is None or channel.message_encoding != "cdr":
+        what = f"{name} in {channel.message_encoding!r}"
+        if topics is None:
+            warnings.warn(
+                f"{path}: skipping {channel.topic} ({what}: no otonav message type)", stacklevel=3
+            )
+            return None
+        raise RecordingError(
+            f"{path}: {channel.topic} holds {what}, which otonav has no message type for "
+            "(it reads the types of otonav.msgs and of any Message subclass imported)"
+        )
+    return kind
+
+
+def _decode(path: Path, channel: Channel, kind: type[Message], message: Message_) -> Message:
     try:
-        decoder = factory.decoder_for(channel.message_encoding, schema)
-        if decoder is None:
-            raise ValueError(f"no decoder for encoding {channel.message_encoding!r}")
-    except Exception as exc:
+        return decode(kind, message.data)
+    except ValueError as exc:
         raise DamagedRecordingError(
-            f"{path}: the schema of {channel.topic} ({schema.name if schema else '?'}) "
-            f"does not parse ({_one_line(exc)})"
+            f"{path}: the {channel.topic} message at {message.log_time / 1e9:.9f} s does not "
+            f"decode as {kind.ros_type} ({_one_line(exc)})"
         ) from None
-    return decoder
 
 
 def _read_cut_off(
@@ -310,27 +358,23 @@ def _read_cut_off(
     end: float | None,
     damage: list[Damage] | None = None,
 ) -> Iterator[tuple[str, float, Any]]:
-    factory = DecoderFactory()
     schemas: dict[int, Schema] = {}
-    channels: dict[int, tuple[Channel, Any]] = {}
-    wanted = None if topics is None else set(topics)
+    channels: dict[int, tuple[Channel, type[Message]]] = {}
     first = None if start is None else round(start * 1e9)
     last = None if end is None else round(end * 1e9)
     for record in iter_readable(path, damage):
         if isinstance(record, Schema):
             schemas[record.id] = record
         elif isinstance(record, Channel):
-            if wanted is None or record.topic in wanted:
-                try:
-                    channels[record.id] = (record, _decoder(path, factory, record, schemas))
-                except DamagedRecordingError:
-                    if damage is None:
-                        raise
-                    # Its schema was in a damaged chunk (reported): its messages are lost.
-        elif isinstance(record, Message) and record.channel_id in channels:
+            if damage and record.schema_id not in schemas:
+                continue  # its schema was in a damaged chunk (reported): its messages are lost
+            kind = _type_of(path, record, schemas, topics)
+            if kind is not None:
+                channels[record.id] = (record, kind)
+        elif isinstance(record, Message_) and record.channel_id in channels:
             if (first is not None and record.log_time < first) or (
                 last is not None and record.log_time >= last
             ):
                 continue
-            channel, decode = channels[record.channel_id]
-            yield channel.topic, record.log_time / 1e9, decode(record.data)
+            channel, kind = channels[record.channel_id]
+            yield channel.topic, record.log_time / 1e9, _decode(path, channel, kind, record)

@@ -31,15 +31,12 @@ from otonav.msgs import Header, Message
 from otonav.msgs.flat import FlatLayout
 from otonav.msgs.stand_in import become, stand_in_class
 from otonav.msgs.stand_in import get as _get
-from otonav.msgs.stand_in import new as _new
-from otonav.msgs.stand_in import set_dict as _set_dict
-from otonav.msgs.stand_in import set_extra as _set_extra
-from otonav.msgs.stand_in import set_fields_set as _set_fields_set
-from otonav.msgs.stand_in import set_private as _set_private
 from otonav.record.cdr import decode, flat_values
 from otonav.record.schemas import layout_for
 
 __all__ = ("input_maker", "is_lazy", "lazy", "lazy_maker", "materialize")
+
+_new = object.__new__
 
 M = TypeVar("M", bound=Message)
 
@@ -107,30 +104,20 @@ def _lazy_class(real: type[Message]) -> type[Message]:
 def lazy(message_type: type[M], data: bytes) -> M:
     """A ``message_type`` message that decodes ``data`` (CDR with its encapsulation
     header) the first time it is used. Bad data raises ``ValueError`` then."""
-    cls = _LAZY.get(message_type) or _lazy_class(message_type)
-    message: M = message_type.__new__(cls)  # type: ignore[assignment]
-    _set_dict(message, {_KEY: data})
-    _set_fields_set(message, message_type._otonav_fields)
-    _set_extra(message, None)
-    _set_private(message, None)
-    return message
+    return lazy_maker(message_type)(data)
 
 
 def lazy_maker(message_type: type[M]) -> Callable[[bytes], M]:
     """``lambda data: lazy(message_type, data)``, with the class looked up once (the
     replay's feeder makes one per recorded input)."""
     cls = _LAZY.get(message_type) or _lazy_class(message_type)
-    fields = message_type._otonav_fields
 
-    def make(data: bytes) -> M:
+    def make_lazy(data: bytes) -> M:
         message: M = _new(cls)  # type: ignore[assignment]
-        _set_dict(message, {_KEY: data})
-        _set_fields_set(message, fields)
-        _set_extra(message, None)
-        _set_private(message, None)
+        _get(message, "__dict__")[_KEY] = data  # its state: when decoded (as a flat one's)
         return message
 
-    return make
+    return make_lazy
 
 
 def input_maker(

@@ -79,7 +79,7 @@ def test_every_topic_is_advertised_and_odom_arrives_as_recorded(tmp_path: Path) 
         assert (channel.encoding, channel.schema_encoding) == ("cdr", "ros2msg")
         assert channel.schema_name == types[topic]
     # /odom: every message, in order, at its sim time, decoded by mcap_ros2 from the
-    # advertised schema, equal to the recording's (which that decoder also reads).
+    # advertised schema, equal to the recording's (read by otonav's own decoder).
     odom = client.channels["/odom"]
     got = [(stamp, odom.decode(data)) for stamp, data in client.received["/odom"]]
     assert len(got) == len(recorded) >= 299

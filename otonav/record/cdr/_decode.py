@@ -7,8 +7,8 @@ same layouts (:func:`~otonav.record.schemas.layout_for`) and the same leaf flatt
 the encoder: each run of fixed-size fields is one precompiled ``unpack_from`` (one per
 start offset mod 8, since the padding inside a run depends on where it starts);
 strings and sequences are read one by one; then the values are built back into the
-nested messages as ``Message.fast`` builds them. Both are generated per class as one
-straight-line function (:func:`_compile_decoder`). ``decode(type(m), encode(m)) == m`` for every
+nested messages as ``Message.fast`` builds them, all in one straight-line function
+generated per class (:func:`_compile_decoder`). ``decode(type(m), encode(m)) == m`` for every
 message (a property test), and the values agree with ``mcap_ros2``'s generic decoder on
 recordings (a test), which is the independent oracle.
 
@@ -24,8 +24,8 @@ from collections.abc import Callable
 from typing import Any, Final, TypeVar
 
 from otonav.msgs import Header, Message
+from otonav.msgs._base import _new, _setstate
 from otonav.msgs.flat import FlatLayout
-from otonav.msgs.stand_in import make, new, set_dict, set_extra, set_fields_set, set_private
 from otonav.record.cdr._encode import encode
 from otonav.record.cdr._layout import (
     ENCAPSULATION,
@@ -45,8 +45,6 @@ M = TypeVar("M", bound=Message)
 ReadStep = Callable[[bytes, int, list[Any]], int]
 """Read one part of a message from ``data`` at ``pos``, append its value(s), return
 the new position (``pos`` counts the 4-byte encapsulation header)."""
-Builder = Callable[[list[Any], int], tuple[Any, int]]
-"""Build one message from the flat values starting at index ``i``."""
 
 _U32: Final = struct.Struct("<I")
 
@@ -54,17 +52,6 @@ _U32: Final = struct.Struct("<I")
 def _aligned(pos: int, size: int) -> int:
     """``pos`` moved up to a multiple of ``size`` counted from the payload start."""
     return pos + (-(pos - 4) % size)
-
-
-def _fixed_run(run: list[Fixed]) -> ReadStep:
-    structs = tuple(struct.Struct(run_format(run, start)) for start in range(8))
-
-    def read(data: bytes, pos: int, out: list[Any]) -> int:
-        unpacker = structs[(pos - 4) & 7]
-        out.extend(unpacker.unpack_from(data, pos))
-        return pos + unpacker.size
-
-    return read
 
 
 def _read_string(data: bytes, pos: int) -> tuple[str, int]:
@@ -77,12 +64,6 @@ def _read_string(data: bytes, pos: int) -> tuple[str, int]:
     if end > len(data):
         raise ValueError("string runs past the end of the message")
     return data[pos : end - 1].decode(), end
-
-
-def _string(data: bytes, pos: int, out: list[Any]) -> int:
-    text, pos = _read_string(data, pos)
-    out.append(text)
-    return pos
 
 
 def _count(data: bytes, pos: int, count: int) -> tuple[int, int]:
@@ -125,13 +106,11 @@ def _strings(count: int) -> ReadStep:
 def _messages(message: type[Message], count: int) -> ReadStep:
     def read(data: bytes, pos: int, out: list[Any]) -> int:
         n, pos = _count(data, pos, count)
-        steps, build = _plan(message)
+        decode_one = _decoder(message)
         items = []
         for _ in range(n):
-            values: list[Any] = []
-            for step in steps:
-                pos = step(data, pos, values)
-            items.append(build(values, 0)[0])
+            item, pos = decode_one(data, None, pos)
+            items.append(item)
         out.append(tuple(items))
         return pos
 
@@ -144,8 +123,7 @@ def _empty(data: bytes, pos: int, out: list[Any]) -> int:
 
 
 def _var(leaf: Var) -> ReadStep:
-    if leaf.kind == "string":
-        return _string
+    """The read step of a variable part other than a string (read inline)."""
     if leaf.kind == "sequence":
         return _sequence(leaf.code, SEQUENCE)
     if leaf.kind == "strings":
@@ -156,87 +134,22 @@ def _var(leaf: Var) -> ReadStep:
     return _empty
 
 
-def _compile_steps(message: type[Message]) -> tuple[ReadStep, ...]:
-    return tuple(
-        _fixed_run(part) if isinstance(part, list) else _var(part)
-        for part in wire_parts(flatten(message))
-    )
-
-
-def _compile_builder(message: type[Message]) -> Builder:
-    """The inverse of the leaf flattening: one generated expression per class that
-    reads the flat values at fixed indices (every field takes one value, a fixed
-    primitive array n) and nests the messages' construction. Generated rather than
-    looped: an Odometry took 15 µs through a generic loop over fields, 4 µs this way;
-    ``_make`` instead of ``Message.fast(**fields)`` saves another quarter per message
-    (1.5 µs against 2.0 µs for a Vector3)."""
-    names: dict[str, object] = {"_make": _make}
-
-    def expr(current: type[Message], i: int) -> tuple[str, int]:
-        name = f"_c{len(names)}"
-        names[name] = current
-        names[name + "_fields"] = current._otonav_fields
-        layout = layout_for(current)
-        if not layout.fields:
-            return f"_make({name}, {{}}, {name}_fields)", i + 1
-        parts = []
-        for field in layout.fields:
-            if not isinstance(field.type, str) and field.array is None:
-                code, i = expr(field.type, i)
-            elif isinstance(field.type, str) and field.type != "string" and (field.array or 0) > 0:
-                n = field.array or 0
-                code, i = f"tuple(v[{i}:{i + n}])", i + n
-            else:  # one value: a scalar, a string, a sequence, an array of messages/strings
-                code, i = f"v[{i}]", i + 1
-            parts.append(f"{field.name!r}: {code}")
-        return f"_make({name}, {{{', '.join(parts)}}}, {name}_fields)", i
-
-    body, used = expr(message, 0)
-    source = f"lambda v, i: ({body}, {used})"
-    build: Builder = eval(source, names)  # generated from our own layouts only
-    return build
-
-
-# The slot setters of a message built without pydantic's constructor (Message.fast's way),
-# shared with the stand-in messages; the generated decoders call them directly.
-_make = make
-_new, _set_dict, _set_fields_set = new, set_dict, set_fields_set
-_set_extra, _set_private = set_extra, set_private
-
-
-_PLANS: dict[type[Message], tuple[tuple[ReadStep, ...], Builder]] = {}
-
-
-def _plan(message: type[Message]) -> tuple[tuple[ReadStep, ...], Builder]:
-    plan = _PLANS.get(message)
-    if plan is None:
-        plan = _PLANS[message] = (_compile_steps(message), _compile_builder(message))
-    return plan
-
-
-Decoder = Callable[[bytes, Any], tuple[Any, int]]
-"""Decode one message from CDR data that starts with its encapsulation header (and, for
-a stamped message, its Header if already decoded); returns it and where it ended."""
+Decoder = Callable[..., tuple[Any, int]]
+"""``(data, header=None, pos=4)``: decode one message from CDR ``data`` (with its
+encapsulation header) at ``pos`` (and, for a stamped message, its Header if already
+decoded); returns it and where it ended."""
 
 
 def _compile_decoder(message: type[Message]) -> Decoder:
     """One generated function per class, straight-line: each fixed run one
     ``unpack_from`` into a tuple, each string read inline, the other variable parts
-    through their read steps; then every message built bottom-up with ``_new`` and the
-    slot setters, no call per message and no flat list: an Odometry 6.3 -> 5.0 us, a
-    360-beam LaserScan 6.5 -> 5.9 us (the navigator's replay decodes ~860 inputs). The
-    same values and objects as the steps and builder above (which nested message arrays
-    still use); ``tests/unit/record/test_cdr.py`` checks every message type, and strings
-    of every length mod 4 before each field, against the original."""
-    names: dict[str, object] = {
-        "_new": _new,
-        "_sd": _set_dict,
-        "_sf": _set_fields_set,
-        "_se": _set_extra,
-        "_sp": _set_private,
-        "_U32": _U32,
-        "_len": len,
-    }
+    through their read steps; then every message built bottom-up as
+    ``otonav.msgs._base.make`` builds one (inlined), no flat list: an Odometry 6.3 -> 5.0 us, a
+    360-beam LaserScan 6.5 -> 5.9 us (the navigator's replay decodes ~860 inputs). An
+    element of an array of messages is read by its own class's decoder from where it
+    starts (``pos``). ``tests/unit/record/test_cdr.py`` checks every message type, and
+    strings of every length mod 4 before each field, against the original."""
+    names: dict[str, object] = {"_new": _new, "_ss": _setstate, "_U32": _U32, "_len": len}
     lines: list[str] = []
     values: list[str] = []  # flat value index -> its expression
     runs: dict[int, tuple[str, int]] = {}  # flat index -> (run tuple name, index in it)
@@ -266,12 +179,10 @@ def _compile_decoder(message: type[Message]) -> Decoder:
         names["_past_header"] = _past_header
         lines += [
             "if header is None:",
-            "    header, pos = _header(data)",
+            "    header, pos = _header(data, None, pos)",
             "else:",
             "    pos = _past_header(data)",
         ]
-    else:
-        lines.append("pos = 4")
     for leaf in wire_parts(leaves):
         if isinstance(leaf, list):
             read_run(leaf)
@@ -325,13 +236,11 @@ def _compile_decoder(message: type[Message]) -> Decoder:
             else:  # one value: a scalar, a string, a sequence, an array of messages/strings
                 code, i = values[i], i + 1
             parts.append(f"{field.name!r}: {code}")
-        lines.extend(
+        lines.extend(  # make(), inlined
             [
                 f"{name} = _new({cls})",
-                f"_sd({name}, {{{', '.join(parts)}}})",
-                f"_sf({name}, {cls}_fields)",
-                f"_se({name}, None)",
-                f"_sp({name}, None)",
+                f"_ss({name}, {{'__dict__': {{{', '.join(parts)}}}, '__pydantic_fields_set__': "
+                f"{cls}_fields, '__pydantic_extra__': None, '__pydantic_private__': None}})",
             ]
         )
         return name, i
@@ -340,7 +249,9 @@ def _compile_decoder(message: type[Message]) -> Decoder:
     assert used == len(values)
     # The reads (in wire order), then the builds (innermost messages first).
     body = "\n".join("    " + line for line in lines)
-    source = f"def decode_{message.__name__}(data, header=None):\n{body}\n    return {top}, pos\n"
+    source = (
+        f"def decode_{message.__name__}(data, header=None, pos=4):\n{body}\n    return {top}, pos\n"
+    )
     exec(compile(source, f"<cdr decoder of {message.__name__}>", "exec"), names)
     decoder: Decoder = names[f"decode_{message.__name__}"]  # type: ignore[assignment]
     return decoder
