@@ -19,6 +19,7 @@ from otonav.hal.types import (
     BoxObstacle,
     GroundTruth,
     ImuSample,
+    LidarSpec,
     RangeScan,
     RobotGeometry,
     WheelSetpoint,
@@ -31,6 +32,7 @@ GRAVITY = 9.81
 """m/s^2, reported by the fake accelerometer on +z."""
 
 _TINY = 1e-12
+_LIDAR = LidarSpec()  # the default lidar
 
 
 def arena_walls(half_size: float, thickness: float = 0.1) -> tuple[BoxObstacle, ...]:
@@ -102,19 +104,13 @@ class FakeHardware(RobotHardwareInterface):
         arena_half_size: float | None = None,
         start: tuple[float, float, float] = (0.0, 0.0, 0.0),
         wheel_time_constant: float = 0.0,
-        lidar_beams: int = 360,
-        lidar_range_min: float = 0.12,
-        lidar_range_max: float = 8.0,
+        lidar_beams: int = _LIDAR.beams,
+        lidar_range_min: float = _LIDAR.range_min,
+        lidar_range_max: float = _LIDAR.range_max,
     ) -> None:
         if not tick > 0.0:
             raise ValueError(f"tick must be positive, got {tick}")
-        if lidar_beams < 1:
-            raise ValueError(f"lidar_beams must be >= 1, got {lidar_beams}")
-        if not 0.0 <= lidar_range_min < lidar_range_max:
-            raise ValueError(
-                f"need 0 <= lidar_range_min < lidar_range_max, got "
-                f"{lidar_range_min}, {lidar_range_max}"
-            )
+        self._lidar = LidarSpec(lidar_beams, lidar_range_min, lidar_range_max)
         if wheel_time_constant < 0.0:
             raise ValueError(f"wheel_time_constant must be >= 0, got {wheel_time_constant}")
         self._tick = tick
@@ -129,11 +125,7 @@ class FakeHardware(RobotHardwareInterface):
         self._walls = () if arena_half_size is None else arena_walls(arena_half_size)
         self._boxes = self._obstacles + self._walls
         self._tau = wheel_time_constant
-        self._range_min = lidar_range_min
-        self._range_max = lidar_range_max
-        self._angle_increment = 2.0 * math.pi / lidar_beams
-        self._angle_min = -math.pi
-        self._beam_angles = self._angle_min + self._angle_increment * np.arange(lidar_beams)
+        self._beam_angles = self._lidar.angles()
 
         self._ticks = 0
         self._x, self._y, self._yaw = start
@@ -230,20 +222,7 @@ class FakeHardware(RobotHardwareInterface):
         ox = self._x + self._geometry.laser_offset_x * math.cos(self._yaw)
         oy = self._y + self._geometry.laser_offset_x * math.sin(self._yaw)
         world_angles = np.asarray(self._beam_angles + self._yaw, dtype=np.float64)
-        dist = cast_rays_2d(ox, oy, world_angles, self._boxes)
-        valid = (dist >= self._range_min) & (dist <= self._range_max)
-        # REP 117: a miss is +inf, a return closer than range_min is -inf.
-        too_close = dist < self._range_min
-        ranges = np.where(valid, dist, np.where(too_close, -np.inf, np.inf)).astype(np.float32)
-        ranges.flags.writeable = False
-        return RangeScan(
-            angle_min=self._angle_min,
-            angle_max=self._angle_min + self._angle_increment * (ranges.size - 1),
-            angle_increment=self._angle_increment,
-            range_min=self._range_min,
-            range_max=self._range_max,
-            ranges=ranges,
-        )
+        return self._lidar.scan(cast_rays_2d(ox, oy, world_angles, self._boxes))
 
     def ground_truth(self) -> GroundTruth:
         v, _ = self._body_rates()

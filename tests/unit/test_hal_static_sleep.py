@@ -12,7 +12,7 @@ import pytest
 
 from otonav.bench.clutter import clutter_scenario
 from otonav.hal import WheelSetpoint
-from otonav.hal.mujoco import MujocoInterface, static_geoms, static_sleep
+from otonav.hal.mujoco import MujocoInterface, lidar, static_sleep
 from otonav.hal.mujoco._lib import mujoco
 
 
@@ -20,7 +20,7 @@ def _clutter(
     n: int, monkeypatch: pytest.MonkeyPatch, *, anchor: bool, caster: bool, **kw: object
 ) -> MujocoInterface:
     monkeypatch.setattr(static_sleep, "MIN_STATIC_GEOMS", 100 if anchor else 10**9)
-    monkeypatch.setattr(static_geoms, "MIN_STATIC_BOXES", 400 if caster else 10**9)
+    monkeypatch.setattr(lidar, "MIN_STATIC_BOXES", 400 if caster else 10**9)
     boxes = [b.to_obstacle() for b in clutter_scenario(n).obstacles]
     return MujocoInterface("empty", extra_obstacles=boxes, **kw)  # type: ignore[arg-type]
 
@@ -44,7 +44,7 @@ def _drive(
             sa, sb = a.read_scan(), b.read_scan()
             assert np.array_equal(sa.ranges, sb.ranges), k
             assert np.array_equal(a.scan_hit_geoms(), b.scan_hit_geoms()), k
-            assert np.array_equal(a._ray_dist, b._ray_dist), k  # every float64
+            assert np.array_equal(a._lidar._dist, b._lidar._dist), k  # every float64
 
 
 @pytest.mark.parametrize("start", [(-3.0, 0.0, 0.0), (-3.0, 1.3, 0.3)])
@@ -58,8 +58,8 @@ def test_the_1000_box_course_is_what_it_was_bit_for_bit(
     fast = _clutter(1000, monkeypatch, anchor=True, caster=True, start=start)
     ref = _clutter(1000, monkeypatch, anchor=False, caster=False, start=start)
     assert fast.mj_model.nbody == ref.mj_model.nbody + 1  # type: ignore[attr-defined]
-    assert fast._caster is not None
-    assert ref._caster is None
+    assert fast._lidar._caster is not None
+    assert ref._lidar._caster is None
     _drive((fast, ref), 2500)
     if start[1] > 0:  # it did meet the boxes: box contacts, the same in both
         m: Any = fast.mj_model
