@@ -133,7 +133,6 @@ class FakeHardware(RobotHardwareInterface):
         self._wl = self._wr = 0.0  # wheel angular velocities, rad/s
         self._ql = self._qr = 0.0  # wheel angles, rad
         self._accel = 0.0  # forward acceleration over the last tick, m/s^2
-        self._closed = False
 
     # -- time ---------------------------------------------------------------------------
 
@@ -245,10 +244,3 @@ class FakeHardware(RobotHardwareInterface):
 
     def walls(self) -> tuple[BoxObstacle, ...]:
         return self._walls
-
-    def close(self) -> None:
-        self._closed = True
-
-    def _check_open(self) -> None:
-        if self._closed:
-            raise RuntimeError("FakeHardware is closed")

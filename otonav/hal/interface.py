@@ -37,6 +37,8 @@ class RobotHardwareInterface(abc.ABC):
     Usable as a context manager (``close()`` on exit).
     """
 
+    _closed = False
+
     @property
     @abc.abstractmethod
     def tick(self) -> float:
@@ -148,9 +150,13 @@ class RobotHardwareInterface(abc.ABC):
         is returned until something changes."""
         return _OK
 
-    @abc.abstractmethod
     def close(self) -> None:
         """Release resources. Idempotent; the interface must not be used afterwards."""
+        self._closed = True
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise RuntimeError(f"{type(self).__name__} is closed")
 
     def __enter__(self) -> Self:
         return self

@@ -82,21 +82,6 @@ class RangeScan:
         angles = self.angle_min + self.angle_increment * np.arange(self.ranges.size)
         return np.asarray(angles, dtype=np.float64)
 
-    def beam_index(self, angle: float) -> int:
-        """Index of the beam closest to ``angle`` (rad, laser frame).
-
-        A full-circle scan wraps around; a partial one clamps to its first/last beam.
-        """
-        n = self.ranges.size
-        if n == 0:
-            raise ValueError("empty scan has no beams")
-        if n == 1 or self.angle_increment == 0.0:
-            return 0
-        k = round((angle - self.angle_min) / self.angle_increment)
-        if abs(self.angle_increment) * n >= 2.0 * math.pi - 1e-9:
-            return k % n
-        return min(max(k, 0), n - 1)
-
 
 @dataclass(frozen=True, slots=True)
 class LidarSpec:

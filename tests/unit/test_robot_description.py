@@ -58,7 +58,7 @@ def variant(tmp_path: Path, old: str, new: str) -> RobotDescription:
 
 def old_scene(tmp_path: Path, scene: str) -> Path:
     """A built-in scene as scenes were written before: including robot.xml."""
-    assets = Path(MujocoInterface("empty").scene_file).parent
+    assets = Path(MujocoInterface("empty")._label).parent
     shutil.copy(assets / "robot.xml", tmp_path / "robot.xml")
     text = (assets / f"{scene}.xml").read_text()
     attached = '<compiler angle="radian"/>\n  <option timestep="0.002" integrator="implicitfast"/>'
@@ -336,7 +336,7 @@ def test_a_vendor_model_runs_as_written_whichever_base_frame_is_named(base: str)
 
 
 def test_a_condim_1_caster_without_priority_is_made_frictionless(tmp_path: Path) -> None:
-    assets = Path(MujocoInterface("empty").scene_file).parent
+    assets = Path(MujocoInterface("empty")._label).parent
     text = (assets / "robots" / "burger.xml").read_text()
     old = 'condim="1" priority="1"'
     assert old in text

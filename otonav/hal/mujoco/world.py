@@ -127,7 +127,6 @@ class MujocoInterface(RobotHardwareInterface):
         self._shapes = _static_shapes(self._model)
         self._reach: dict[tuple[float, float], Reach] = {}
         self._ticks = 0
-        self._closed = False
         self._settle(start)
         # The static boxes and planes are cast in numpy (ADR 0057), MuJoCo casts the rest.
         self._lidar = Lidar(
@@ -228,21 +227,6 @@ class MujocoInterface(RobotHardwareInterface):
         self._sync()
 
     # -- model facts ----------------------------------------------------------------------
-
-    @property
-    def scene_file(self) -> str:
-        """The MJCF file this world was built from."""
-        return self._label
-
-    @property
-    def mj_model(self) -> object:
-        """The compiled ``mujoco.MjModel`` (for a viewer inside ``otonav.hal`` only)."""
-        return self._model
-
-    @property
-    def mj_data(self) -> object:
-        """The live ``mujoco.MjData`` (for a viewer inside ``otonav.hal`` only)."""
-        return self._data
 
     def open_viewer(self, *, track: bool = True) -> ViewerHandle:
         """Open MuJoCo's passive viewer (no side panels) on this world.
@@ -452,10 +436,3 @@ class MujocoInterface(RobotHardwareInterface):
 
     def unjudged_geoms(self) -> tuple[str, ...]:
         return self._shapes.unjudged
-
-    def close(self) -> None:
-        self._closed = True
-
-    def _check_open(self) -> None:
-        if self._closed:
-            raise RuntimeError(f"MujocoInterface for {self._label} is closed")
