@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from otonav.hal.mujoco._lib import mujoco
-from otonav.hal.raycast import StaticGeometry, StaticRayCaster
+from otonav.hal.raycast import StaticGeometry, StaticGeoms, StaticRayCaster
 from otonav.hal.types import LidarSpec, RangeScan
 from otonav.limits import LIDAR_CASTER_MIN_BOXES
 
@@ -68,44 +68,20 @@ def ray_caster(
             half = aabb[3:6]
             ssz[row] = half[0] * half[0] + half[1] * half[1] + half[2] * half[2]
 
-    def part(mask: NDArray[np.bool_]) -> dict[str, Any]:
+    def part(mask: NDArray[np.bool_]) -> StaticGeoms:
         ids = np.flatnonzero(mask)
-        return {
-            "ids": ids.astype(np.int32),
-            "pos": np.array(d.geom_xpos[ids], dtype=np.float64).reshape(-1, 3),
-            "mat": np.array(d.geom_xmat[ids], dtype=np.float64).reshape(-1, 9),
-            "size": np.array(m.geom_size[ids], dtype=np.float64).reshape(-1, 3),
-            "rbound": np.array(m.geom_rbound[ids], dtype=np.float64),
-            "aabb": np.array(m.geom_aabb[ids], dtype=np.float64).reshape(-1, 6),
-            "body": body_row[np.asarray(m.geom_bodyid)[ids]],
-        }
+        return StaticGeoms(
+            ids=ids.astype(np.int32),
+            pos=np.array(d.geom_xpos[ids], dtype=np.float64).reshape(-1, 3),
+            mat=np.array(d.geom_xmat[ids], dtype=np.float64).reshape(-1, 9),
+            size=np.array(m.geom_size[ids], dtype=np.float64).reshape(-1, 3),
+            rbound=np.array(m.geom_rbound[ids], dtype=np.float64),
+            aabb=np.array(m.geom_aabb[ids], dtype=np.float64).reshape(-1, 6),
+            body=body_row[np.asarray(m.geom_bodyid)[ids]],
+        )
 
-    b, p = part(box), part(plane)
-    geometry = StaticGeometry(
-        box_ids=b["ids"],
-        box_pos=b["pos"],
-        box_mat=b["mat"],
-        box_size=b["size"],
-        box_rbound=b["rbound"],
-        box_aabb=b["aabb"],
-        box_body=b["body"],
-        plane_ids=p["ids"],
-        plane_pos=p["pos"],
-        plane_mat=p["mat"],
-        plane_size=p["size"],
-        plane_rbound=p["rbound"],
-        plane_aabb=p["aabb"],
-        plane_body=p["body"],
-        body_center=center,
-        body_ssz=ssz,
-    )
-    caster = StaticRayCaster(
-        geometry,
-        angle_min=spec.angle_min,
-        increment=spec.increment,
-        beams=spec.beams,
-        cutoff=spec.range_max,
-    )
+    geometry = StaticGeometry(part(box), part(plane), center, ssz)
+    caster = StaticRayCaster(geometry, spec)
     return caster, moving
 
 
