@@ -1,15 +1,8 @@
-"""MuJoCo implementation of :class:`~otonav.hal.interface.RobotHardwareInterface`.
-
-Part of ``otonav.hal.mujoco``, the only code in otonav that touches MuJoCo; nothing
-outside it sees a MuJoCo type (``mujoco`` has no type stubs, so its objects are ``Any``
-here and never escape through a public signature).
-
-A scene is a built-in name (see :func:`scene_names`) or a path to an MJCF file. The
-robot is found by name: body ``chassis`` (free joint, base_link), hinge joints
-``left_wheel``/``right_wheel``, actuators ``left_motor``/``right_motor``, sites ``imu``
-and ``lidar``, sensors ``imu_gyro``, ``imu_accel``, ``imu_quat``. Static box geoms named
-``obstacle*`` and ``wall*`` are the world's obstacles and walls. Robot geoms live in
-geom group 1; the lidar casts only against groups 0 and 2.
+"""MuJoCo implementation of :class:`~otonav.hal.interface.RobotHardwareInterface`: a
+scene (a built-in name, see :func:`scene_names`, or an MJCF file) with the robot of a
+:class:`~otonav.hal.description.RobotDescription` put in it. No MuJoCo type escapes
+through a public signature (``mujoco`` has no type stubs: its objects are ``Any`` here).
+Robot geoms live in geom group 1; the lidar casts only against groups 0 and 2.
 
 Time: ``advance(n)`` is the only thing that steps physics; ``ticks`` is an integer
 counter (``data.time`` accumulates float error and is not used). Readings taken after an
