@@ -127,7 +127,6 @@ class FakeHardware(RobotHardwareInterface):
         self._tau = wheel_time_constant
         self._beam_angles = self._lidar.angles()
 
-        self._ticks = 0
         self._x, self._y, self._yaw = start
         self._cmd = WheelSetpoint(0.0, 0.0)
         self._wl = self._wr = 0.0  # wheel angular velocities, rad/s
@@ -140,15 +139,8 @@ class FakeHardware(RobotHardwareInterface):
     def tick(self) -> float:
         return self._tick
 
-    @property
-    def ticks(self) -> int:
-        return self._ticks
-
     def advance(self, n: int) -> None:
-        self._check_open()
-        if n < 0:
-            raise ValueError(f"cannot advance by a negative number of ticks ({n})")
-        if n == 0:
+        if not self._steps(n):
             return
         if self._tau == 0.0:
             wl, wr = self._cmd.left, self._cmd.right

@@ -38,6 +38,7 @@ class RobotHardwareInterface(abc.ABC):
     """
 
     _closed = False
+    _ticks = 0
 
     @property
     @abc.abstractmethod
@@ -45,9 +46,9 @@ class RobotHardwareInterface(abc.ABC):
         """Physics step, seconds. Constant for the life of the interface."""
 
     @property
-    @abc.abstractmethod
     def ticks(self) -> int:
         """Number of physics steps taken since construction: the truth of time."""
+        return self._ticks
 
     @property
     def sim_time(self) -> float:
@@ -57,6 +58,13 @@ class RobotHardwareInterface(abc.ABC):
     @abc.abstractmethod
     def advance(self, n: int) -> None:
         """Step the world ``n`` ticks (``n >= 0``) holding the current wheel command."""
+
+    def _steps(self, n: int) -> bool:
+        """Check an :meth:`advance` by ``n``: open, ``n >= 0``; False: nothing to do."""
+        self._check_open()
+        if n < 0:
+            raise ValueError(f"cannot advance by a negative number of ticks ({n})")
+        return n > 0
 
     @abc.abstractmethod
     def write(self, cmd: WheelSetpoint) -> None:

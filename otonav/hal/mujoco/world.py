@@ -119,7 +119,6 @@ class MujocoInterface(RobotHardwareInterface):
         self._bind(parts, prefix, robot_file, mover)
         self._shapes = _static_shapes(self._model)
         self._reach: dict[tuple[float, float], Reach] = {}
-        self._ticks = 0
         self._settle(start)
         # The static boxes and planes are cast in numpy (ADR 0057), MuJoCo casts the rest.
         self._lidar = Lidar(
@@ -246,15 +245,8 @@ class MujocoInterface(RobotHardwareInterface):
     def tick(self) -> float:
         return float(self._model.opt.timestep)
 
-    @property
-    def ticks(self) -> int:
-        return self._ticks
-
     def advance(self, n: int) -> None:
-        self._check_open()
-        if n < 0:
-            raise ValueError(f"cannot advance by a negative number of ticks ({n})")
-        if n == 0:
+        if not self._steps(n):
             return
         mujoco.mj_step(self._model, self._data, nstep=n)
         self._ticks += n
