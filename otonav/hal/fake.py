@@ -144,10 +144,10 @@ class FakeHardware(RobotHardwareInterface):
             return
         if self._tau == 0.0:
             wl, wr = self._cmd.left, self._cmd.right
-            v_before = self._speed(self._wl, self._wr)
+            v_before = self._rates(self._wl, self._wr)[0]
             self._wl, self._wr = wl, wr
             self._integrate(wl, wr, n * self._tick)
-            self._accel = (self._speed(wl, wr) - v_before) / self._tick if n == 1 else 0.0
+            self._accel = (self._rates(wl, wr)[0] - v_before) / self._tick if n == 1 else 0.0
         else:
             decay = math.exp(-self._tick / self._tau)
             gain = self._tau * (1.0 - decay)  # integral of the decaying error over a tick
@@ -161,17 +161,18 @@ class FakeHardware(RobotHardwareInterface):
                 mr = cr + (wr0 - cr) * gain / self._tick
                 self._wl, self._wr = wl1, wr1
                 self._integrate(ml, mr, self._tick)
-                self._accel = (self._speed(wl1, wr1) - self._speed(wl0, wr0)) / self._tick
+                dv = self._rates(wl1, wr1)[0] - self._rates(wl0, wr0)[0]
+                self._accel = dv / self._tick
         self._ticks += n
 
-    def _speed(self, wl: float, wr: float) -> float:
-        return self._geometry.wheel_radius * (wl + wr) / 2.0
+    def _rates(self, wl: float, wr: float) -> tuple[float, float]:
+        """Body speed (m/s) and turn rate (rad/s) at wheel speeds ``wl``, ``wr``."""
+        r = self._geometry.wheel_radius
+        return r * (wl + wr) / 2.0, r * (wr - wl) / self._geometry.wheel_separation
 
     def _integrate(self, wl: float, wr: float, dt: float) -> None:
         """Advance pose and wheel angles by ``dt`` at constant wheel speeds (exact arc)."""
-        r, b = self._geometry.wheel_radius, self._geometry.wheel_separation
-        v = r * (wl + wr) / 2.0
-        w = r * (wr - wl) / b
+        v, w = self._rates(wl, wr)
         yaw0 = self._yaw
         dyaw = w * dt
         if abs(dyaw) < 1e-9:
@@ -196,12 +197,8 @@ class FakeHardware(RobotHardwareInterface):
     def read_wheels(self) -> WheelState:
         return WheelState(self._ql, self._qr, self._wl, self._wr)
 
-    def _body_rates(self) -> tuple[float, float]:
-        r, b = self._geometry.wheel_radius, self._geometry.wheel_separation
-        return r * (self._wl + self._wr) / 2.0, r * (self._wr - self._wl) / b
-
     def read_imu(self) -> ImuSample:
-        v, w = self._body_rates()
+        v, w = self._rates(self._wl, self._wr)
         half = self._yaw / 2.0
         return ImuSample(
             orientation=(math.cos(half), 0.0, 0.0, math.sin(half)),
@@ -216,7 +213,7 @@ class FakeHardware(RobotHardwareInterface):
         return self._lidar.scan(cast_rays_2d(ox, oy, world_angles, self._boxes))
 
     def ground_truth(self) -> GroundTruth:
-        v, _ = self._body_rates()
+        v, _ = self._rates(self._wl, self._wr)
         return GroundTruth(
             x=self._x,
             y=self._y,
