@@ -146,7 +146,7 @@ class MujocoInterface(RobotHardwareInterface):
         probe = _probe(parts)
         parts.casters(probe.resting)
         parts.prepare(probe.mass, probe.wheel_radius)
-        self._sites = (
+        self._sites = (  # the names of the lidar's and the IMU's sites
             parts.mount("lidar", robot.lidar, (0.0, 0.0, probe.top + _MOUNT_ABOVE)),
             parts.mount("imu", robot.imu, (0.0, 0.0, 0.0)),
         )
