@@ -231,6 +231,18 @@ def test_lidar_range_limits_give_inf() -> None:
     assert scan.ranges[beam(scan, math.pi)] == pytest.approx(5.06, abs=0.005)
 
 
+def test_a_beam_that_meets_nothing_reads_plus_inf(tmp_path: Path) -> None:
+    """REP 117 through MuJoCo's -1 for a miss: +inf (free), never -inf (too close)."""
+    scene = tmp_path / "open.xml"
+    scene.write_text(
+        '<mujoco><worldbody><geom name="floor" type="plane" size="20 20 0.1"/></worldbody></mujoco>'
+    )
+    hw = MujocoInterface(scene, lidar_beams=36)
+    scan = hw.read_scan()
+    assert (hw.scan_hit_geoms() == -1).all()
+    assert np.isposinf(scan.ranges).all()
+
+
 def _mirrored(ranges: np.ndarray) -> np.ndarray:
     """The scan a lidar with the wrong handedness would give: the beam at angle a reads
     what is at -a (beam i at -pi + i*2pi/n swaps with beam n - i)."""
