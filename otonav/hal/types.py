@@ -184,6 +184,11 @@ class RobotGeometry:
     0.06 m ahead of the axle, wheels reaching y = +-0.1225 m)."""
     wheel_joints: tuple[str, str] = ("left_wheel", "right_wheel")
     """The wheel joints' names in the model (/joint_states)."""
+    wheel_signs: tuple[float, float] = (1.0, 1.0)
+    """Each wheel joint's own sign: +1 if its positive turn rolls the robot forward, -1
+    if its axis points the other way (a mirrored joint). The HAL's wheel readings are
+    positive-forward; /joint_states reports each joint in its own sign, as
+    robot_state_publisher expects."""
 
     @property
     def footprint_radius(self) -> float:

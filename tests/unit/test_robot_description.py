@@ -10,12 +10,16 @@ import struct
 from dataclasses import replace
 from pathlib import Path
 
+import anyio
 import numpy as np
 import pytest
 
+from otonav.actors import Bridge, topics
 from otonav.hal import BoxObstacle, WheelSetpoint
 from otonav.hal.description import Mount, RobotDescription, builtin_robot
 from otonav.hal.mujoco import MujocoInterface, SceneError
+from otonav.msgs import JointState, WheelCommand
+from otonav.runtime import System, virtual_loop_factory
 from otonav.scenario.verdict import lidar_over_obstacles
 
 PATHFINDER = Path(__file__).resolve().parents[2] / "examples" / "my_robot"
@@ -547,3 +551,30 @@ def test_the_speed_asked_is_capped_by_the_wheels_control_range() -> None:
     assert reach.asked_omega == pytest.approx(6.67 * 0.033 / 0.08)
     assert 0.8 < reach.v / reach.asked_v < 0.9
     assert world.geometry_sources()["reach"].endswith("(the wheels' control range: 6.67 rad/s)")
+
+
+def test_joint_states_report_a_mirrored_joint_in_its_own_sign() -> None:
+    """Pathfinder's right hinge turns about -y: rolling forward it turns negative, and
+    robot_state_publisher (and MuJoCo's qpos) expect that sign on /joint_states."""
+    world = MujocoInterface("empty", robot=pathfinder())
+    assert world.geometry.wheel_signs == (1.0, -1.0)
+    right_dof = world._wheel_qvel[1]
+    states: list[JointState] = []
+
+    async def main() -> None:
+        async with System([Bridge(world)]) as system:
+            sub = system.subscribe(topics.JOINT_STATES, JointState, topics.SENSOR_QOS)
+            wheels = system.publisher(topics.WHEEL_CMD, WheelCommand, topics.COMMAND_QOS)
+            await wheels.publish(WheelCommand(left=3.0, right=3.0))
+            with anyio.move_on_after(1.0):
+                async for message in sub:
+                    states.append(message)
+
+    anyio.run(main, backend_options={"loop_factory": virtual_loop_factory(world, wall_ceiling=30)})
+    assert world.ground_truth().x > 0.1  # it rolled forward
+    last = states[-1]
+    assert last.velocity[0] == pytest.approx(3.0, rel=0.05)
+    assert last.velocity[1] == pytest.approx(-3.0, rel=0.05)
+    assert last.position[0] > 1.0
+    assert last.position[1] < -1.0
+    assert math.copysign(1.0, world._data.qvel[right_dof]) == -1.0  # the model's own sign

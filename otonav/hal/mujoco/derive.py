@@ -183,6 +183,7 @@ class _Derivation:
         return result
 
     def geometry(self, joints: tuple[int, int], lidar: int, imu: int) -> RobotGeometry:
+        signs = (self.wheel_sign(joints[0]), self.wheel_sign(joints[1]))
         radius = self.wheel_radius(joints[0])
         separation = self.separation(*joints)
         laser = self.site_offset(lidar, "lidar")
@@ -197,6 +198,7 @@ class _Derivation:
             imu_offset=(float(imu_pos[0]), float(imu_pos[1]), float(imu_pos[2])),
             footprint=footprint,
             wheel_joints=(self.robot.left_wheel, self.robot.right_wheel),
+            wheel_signs=signs,
         )
 
     def _given(self, key: str, value: object) -> bool:

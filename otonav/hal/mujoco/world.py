@@ -187,13 +187,13 @@ class MujocoInterface(RobotHardwareInterface):
         self._quat = _site_sensor(m, mujoco.mjtSensor.mjSENS_FRAMEQUAT, imu_site)
 
         derived = _Derivation(m, ident(obj.mjOBJ_BODY, robot.base), parts)
-        self._wheel_sign = (derived.wheel_sign(left_joint), derived.wheel_sign(right_joint))
+        self._geometry = derived.geometry((left_joint, right_joint), self._lidar_site, imu_site)
+        self._wheel_sign = self._geometry.wheel_signs
         self._mirrored = self._wheel_sign != (1.0, 1.0)
         self._ctrl_scale = (
             parts.ctrl_scale["left_wheel"] * self._wheel_sign[0],
             parts.ctrl_scale["right_wheel"] * self._wheel_sign[1],
         )
-        self._geometry = derived.geometry((left_joint, right_joint), self._lidar_site, imu_site)
         self._sources = {**parts.sources, **derived.sources}
         self._identity = _Robot(
             body=prefix + mover,
