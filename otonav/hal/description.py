@@ -8,8 +8,13 @@ stack config's ``robot`` section becomes one (``otonav.stack.robot``).
 
 from __future__ import annotations
 
+import atexit
+import shutil
+import tempfile
 from dataclasses import dataclass, field, replace
 from importlib import resources
+from importlib.resources.abc import Traversable
+from pathlib import Path
 from typing import Final
 
 __all__ = [
@@ -79,8 +84,40 @@ BUILTIN_ROBOTS: Final[dict[str, RobotDescription]] = {
 """The robots shipped in ``otonav/hal/assets`` by name (``model`` relative to it)."""
 
 
+def _shipped() -> Traversable:
+    return resources.files("otonav.hal").joinpath("assets")
+
+
+_copy: list[Path] = []  # the one copy, removed at exit
+
+
+def assets_dir() -> Path:
+    """``otonav/hal/assets`` as a real folder: the package's own, or, when the package is
+    not on a filesystem (zipped), a copy of the whole tree made once per process (MuJoCo
+    reads files, and a scene's ``<include>`` and a robot's ``robots/`` need their
+    neighbours)."""
+    root = _shipped()
+    if isinstance(root, Path):
+        return root
+    if not _copy:
+        tmp = Path(tempfile.mkdtemp(prefix="otonav-assets-"))
+        atexit.register(shutil.rmtree, tmp, ignore_errors=True)
+        _copy_tree(root, tmp)
+        _copy.append(tmp)
+    return _copy[0]
+
+
+def _copy_tree(source: Traversable, target: Path) -> None:
+    for entry in source.iterdir():
+        if entry.is_dir():
+            (target / entry.name).mkdir()
+            _copy_tree(entry, target / entry.name)
+        else:
+            with entry.open("rb") as src, (target / entry.name).open("wb") as dst:
+                shutil.copyfileobj(src, dst)
+
+
 def builtin_robot(name: str) -> RobotDescription:
     """The description of a built-in robot (``KeyError`` for an unknown name)."""
     shipped = BUILTIN_ROBOTS[name]
-    model = resources.files("otonav.hal").joinpath("assets", shipped.model)
-    return replace(shipped, model=str(model), overrides={})
+    return replace(shipped, model=str(assets_dir() / shipped.model), overrides={})

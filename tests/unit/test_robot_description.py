@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import shutil
 import struct
+import zipfile
 from dataclasses import replace
 from pathlib import Path
 
@@ -15,9 +16,9 @@ import numpy as np
 import pytest
 
 from otonav.actors import Bridge, topics
-from otonav.hal import BoxObstacle, WheelSetpoint
+from otonav.hal import BoxObstacle, WheelSetpoint, description
 from otonav.hal.description import Mount, RobotDescription, builtin_robot
-from otonav.hal.mujoco import MujocoInterface, SceneError
+from otonav.hal.mujoco import MujocoInterface, SceneError, scene_path
 from otonav.msgs import JointState, WheelCommand
 from otonav.runtime import System, virtual_loop_factory
 from otonav.scenario.verdict import lidar_over_obstacles
@@ -578,3 +579,29 @@ def test_joint_states_report_a_mirrored_joint_in_its_own_sign() -> None:
     assert last.position[0] > 1.0
     assert last.position[1] < -1.0
     assert math.copysign(1.0, world._data.qvel[right_dof]) == -1.0  # the model's own sign
+
+
+def test_a_zipped_package_copies_the_whole_assets_tree_for_its_scenes_and_robots(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Installed as a zip, the assets are no real files: MuJoCo gets a copy of the whole
+    tree, so the Burger in ``robots/`` loads as it does from a folder."""
+    shipped = description.assets_dir()
+    archive = tmp_path / "otonav.zip"
+    with zipfile.ZipFile(archive, "w") as z:
+        for file in shipped.rglob("*"):
+            if file.is_file():
+                z.write(file, f"otonav/hal/assets/{file.relative_to(shipped).as_posix()}")
+    monkeypatch.setattr(
+        description, "_shipped", lambda: zipfile.Path(archive, "otonav/hal/assets/")
+    )
+    monkeypatch.setattr(description, "_copy", [])
+    with scene_path("obstacles") as path:
+        assert not path.is_relative_to(shipped)
+        copied = path.parent / "robots" / "burger.xml"
+        assert copied.read_bytes() == (shipped / "robots" / "burger.xml").read_bytes()
+    burger = builtin_robot("burger")
+    assert Path(burger.model) == copied
+    world = MujocoInterface("obstacles", robot=burger)
+    assert world.geometry.wheel_radius == pytest.approx(0.033)
+    assert world.geometry.wheel_joints == ("wheel_left_joint", "wheel_right_joint")
