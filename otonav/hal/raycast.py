@@ -59,6 +59,8 @@ _NO_ID: Final = np.iinfo(np.int64).max
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
+Mask = NDArray[np.bool_]
+_Found = list[tuple[I64, F64, I64, Mask]]  # (beams, distances, geom ids, deep) per caster
 
 
 @dataclass(frozen=True, slots=True)
@@ -88,7 +90,7 @@ class StaticGeometry:
     body_ssz: F64
 
 
-def _sphere_hit(center: F64, ssz: F64, pnt: F64, vec: F64) -> NDArray[np.bool_]:
+def _sphere_hit(center: F64, ssz: F64, pnt: F64, vec: F64) -> Mask:
     """MuJoCo's ``ray_sphere(center, ssz) >= 0``; ``center``/``ssz`` broadcast against
     the rays ``vec`` (..., 3), the same operations in the same order."""
     d0 = pnt[0] - center[..., 0]
@@ -101,7 +103,7 @@ def _sphere_hit(center: F64, ssz: F64, pnt: F64, vec: F64) -> NDArray[np.bool_]:
     det = b * b - a * c
     ok = det >= _MINVAL
     root = np.sqrt(np.where(ok, det, 0.0))
-    result: NDArray[np.bool_] = ok & (((-b - root) / a >= 0) | ((-b + root) / a >= 0))
+    result: Mask = ok & (((-b - root) / a >= 0) | ((-b + root) / a >= 0))
     return result
 
 
@@ -175,9 +177,7 @@ def ray_plane(pos: F64, mat: F64, size: F64, pnt: F64, vec: F64) -> F64:
     return result
 
 
-def _unsure_angles(
-    aabb: F64, pos: F64, mat: F64, pnt: F64, vec: F64, which: I64
-) -> NDArray[np.bool_]:
+def _unsure_angles(aabb: F64, pos: F64, mat: F64, pnt: F64, vec: F64, which: I64) -> Mask:
     """Per ray: could MuJoCo's bounding angles (``mju_multiRayPrepare``: azimuth and
     elevation of the geom's AABB corners) have skipped geom ``which[ray]`` (a row of
     ``aabb``/``pos``/``mat``)? True when the ray lies outside them or within ``_SLACK``
@@ -221,7 +221,7 @@ def _unsure_angles(
         & (ray_el >= el_lo[which] + _SLACK)
         & (ray_el <= el_hi[which] - _SLACK)
     )
-    unsure: NDArray[np.bool_] = full_unsure[which] | ~(full[which] | within)
+    unsure: Mask = full_unsure[which] | ~(full[which] | within)
     return unsure
 
 
@@ -238,7 +238,7 @@ class _Slabs:
 
     def pairs(
         self, boxes: I64, lo: I64, count: I64, nb: int, bound: F64, lower: F64 | None = None
-    ) -> tuple[I64, I64, F64, NDArray[np.bool_], NDArray[np.bool_]]:
+    ) -> tuple[I64, I64, F64, Mask, Mask]:
         """Test every beam each of ``boxes`` may meet (``lower``: only where the beam's
         ``bound`` does not stop it first); the clear hits lower ``bound``. Returns per
         pair: box, beam, first hit, clear, grazing. Call under ``np.errstate`` ignoring
@@ -277,9 +277,7 @@ class _Slabs:
         lv = self.cos[beam] * rows[:, 6:9] + self.sin[beam] * rows[:, 9:12]
         return p, s, lv, (-s - p) / lv, (s - p) / lv
 
-    def faces(
-        self, box: I64, beam: I64, clear: NDArray[np.bool_]
-    ) -> tuple[I64, F64, NDArray[np.bool_]]:
+    def faces(self, box: I64, beam: I64, clear: Mask) -> tuple[I64, F64, Mask]:
         """For the pairs that go on to MuJoCo's arithmetic: the face a clear entry from
         outside meets away from its edges (-1: none; then MuJoCo's ray_box returns that
         face's distance, the only other face it meets being the exit), its side, and
@@ -330,16 +328,14 @@ class StaticRayCaster:
         self._all_pos = np.concatenate([geometry.boxes.pos, geometry.planes.pos])
         self._all_mat = np.concatenate([geometry.boxes.mat, geometry.planes.mat])
 
-    def cast(
-        self, pnt: F64, rot: F64, vec: F64, geom: NDArray[np.int32], dist: F64
-    ) -> NDArray[np.bool_]:
+    def cast(self, pnt: F64, rot: F64, vec: F64, geom: NDArray[np.int32], dist: F64) -> Mask:
         """Fill ``geom`` (-1: none) and ``dist`` (-1: none) per beam as ``mj_multiRay``
         would for the static geoms; ``rot`` is the lidar frame (columns: its axes),
         ``vec`` the beams in the world (``rot @ (cos, sin, 0)``). Returns the beams whose
         result is not certain to be MuJoCo's: cast those with MuJoCo."""
         nb = self._nb
         body_ok = self._body_ok(pnt, vec)
-        found: list[tuple[I64, F64, I64, NDArray[np.bool_]]] = []
+        found: _Found = []
         self._planes(pnt, vec, body_ok, found)
         bound = self._boxes(pnt, rot, vec, body_ok, found)
         best_t = np.full(nb, np.inf)
@@ -373,7 +369,7 @@ class StaticRayCaster:
 
     # -- the parts --------------------------------------------------------------------
 
-    def _body_ok(self, pnt: F64, vec: F64) -> NDArray[np.bool_] | None:
+    def _body_ok(self, pnt: F64, vec: F64) -> Mask | None:
         """(bodies, beams): does the beam pass MuJoCo's bounding sphere of the body?"""
         if not self._has_spheres:
             return None
@@ -386,13 +382,7 @@ class StaticRayCaster:
         ok |= ~np.isfinite(g.body_center[:, 0])[:, None]
         return ok
 
-    def _planes(
-        self,
-        pnt: F64,
-        vec: F64,
-        body_ok: NDArray[np.bool_] | None,
-        found: list[tuple[I64, F64, I64, NDArray[np.bool_]]],
-    ) -> None:
+    def _planes(self, pnt: F64, vec: F64, body_ok: Mask | None, found: _Found) -> None:
         g = self._g
         beams = np.arange(self._nb)
         for k in range(len(g.planes.ids)):
@@ -425,14 +415,7 @@ class StaticRayCaster:
             ids = np.full(m, g.planes.ids[k], dtype=np.int64)
             found.append((beams[down], t, ids, np.zeros(m, dtype=np.bool_)))
 
-    def _boxes(
-        self,
-        pnt: F64,
-        rot: F64,
-        vec: F64,
-        body_ok: NDArray[np.bool_] | None,
-        found: list[tuple[I64, F64, I64, NDArray[np.bool_]]],
-    ) -> F64:
+    def _boxes(self, pnt: F64, rot: F64, vec: F64, body_ok: Mask | None, found: _Found) -> F64:
         """Cast the boxes; returns the per-beam bound used to drop pairs (inf: none)."""
         g = self._g
         nb = self._nb
@@ -537,9 +520,7 @@ class StaticRayCaster:
         self._last_boxes = np.flatnonzero(hit)  # sorted, each once
         return bound
 
-    def _winners_unsure(
-        self, pnt: F64, vec: F64, won: NDArray[np.bool_], best_id: NDArray[np.int64]
-    ) -> NDArray[np.bool_]:
+    def _winners_unsure(self, pnt: F64, vec: F64, won: Mask, best_id: NDArray[np.int64]) -> Mask:
         """Beams whose winner MuJoCo's bounding angles might have skipped."""
         beams = np.flatnonzero(won)
         ids, which = np.unique(best_id[beams], return_inverse=True)
