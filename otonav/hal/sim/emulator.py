@@ -25,7 +25,7 @@ from __future__ import annotations
 import heapq
 import math
 import struct
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -33,7 +33,7 @@ from otonav.hal.can import protocol as p
 from otonav.hal.can.bus import CAN_ERR_BUSOFF, CAN_ERR_RESTARTED, CanEndpoint, RawFrame
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.sim.odrive import AxisModel, AxisParams
-from otonav.hal.sim.schedule import FaultPlan, FaultSchedule
+from otonav.hal.sim.schedule import BusFaults, FaultPlan, FaultSchedule
 from otonav.hal.types import WheelSetpoint
 
 __all__ = ["BusFaults", "DriveEmulator", "DriveMount"]
@@ -55,22 +55,6 @@ class DriveMount:
             raise ValueError(f"DriveMount needs sign +-1 and gear_ratio > 0, got {self}")
 
 
-@dataclass(slots=True)
-class BusFaults:
-    """Bus-level fault injection, applied to frames in both directions.
-
-    ``drop_rate``: probability (0..1) that a frame is lost. ``delay``: seconds every
-    frame is held back, plus up to ``jitter`` seconds more (uniform; frames may then
-    arrive out of order, as behind a congested gateway).
-    """
-
-    drop_rate: float = 0.0
-    delay: float = 0.0
-    jitter: float = 0.0
-    dropped: int = field(default=0)
-    delayed: int = field(default=0)
-
-
 class _Drive:
     __slots__ = (
         "axis",
@@ -79,14 +63,12 @@ class _Drive:
         "heartbeat_id",
         "heartbeat_silent",
         "k",
-        "mount",
         "node_id",
         "sign",
     )
 
     def __init__(self, params: AxisParams, mount: DriveMount) -> None:
         self.axis = AxisModel(params)
-        self.mount = mount
         self.sign, self.gear = mount.sign, mount.gear_ratio
         self.node_id = params.node_id
         self.heartbeat_silent = False
@@ -145,8 +127,6 @@ class DriveEmulator:
         # Delayed frames: (due tick, seq, outbound?, frame, sim time it was sent).
         self._held: list[tuple[int, int, bool, RawFrame, float]] = []
         self._last_cmd = (math.nan, math.nan)
-        self.frames_sent = 0
-        self.frames_received = 0
 
     # -- fault injection -----------------------------------------------------------------
 
@@ -162,19 +142,15 @@ class DriveEmulator:
         """Drive ``node_id`` reports ``code`` and disarms, until Clear_Errors."""
         self._by_node[node_id].axis.raise_error(code)
 
-    def set_bus_off(self, off: bool, now_tick: int | None = None) -> None:
+    def set_bus_off(self, off: bool) -> None:
         """The bus goes bus-off (nothing passes; the host's controller reports
         CAN_ERR_BUSOFF) or restarts (CAN_ERR_RESTARTED), like SocketCAN with restart-ms."""
         if off == self._bus_off:
             return
-        t = (self._world.ticks if now_tick is None else now_tick) * self._tick
+        t = self._world.ticks * self._tick
         error = CAN_ERR_BUSOFF if off else CAN_ERR_RESTARTED
         self._endpoint.send(RawFrame(error, bytes(8), is_error=True), t)
         self._bus_off = off
-
-    @property
-    def bus_off(self) -> bool:
-        return self._bus_off
 
     def close(self) -> None:
         """Leave the bus. Idempotent."""
@@ -202,10 +178,8 @@ class DriveEmulator:
         changed = False
         incoming = self._endpoint.poll()
         if incoming and not self._bus_off:  # nothing crosses a bus-off bus
-            faults = self.faults
-            lossy = faults.drop_rate > 0.0 or faults.delay > 0.0 or faults.jitter > 0.0
+            lossy = self.faults.lossy
             for frame in incoming:
-                self.frames_received += 1
                 if lossy and self._lose_or_hold(frame, now, outbound=False):
                     continue
                 changed |= self._handle(frame, t)
@@ -220,7 +194,6 @@ class DriveEmulator:
                 # adapter's buffer, a socket nobody drains), which SocketCAN's receive
                 # timestamps show. The host judges the data's age by it (issue 27).
                 self._endpoint.send(frame, sent_at)
-                self.frames_sent += 1
             else:
                 changed |= self._handle(frame, t)
         if now == self._updated_at and not changed:
@@ -264,18 +237,12 @@ class DriveEmulator:
             due = now + max(1, round((faults.delay + extra) / self._tick))
             self._seq += 1
             heapq.heappush(self._held, (due, self._seq, outbound, frame, now * self._tick))
-            faults.delayed += 1
             return True
         return False
 
     def _transmit(self, frame: RawFrame, now: int, t: float) -> None:
-        faults = self.faults
-        if (
-            faults.drop_rate > 0.0 or faults.delay > 0.0 or faults.jitter > 0.0
-        ) and self._lose_or_hold(frame, now, outbound=True):
-            return
-        self._endpoint.send(frame, t)
-        self.frames_sent += 1
+        if not (self.faults.lossy and self._lose_or_hold(frame, now, outbound=True)):
+            self._endpoint.send(frame, t)
 
     def _handle(self, frame: RawFrame, t: float) -> bool:
         """Apply one command frame; True if it may have changed an axis' state or
@@ -313,8 +280,7 @@ class DriveEmulator:
         kl, kr = left.k, right.k
         data_l = _pack_two_f32(position_l * kl, velocity_l * kl)
         data_r = _pack_two_f32(position_r * kr, velocity_r * kr)
-        faults = self.faults
-        if faults.drop_rate > 0.0 or faults.delay > 0.0 or faults.jitter > 0.0:
+        if self.faults.lossy:
             self._transmit(RawFrame(left.encoder_id, data_l), now, t)
             self._transmit(RawFrame(right.encoder_id, data_r), now, t)
             return
@@ -322,7 +288,6 @@ class DriveEmulator:
         send = self._endpoint.send_data
         send(left.encoder_id, data_l, t)
         send(right.encoder_id, data_r, t)
-        self.frames_sent += 2
 
     def _send_heartbeats(self, now: int, t: float) -> None:
         for drive in self.drives:

@@ -14,20 +14,33 @@ from typing import Protocol
 
 from otonav.hal.can.protocol import AxisError
 
-__all__ = ["FaultPlan", "FaultSchedule", "FaultTarget", "Window"]
+__all__ = ["BusFaults", "FaultPlan", "FaultSchedule", "FaultTarget", "Window"]
 
 
-class _Faults(Protocol):
-    drop_rate: float
-    delay: float
-    jitter: float
+@dataclass(slots=True)
+class BusFaults:
+    """Bus-level fault injection, applied to frames in both directions.
+
+    ``drop_rate``: probability (0..1) that a frame is lost. ``delay``: seconds every
+    frame is held back, plus up to ``jitter`` seconds more (uniform; frames may then
+    arrive out of order, as behind a congested gateway). ``dropped``: frames lost so far.
+    """
+
+    drop_rate: float = 0.0
+    delay: float = 0.0
+    jitter: float = 0.0
+    dropped: int = 0
+
+    @property
+    def lossy(self) -> bool:
+        return self.drop_rate > 0.0 or self.delay > 0.0 or self.jitter > 0.0
 
 
 class FaultTarget(Protocol):
     """What a schedule drives: the drive emulator (:mod:`otonav.hal.sim.emulator`)."""
 
     @property
-    def faults(self) -> _Faults: ...
+    def faults(self) -> BusFaults: ...
 
     def set_bus_off(self, off: bool) -> None: ...
 
