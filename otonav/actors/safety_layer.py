@@ -54,8 +54,6 @@ class SafetyLayer(Actor):
         self.rate_hz = rate_hz
         self.cmd_timeout = cmd_timeout
         self.scan_timeout = scan_timeout
-        self.limited = 0
-        """Periods in which the command was slowed or stopped (for tests and reports)."""
         self._history = OdomHistory()
         self._scan: LaserScan | None = None
         self._points_pose: tuple[float, float, float] | None = None
@@ -149,8 +147,6 @@ class SafetyLayer(Actor):
                     result.nearest,
                     result.reason,
                 )
-        if reason in ("limited", "stopped", "blind") and (v, w) != (v_in, w_in):
-            self.limited += 1
         await self.cmd_out.publish(
             _STOP
             if v == 0.0 and w == 0.0
