@@ -139,14 +139,8 @@ class SafetyLayer(Actor):
             else:
                 assert self._scan is not None
                 points = to_frame(points_of(self._scan, self.laser_offset_x).xy, scan_pose, pose)
-                result = safe_command(v_in, w_in, v0, w0, points, p)
-                v, w, scale, nearest, reason = (
-                    result.v,
-                    result.omega,
-                    result.scale,
-                    result.nearest,
-                    result.reason,
-                )
+                r = safe_command(v_in, w_in, v0, w0, points, p)
+                v, w, scale, nearest, reason = r.v, r.omega, r.scale, r.nearest, r.reason
         await self.cmd_out.publish(
             _STOP
             if v == 0.0 and w == 0.0
