@@ -33,7 +33,7 @@ from otonav.hal.can import protocol as p
 from otonav.hal.can.bus import CAN_ERR_BUSOFF, CAN_ERR_RESTARTED, CanEndpoint, RawFrame
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.sim.odrive import AxisModel, AxisParams
-from otonav.hal.sim.schedule import BusFaults, FaultPlan, FaultSchedule
+from otonav.hal.sim.schedule import BusFaults, FaultPlan
 from otonav.hal.types import WheelSetpoint
 
 __all__ = ["BusFaults", "DriveEmulator", "DriveMount"]
@@ -110,7 +110,10 @@ class DriveEmulator:
         self._by_node = {d.node_id: d for d in self.drives}
         self.faults = BusFaults()
         # Faults on a timetable (hal.sim.faults); None: only what a caller injects.
-        self._schedule = FaultSchedule(schedule) if schedule and not schedule.empty else None
+        self._plan = schedule if schedule and not schedule.empty else None
+        self._edges = self._plan.times() if self._plan else []  # each start and end, s
+        self._next_edge = 0  # the first not yet applied
+        self._axis_error_done = False
         for node in (schedule.axis_error_node, schedule.heartbeat_node) if schedule else ():
             if node is not None and node not in self._by_node:
                 raise ValueError(
@@ -173,8 +176,8 @@ class DriveEmulator:
         (a Set_Input_Vel in PASSTHROUGH); in VEL_RAMP a Set_Input_Vel alone moves
         nothing before time passes (the ramp is ``vel_ramp_rate * dt`` and dt is 0)."""
         t = now * self._tick
-        if self._schedule is not None:
-            self._schedule.apply(self, t)
+        if self._next_edge < len(self._edges) and t >= self._edges[self._next_edge]:
+            self._apply_plan(t)
         changed = False
         incoming = self._endpoint.poll()
         if incoming and not self._bus_off:  # nothing crosses a bus-off bus
@@ -222,6 +225,24 @@ class DriveEmulator:
             self._send_heartbeats(now, t)
 
     # -- internals -----------------------------------------------------------------------
+
+    def _apply_plan(self, t: float) -> None:
+        """Bring the faults to what the plan says at ``t`` (an edge is due)."""
+        while self._next_edge < len(self._edges) and self._edges[self._next_edge] <= t:
+            self._next_edge += 1
+        plan, faults = self._plan, self.faults
+        assert plan is not None
+        faults.drop_rate = plan.drop_rate if plan.drop.holds(t) else 0.0
+        on = plan.delayed.holds(t)
+        faults.delay, faults.jitter = (plan.delay, plan.jitter) if on else (0.0, 0.0)
+        if plan.bus_off is not None:
+            self.set_bus_off(plan.bus_off.holds(t))
+        if plan.heartbeat_node is not None:
+            self.silence_heartbeat(plan.heartbeat_node, plan.heartbeat_lost.holds(t))
+        node = plan.axis_error_node
+        if node is not None and not self._axis_error_done and t >= plan.axis_error_at:
+            self._axis_error_done = True
+            self.inject_axis_error(node, plan.axis_error_code)
 
     def _lose_or_hold(self, frame: RawFrame, now: int, *, outbound: bool) -> bool:
         """Apply drop/delay to ``frame``: True if it is not to be used now."""
