@@ -37,8 +37,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from otonav.bench.clutter import clutter_scenario
-from otonav.hal.mujoco import scene_path, static_geoms, static_sleep
+from otonav.hal.mujoco import lidar, scene_path, static_sleep
 from otonav.hal.raycast import StaticRayCaster
+from otonav.hal.types import LidarSpec
 
 BEAMS = 360
 RANGE = 8.0
@@ -108,21 +109,12 @@ def two_passes(m: Any, d: Any, pnt: NDArray[np.float64], first: float = 2.0) -> 
 
 def numpy_caster(m: Any, d: Any) -> StaticRayCaster:
     """The caster read_scan builds for this world (whatever its box count)."""
-    threshold = static_geoms.MIN_STATIC_BOXES
-    static_geoms.MIN_STATIC_BOXES = 0  # type: ignore[misc]
+    threshold = lidar.MIN_STATIC_BOXES
+    lidar.MIN_STATIC_BOXES = 0  # type: ignore[misc]
     try:
-        caster, _moving = static_geoms.ray_caster(
-            m,
-            d,
-            groups=GROUPS,
-            exclude_body=-1,
-            angle_min=-math.pi,
-            increment=2 * math.pi / BEAMS,
-            beams=BEAMS,
-            cutoff=RANGE,
-        )
+        caster, _moving = lidar.ray_caster(m, d, LidarSpec(BEAMS, range_max=RANGE), -1)
     finally:
-        static_geoms.MIN_STATIC_BOXES = threshold  # type: ignore[misc]
+        lidar.MIN_STATIC_BOXES = threshold  # type: ignore[misc]
     assert caster is not None
     return caster
 

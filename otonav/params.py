@@ -17,6 +17,8 @@ from otonav import limits
 
 __all__ = (
     "CONFIG_KEYS",
+    "LIDAR_BEAMS",
+    "LIDAR_RANGE",
     "BaseConfig",
     "DwaConfig",
     "DwaParams",
@@ -34,6 +36,13 @@ __all__ = (
     "SafetyParams",
     "Section",
 )
+
+
+LIDAR_BEAMS = 360
+"""The default lidar's beams over its field of view (``world.lidar_beams``, the hal's
+``LidarSpec``)."""
+LIDAR_RANGE = (0.12, 8.0)
+"""The default lidar's range, m: (``world.lidar_range_min``, ``world.lidar_range_max``)."""
 
 
 class Section(BaseModel):

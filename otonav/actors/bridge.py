@@ -377,16 +377,17 @@ class Bridge(Actor):
         self._send(self.tf, self._tf_layout(sec, nanosec, pose.x, pose.y, qz, qw))
 
     def _publish_joints(self, sec: int, nanosec: int, _now: float) -> None:
-        """/joint_states: the wheel joints by the model's names, as the HAL reads them
-        (positive rolls the robot forward), after every other stream of the instant."""
+        """/joint_states: the wheel joints by the model's names, each in its own sign
+        (the HAL reads positive-forward), after every other stream of the instant."""
         left, right, left_v, right_v = self.hal.wheel_values()
+        sl, sr = self.hal.geometry.wheel_signs
         self._send(
             self.joint_states,
             JointState.fast(
                 header=Header.fast(stamp=Time.fast(sec=sec, nanosec=nanosec), frame_id=""),
                 name=self.hal.geometry.wheel_joints,
-                position=(left, right),
-                velocity=(left_v, right_v),
+                position=(sl * left, sr * right),
+                velocity=(sl * left_v, sr * right_v),
                 effort=(),
             ),
         )

@@ -33,7 +33,7 @@ from otonav.msgs import (
 )
 from otonav.nav.geometry import wrap_angle
 from otonav.nav.scan_map import ScanMap
-from otonav.nav.scan_match import MatchResult, compose, inverse, match_scan, transform
+from otonav.nav.scan_match import compose, inverse, match_scan, transform
 from otonav.params import LocalizerParams
 from otonav.runtime import Actor, Input, Output
 
@@ -77,9 +77,6 @@ class Localizer(Actor):
         )
         self.correction: tuple[float, float, float] = (0.0, 0.0, 0.0)
         """``map -> odom`` (x m, y m, yaw rad)."""
-        self.pose: tuple[float, float, float] | None = None
-        """The latest localized pose of base_link in the map frame."""
-        self.last: MatchResult | None = None
         self.matches = 0
         self.rejected = 0
         self._history = OdomHistory()
@@ -120,14 +117,12 @@ class Localizer(Actor):
         pose = predicted
         if self.grid.cells > 0:
             result = match_scan(self.grid, points, predicted, self.params.match)
-            self.last = result
             if result.ok:
                 pose = result.pose
                 self.matches += 1
             else:
                 self.rejected += 1
         self.correction = compose(pose, inverse(odom_pose))
-        self.pose = pose
         if self._due(pose):
             self._inserted = pose
             sensor = compose(pose, (self.laser_offset_x, 0.0, 0.0))

@@ -44,9 +44,6 @@ class OdomHistory:
     def __init__(self, size: int = 32) -> None:
         self._items: deque[Odometry] = deque(maxlen=size)
 
-    def add(self, odom: Odometry) -> None:
-        self._items.append(odom)
-
     def extend(self, odoms: Iterable[Odometry]) -> None:
         """Add messages, oldest first (``Subscription.drain``)."""
         self._items.extend(odoms)

@@ -1,10 +1,10 @@
-"""The recorder: every topic (or a chosen set) into one MCAP file, in publish order."""
+"""The recorder: every topic into one MCAP file, in publish order."""
 
 from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Callable, Collection
+from collections.abc import Callable
 
 import anyio
 
@@ -38,7 +38,6 @@ class Recorder(Actor):
         self,
         writer: RecordingWriter,
         *,
-        topics: Collection[str] | None = None,
         period: float = 0.1,
         depth: int = 10_000,
         name: str = "recorder",
@@ -49,24 +48,16 @@ class Recorder(Actor):
         self.period = period
         self.depth = depth
         self.writer = writer
-        self._wanted = frozenset(topics) if topics is not None else None
         self._funnel: Funnel | None = None
         self.on_disk_full: Callable[[DiskFullError], None] | None = None
 
     def on_wired(self, bus: Bus) -> None:
-        wanted = self._wanted
         # What each topic's publishers offer goes into its channel (rosbag2's
         # offered_qos_profiles), so `ros2 bag play` offers the same QoS again.
         self.writer.offered_qos = lambda name: (
             [p.qos for p in bus.topics[name].publishers] if name in bus.topics else []
         )
-        self._funnel = Funnel(
-            bus,
-            self.name,
-            self._now,
-            wanted=(lambda name: name in wanted) if wanted is not None else (lambda _n: True),
-            depth=self.depth,
-        )
+        self._funnel = Funnel(bus, self.name, self._now, depth=self.depth)
 
     def _now(self) -> float:
         # Until the System hands out clocks (a latched message replayed at wiring), the

@@ -57,8 +57,6 @@ class SafetyLayer(Actor):
         self.rate_hz = rate_hz
         self.cmd_timeout = cmd_timeout
         self.scan_timeout = scan_timeout
-        self.limited = 0
-        """Periods in which the command was slowed or stopped (for tests and reports)."""
         self._history = OdomHistory()
         self._scan: LaserScan | None = None
         self._points_pose: tuple[float, float, float] | None = None
@@ -144,16 +142,8 @@ class SafetyLayer(Actor):
             else:
                 assert self._scan is not None
                 points = to_frame(points_of(self._scan, self.laser_offset_x).xy, scan_pose, pose)
-                result = safe_command(v_in, w_in, v0, w0, points, p)
-                v, w, scale, nearest, reason = (
-                    result.v,
-                    result.omega,
-                    result.scale,
-                    result.nearest,
-                    result.reason,
-                )
-        if reason in ("limited", "stopped", "blind") and (v, w) != (v_in, w_in):
-            self.limited += 1
+                r = safe_command(v_in, w_in, v0, w0, points, p)
+                v, w, scale, nearest, reason = r.v, r.omega, r.scale, r.nearest, r.reason
         await self.cmd_out.publish(
             _STOP
             if v == 0.0 and w == 0.0

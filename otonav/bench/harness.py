@@ -29,7 +29,7 @@ class Case:
 
     kind: str
     duration: float = 30.0
-    beams: int = 360
+    beams: int = WorldConfig.model_fields["lidar_beams"].default
     scan_subscribers: int = 0
     """Extra actors subscribed to /scan (scaling with fan-out)."""
     overrides: tuple[str, ...] = ()

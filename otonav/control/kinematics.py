@@ -20,15 +20,13 @@ __all__ = (
 )
 
 
-def _require_finite(name: str, value: float) -> None:
-    if not math.isfinite(value):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-
-
-def _require_non_negative(name: str, value: float) -> None:
-    _require_finite(name, value)
-    if value < 0.0:
-        raise ValueError(f"{name} must be >= 0, got {value!r}")
+def _require(values: dict[str, float], *, non_negative: bool = False) -> None:
+    """Each value finite (and >= 0), checked in order: a ValueError names the first not."""
+    for name, value in values.items():
+        if not math.isfinite(value):
+            raise ValueError(f"{name} must be finite, got {value!r}")
+        if non_negative and value < 0.0:
+            raise ValueError(f"{name} must be >= 0, got {value!r}")
 
 
 @dataclass(frozen=True, slots=True)
@@ -124,12 +122,8 @@ def integrate_odometry(pose: Pose2D, v: float, omega: float, dt: float) -> Pose2
     Raises:
         ValueError: if any input is not finite or ``dt`` is negative.
     """
-    _require_finite("pose.x", pose.x)
-    _require_finite("pose.y", pose.y)
-    _require_finite("pose.yaw", pose.yaw)
-    _require_finite("v", v)
-    _require_finite("omega", omega)
-    _require_non_negative("dt", dt)
+    _require({"pose.x": pose.x, "pose.y": pose.y, "pose.yaw": pose.yaw, "v": v, "omega": omega})
+    _require({"dt": dt}, non_negative=True)
     dtheta = omega * dt
     half = 0.5 * dtheta
     chord = v * dt * _sinc(half)
@@ -182,15 +176,9 @@ def limit_twist(
     Raises:
         ValueError: if an input is not finite or a limit or ``dt`` is negative.
     """
-    _require_finite("v", v)
-    _require_finite("omega", omega)
-    _require_finite("prev_v", prev_v)
-    _require_finite("prev_omega", prev_omega)
-    _require_non_negative("dt", dt)
-    _require_non_negative("max_v", max_v)
-    _require_non_negative("max_omega", max_omega)
-    _require_non_negative("max_accel", max_accel)
-    _require_non_negative("max_alpha", max_alpha)
+    _require({"v": v, "omega": omega, "prev_v": prev_v, "prev_omega": prev_omega})
+    _require({"dt": dt, "max_v": max_v, "max_omega": max_omega}, non_negative=True)
+    _require({"max_accel": max_accel, "max_alpha": max_alpha}, non_negative=True)
     v = _clamp(v, -max_v, max_v)
     omega = _clamp(omega, -max_omega, max_omega)
     dv = max_accel * dt

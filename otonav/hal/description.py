@@ -8,9 +8,13 @@ stack config's ``robot`` section becomes one (``otonav.stack.robot``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import atexit
+import shutil
+import tempfile
+from dataclasses import dataclass, field, replace
 from importlib import resources
 from importlib.resources.abc import Traversable
+from pathlib import Path
 from typing import Final
 
 __all__ = [
@@ -59,59 +63,61 @@ class RobotDescription:
     """How each name or value was chosen (for the provenance record)."""
 
 
-@dataclass(frozen=True, slots=True)
-class _Builtin:
-    file: str
-    base: str
-    left_wheel: str
-    right_wheel: str
-    lidar: Mount
-    imu: Mount
-    max_v: float | None = None
-    max_omega: float | None = None
-    what: str = ""
-
-
-BUILTIN_ROBOTS: Final[dict[str, _Builtin]] = {
-    "otonav": _Builtin(
-        file="robot.xml",
-        base="chassis",
-        left_wheel="left_wheel",
-        right_wheel="right_wheel",
-        lidar=Mount(site="lidar"),
-        imu=Mount(site="imu"),
-        what="otonav's robot: 2.5 kg, wheels r 0.05 m 0.22 m apart, 360-beam lidar",
+BUILTIN_ROBOTS: Final[dict[str, RobotDescription]] = {
+    # otonav's robot: 2.5 kg, wheels r 0.05 m 0.22 m apart, 360-beam lidar
+    "otonav": RobotDescription(
+        "robot.xml", "otonav", "chassis", "left_wheel", "right_wheel", Mount("lidar"), Mount("imu")
     ),
-    "burger": _Builtin(
-        file="robots/burger.xml",
-        base="base_link",
-        left_wheel="wheel_left_joint",
-        right_wheel="wheel_right_joint",
-        lidar=Mount(site="base_scan"),
-        imu=Mount(site="imu_link"),
+    # a TurtleBot3 Burger's dimensions: wheels r 0.033 m 0.160 m apart, 0.22 m/s
+    "burger": RobotDescription(
+        "robots/burger.xml",
+        "burger",
+        "base_link",
+        "wheel_left_joint",
+        "wheel_right_joint",
+        Mount("base_scan"),
+        Mount("imu_link"),
         max_v=0.22,
         max_omega=2.84,
-        what="a TurtleBot3 Burger's dimensions: wheels r 0.033 m 0.160 m apart, 0.22 m/s",
     ),
 }
-"""The robots shipped in ``otonav/hal/assets`` by name."""
+"""The robots shipped in ``otonav/hal/assets`` by name (``model`` relative to it)."""
 
 
-def _assets() -> Traversable:
+def _shipped() -> Traversable:
     return resources.files("otonav.hal").joinpath("assets")
+
+
+_copy: list[Path] = []  # the one copy, removed at exit
+
+
+def assets_dir() -> Path:
+    """``otonav/hal/assets`` as a real folder: the package's own, or, when the package is
+    not on a filesystem (zipped), a copy of the whole tree made once per process (MuJoCo
+    reads files, and a scene's ``<include>`` and a robot's ``robots/`` need their
+    neighbours)."""
+    root = _shipped()
+    if isinstance(root, Path):
+        return root
+    if not _copy:
+        tmp = Path(tempfile.mkdtemp(prefix="otonav-assets-"))
+        atexit.register(shutil.rmtree, tmp, ignore_errors=True)
+        _copy_tree(root, tmp)
+        _copy.append(tmp)
+    return _copy[0]
+
+
+def _copy_tree(source: Traversable, target: Path) -> None:
+    for entry in source.iterdir():
+        if entry.is_dir():
+            (target / entry.name).mkdir()
+            _copy_tree(entry, target / entry.name)
+        else:
+            with entry.open("rb") as src, (target / entry.name).open("wb") as dst:
+                shutil.copyfileobj(src, dst)
 
 
 def builtin_robot(name: str) -> RobotDescription:
     """The description of a built-in robot (``KeyError`` for an unknown name)."""
-    spec = BUILTIN_ROBOTS[name]
-    return RobotDescription(
-        model=str(_assets().joinpath(spec.file)),
-        label=name,
-        base=spec.base,
-        left_wheel=spec.left_wheel,
-        right_wheel=spec.right_wheel,
-        lidar=spec.lidar,
-        imu=spec.imu,
-        max_v=spec.max_v,
-        max_omega=spec.max_omega,
-    )
+    shipped = BUILTIN_ROBOTS[name]
+    return replace(shipped, model=str(assets_dir() / shipped.model), overrides={})

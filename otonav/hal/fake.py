@@ -19,6 +19,7 @@ from otonav.hal.types import (
     BoxObstacle,
     GroundTruth,
     ImuSample,
+    LidarSpec,
     RangeScan,
     RobotGeometry,
     WheelSetpoint,
@@ -31,6 +32,7 @@ GRAVITY = 9.81
 """m/s^2, reported by the fake accelerometer on +z."""
 
 _TINY = 1e-12
+_LIDAR = LidarSpec()  # the default lidar
 
 
 def arena_walls(half_size: float, thickness: float = 0.1) -> tuple[BoxObstacle, ...]:
@@ -102,19 +104,13 @@ class FakeHardware(RobotHardwareInterface):
         arena_half_size: float | None = None,
         start: tuple[float, float, float] = (0.0, 0.0, 0.0),
         wheel_time_constant: float = 0.0,
-        lidar_beams: int = 360,
-        lidar_range_min: float = 0.12,
-        lidar_range_max: float = 8.0,
+        lidar_beams: int = _LIDAR.beams,
+        lidar_range_min: float = _LIDAR.range_min,
+        lidar_range_max: float = _LIDAR.range_max,
     ) -> None:
         if not tick > 0.0:
             raise ValueError(f"tick must be positive, got {tick}")
-        if lidar_beams < 1:
-            raise ValueError(f"lidar_beams must be >= 1, got {lidar_beams}")
-        if not 0.0 <= lidar_range_min < lidar_range_max:
-            raise ValueError(
-                f"need 0 <= lidar_range_min < lidar_range_max, got "
-                f"{lidar_range_min}, {lidar_range_max}"
-            )
+        self._lidar = LidarSpec(lidar_beams, lidar_range_min, lidar_range_max)
         if wheel_time_constant < 0.0:
             raise ValueError(f"wheel_time_constant must be >= 0, got {wheel_time_constant}")
         self._tick = tick
@@ -129,19 +125,13 @@ class FakeHardware(RobotHardwareInterface):
         self._walls = () if arena_half_size is None else arena_walls(arena_half_size)
         self._boxes = self._obstacles + self._walls
         self._tau = wheel_time_constant
-        self._range_min = lidar_range_min
-        self._range_max = lidar_range_max
-        self._angle_increment = 2.0 * math.pi / lidar_beams
-        self._angle_min = -math.pi
-        self._beam_angles = self._angle_min + self._angle_increment * np.arange(lidar_beams)
+        self._beam_angles = self._lidar.angles()
 
-        self._ticks = 0
         self._x, self._y, self._yaw = start
         self._cmd = WheelSetpoint(0.0, 0.0)
         self._wl = self._wr = 0.0  # wheel angular velocities, rad/s
         self._ql = self._qr = 0.0  # wheel angles, rad
         self._accel = 0.0  # forward acceleration over the last tick, m/s^2
-        self._closed = False
 
     # -- time ---------------------------------------------------------------------------
 
@@ -149,22 +139,15 @@ class FakeHardware(RobotHardwareInterface):
     def tick(self) -> float:
         return self._tick
 
-    @property
-    def ticks(self) -> int:
-        return self._ticks
-
     def advance(self, n: int) -> None:
-        self._check_open()
-        if n < 0:
-            raise ValueError(f"cannot advance by a negative number of ticks ({n})")
-        if n == 0:
+        if not self._steps(n):
             return
         if self._tau == 0.0:
             wl, wr = self._cmd.left, self._cmd.right
-            v_before = self._speed(self._wl, self._wr)
+            v_before = self._rates(self._wl, self._wr)[0]
             self._wl, self._wr = wl, wr
             self._integrate(wl, wr, n * self._tick)
-            self._accel = (self._speed(wl, wr) - v_before) / self._tick if n == 1 else 0.0
+            self._accel = (self._rates(wl, wr)[0] - v_before) / self._tick if n == 1 else 0.0
         else:
             decay = math.exp(-self._tick / self._tau)
             gain = self._tau * (1.0 - decay)  # integral of the decaying error over a tick
@@ -178,17 +161,18 @@ class FakeHardware(RobotHardwareInterface):
                 mr = cr + (wr0 - cr) * gain / self._tick
                 self._wl, self._wr = wl1, wr1
                 self._integrate(ml, mr, self._tick)
-                self._accel = (self._speed(wl1, wr1) - self._speed(wl0, wr0)) / self._tick
+                dv = self._rates(wl1, wr1)[0] - self._rates(wl0, wr0)[0]
+                self._accel = dv / self._tick
         self._ticks += n
 
-    def _speed(self, wl: float, wr: float) -> float:
-        return self._geometry.wheel_radius * (wl + wr) / 2.0
+    def _rates(self, wl: float, wr: float) -> tuple[float, float]:
+        """Body speed (m/s) and turn rate (rad/s) at wheel speeds ``wl``, ``wr``."""
+        r = self._geometry.wheel_radius
+        return r * (wl + wr) / 2.0, r * (wr - wl) / self._geometry.wheel_separation
 
     def _integrate(self, wl: float, wr: float, dt: float) -> None:
         """Advance pose and wheel angles by ``dt`` at constant wheel speeds (exact arc)."""
-        r, b = self._geometry.wheel_radius, self._geometry.wheel_separation
-        v = r * (wl + wr) / 2.0
-        w = r * (wr - wl) / b
+        v, w = self._rates(wl, wr)
         yaw0 = self._yaw
         dyaw = w * dt
         if abs(dyaw) < 1e-9:
@@ -213,12 +197,8 @@ class FakeHardware(RobotHardwareInterface):
     def read_wheels(self) -> WheelState:
         return WheelState(self._ql, self._qr, self._wl, self._wr)
 
-    def _body_rates(self) -> tuple[float, float]:
-        r, b = self._geometry.wheel_radius, self._geometry.wheel_separation
-        return r * (self._wl + self._wr) / 2.0, r * (self._wr - self._wl) / b
-
     def read_imu(self) -> ImuSample:
-        v, w = self._body_rates()
+        v, w = self._rates(self._wl, self._wr)
         half = self._yaw / 2.0
         return ImuSample(
             orientation=(math.cos(half), 0.0, 0.0, math.sin(half)),
@@ -230,23 +210,10 @@ class FakeHardware(RobotHardwareInterface):
         ox = self._x + self._geometry.laser_offset_x * math.cos(self._yaw)
         oy = self._y + self._geometry.laser_offset_x * math.sin(self._yaw)
         world_angles = np.asarray(self._beam_angles + self._yaw, dtype=np.float64)
-        dist = cast_rays_2d(ox, oy, world_angles, self._boxes)
-        valid = (dist >= self._range_min) & (dist <= self._range_max)
-        # REP 117: a miss is +inf, a return closer than range_min is -inf.
-        too_close = dist < self._range_min
-        ranges = np.where(valid, dist, np.where(too_close, -np.inf, np.inf)).astype(np.float32)
-        ranges.flags.writeable = False
-        return RangeScan(
-            angle_min=self._angle_min,
-            angle_max=self._angle_min + self._angle_increment * (ranges.size - 1),
-            angle_increment=self._angle_increment,
-            range_min=self._range_min,
-            range_max=self._range_max,
-            ranges=ranges,
-        )
+        return self._lidar.scan(cast_rays_2d(ox, oy, world_angles, self._boxes))
 
     def ground_truth(self) -> GroundTruth:
-        v, _ = self._body_rates()
+        v, _ = self._rates(self._wl, self._wr)
         return GroundTruth(
             x=self._x,
             y=self._y,
@@ -266,10 +233,3 @@ class FakeHardware(RobotHardwareInterface):
 
     def walls(self) -> tuple[BoxObstacle, ...]:
         return self._walls
-
-    def close(self) -> None:
-        self._closed = True
-
-    def _check_open(self) -> None:
-        if self._closed:
-            raise RuntimeError("FakeHardware is closed")

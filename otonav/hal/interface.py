@@ -37,15 +37,18 @@ class RobotHardwareInterface(abc.ABC):
     Usable as a context manager (``close()`` on exit).
     """
 
+    _closed = False
+    _ticks = 0
+
     @property
     @abc.abstractmethod
     def tick(self) -> float:
         """Physics step, seconds. Constant for the life of the interface."""
 
     @property
-    @abc.abstractmethod
     def ticks(self) -> int:
         """Number of physics steps taken since construction: the truth of time."""
+        return self._ticks
 
     @property
     def sim_time(self) -> float:
@@ -55,6 +58,13 @@ class RobotHardwareInterface(abc.ABC):
     @abc.abstractmethod
     def advance(self, n: int) -> None:
         """Step the world ``n`` ticks (``n >= 0``) holding the current wheel command."""
+
+    def _steps(self, n: int) -> bool:
+        """Check an :meth:`advance` by ``n``: open, ``n >= 0``; False: nothing to do."""
+        self._check_open()
+        if n < 0:
+            raise ValueError(f"cannot advance by a negative number of ticks ({n})")
+        return n > 0
 
     @abc.abstractmethod
     def write(self, cmd: WheelSetpoint) -> None:
@@ -148,9 +158,13 @@ class RobotHardwareInterface(abc.ABC):
         is returned until something changes."""
         return _OK
 
-    @abc.abstractmethod
     def close(self) -> None:
         """Release resources. Idempotent; the interface must not be used afterwards."""
+        self._closed = True
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise RuntimeError(f"{type(self).__name__} is closed")
 
     def __enter__(self) -> Self:
         return self

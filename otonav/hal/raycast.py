@@ -27,7 +27,7 @@ returns **the same floats and geom ids as** ``mj_multiRay``:
    met, is returned as *unsure*: the caller casts it with MuJoCo itself.
 
 Everything here is numpy; the MuJoCo side (which geoms are static, the fallback cast)
-lives in :mod:`otonav.hal.mujoco.static_geoms` and :mod:`otonav.hal.mujoco.world`.
+lives in :mod:`otonav.hal.mujoco.lidar`.
 """
 
 from __future__ import annotations
@@ -39,7 +39,9 @@ from typing import Final
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["StaticGeometry", "StaticRayCaster"]
+from otonav.hal.types import LidarSpec
+
+__all__ = ["StaticGeometry", "StaticGeoms", "StaticRayCaster"]
 
 _MINVAL: Final = 1e-15  # MuJoCo's mjMINVAL
 _PI: Final = math.pi
@@ -57,35 +59,38 @@ _NO_ID: Final = np.iinfo(np.int64).max
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
+Mask = NDArray[np.bool_]
+_Found = list[tuple[I64, F64, I64, Mask]]  # (beams, distances, geom ids, deep) per caster
+
+
+@dataclass(frozen=True, slots=True)
+class StaticGeoms:
+    """Static geoms of one type as MuJoCo placed them: their MuJoCo ``ids``, ``pos``
+    (``geom_xpos``), ``mat`` (``geom_xmat``, row-major), ``size``, ``rbound``, ``aabb``
+    and ``body``, their row in :class:`StaticGeometry`'s bodies."""
+
+    ids: NDArray[np.int32]
+    pos: F64
+    mat: F64
+    size: F64
+    rbound: F64
+    aabb: F64
+    body: I64
 
 
 @dataclass(frozen=True, slots=True)
 class StaticGeometry:
-    """The static geoms a lidar may hit, as MuJoCo placed them (``geom_xpos``,
-    ``geom_xmat`` row-major, ``geom_size``, ``geom_rbound``, ``geom_aabb``), boxes and
-    planes apart; ``*_ids`` are their MuJoCo geom ids, ``*_body`` index ``body_center``
-    / ``body_ssz`` (a static body's bounding sphere, centre and squared radius; NaN
+    """The static geoms a lidar may hit, boxes and planes apart, and the bounding
+    sphere of each static body (``body_center``, ``body_ssz`` the squared radius; NaN
     centre: the body has none and is never skipped)."""
 
-    box_ids: NDArray[np.int32]
-    box_pos: F64
-    box_mat: F64
-    box_size: F64
-    box_rbound: F64
-    box_aabb: F64
-    box_body: I64
-    plane_ids: NDArray[np.int32]
-    plane_pos: F64
-    plane_mat: F64
-    plane_size: F64
-    plane_rbound: F64
-    plane_aabb: F64
-    plane_body: I64
+    boxes: StaticGeoms
+    planes: StaticGeoms
     body_center: F64
     body_ssz: F64
 
 
-def _sphere_hit(center: F64, ssz: F64, pnt: F64, vec: F64) -> NDArray[np.bool_]:
+def _sphere_hit(center: F64, ssz: F64, pnt: F64, vec: F64) -> Mask:
     """MuJoCo's ``ray_sphere(center, ssz) >= 0``; ``center``/``ssz`` broadcast against
     the rays ``vec`` (..., 3), the same operations in the same order."""
     d0 = pnt[0] - center[..., 0]
@@ -98,7 +103,7 @@ def _sphere_hit(center: F64, ssz: F64, pnt: F64, vec: F64) -> NDArray[np.bool_]:
     det = b * b - a * c
     ok = det >= _MINVAL
     root = np.sqrt(np.where(ok, det, 0.0))
-    result: NDArray[np.bool_] = ok & (((-b - root) / a >= 0) | ((-b + root) / a >= 0))
+    result: Mask = ok & (((-b - root) / a >= 0) | ((-b + root) / a >= 0))
     return result
 
 
@@ -172,9 +177,7 @@ def ray_plane(pos: F64, mat: F64, size: F64, pnt: F64, vec: F64) -> F64:
     return result
 
 
-def _unsure_angles(
-    aabb: F64, pos: F64, mat: F64, pnt: F64, vec: F64, which: I64
-) -> NDArray[np.bool_]:
+def _unsure_angles(aabb: F64, pos: F64, mat: F64, pnt: F64, vec: F64, which: I64) -> Mask:
     """Per ray: could MuJoCo's bounding angles (``mju_multiRayPrepare``: azimuth and
     elevation of the geom's AABB corners) have skipped geom ``which[ray]`` (a row of
     ``aabb``/``pos``/``mat``)? True when the ray lies outside them or within ``_SLACK``
@@ -218,7 +221,7 @@ def _unsure_angles(
         & (ray_el >= el_lo[which] + _SLACK)
         & (ray_el <= el_hi[which] - _SLACK)
     )
-    unsure: NDArray[np.bool_] = full_unsure[which] | ~(full[which] | within)
+    unsure: Mask = full_unsure[which] | ~(full[which] | within)
     return unsure
 
 
@@ -235,7 +238,7 @@ class _Slabs:
 
     def pairs(
         self, boxes: I64, lo: I64, count: I64, nb: int, bound: F64, lower: F64 | None = None
-    ) -> tuple[I64, I64, F64, NDArray[np.bool_], NDArray[np.bool_]]:
+    ) -> tuple[I64, I64, F64, Mask, Mask]:
         """Test every beam each of ``boxes`` may meet (``lower``: only where the beam's
         ``bound`` does not stop it first); the clear hits lower ``bound``. Returns per
         pair: box, beam, first hit, clear, grazing. Call under ``np.errstate`` ignoring
@@ -274,9 +277,7 @@ class _Slabs:
         lv = self.cos[beam] * rows[:, 6:9] + self.sin[beam] * rows[:, 9:12]
         return p, s, lv, (-s - p) / lv, (s - p) / lv
 
-    def faces(
-        self, box: I64, beam: I64, clear: NDArray[np.bool_]
-    ) -> tuple[I64, F64, NDArray[np.bool_]]:
+    def faces(self, box: I64, beam: I64, clear: Mask) -> tuple[I64, F64, Mask]:
         """For the pairs that go on to MuJoCo's arithmetic: the face a clear entry from
         outside meets away from its edges (-1: none; then MuJoCo's ray_box returns that
         face's distance, the only other face it meets being the exit), its side, and
@@ -299,52 +300,42 @@ class _Slabs:
 
 
 class StaticRayCaster:
-    """Casts a planar fan of beams (``beams`` over a full turn from ``angle_min`` in the
-    lidar's xy plane) against :class:`StaticGeometry`, as ``mj_multiRay`` with
-    ``cutoff`` would (see the module's docstring)."""
+    """Casts ``spec``'s planar fan of beams (in the lidar's xy plane) against
+    :class:`StaticGeometry`, as ``mj_multiRay`` with ``spec.range_max`` as the cutoff
+    would (see the module's docstring)."""
 
-    def __init__(
-        self,
-        geometry: StaticGeometry,
-        *,
-        angle_min: float,
-        increment: float,
-        beams: int,
-        cutoff: float,
-    ) -> None:
+    def __init__(self, geometry: StaticGeometry, spec: LidarSpec) -> None:
         self._g = geometry
-        self._angle_min = angle_min
-        self._inc = increment
-        self._nb = beams
-        angles = angle_min + increment * np.arange(beams)
+        self._angle_min = spec.angle_min
+        self._inc = spec.increment
+        self._nb = spec.beams
+        angles = spec.angles()
         self._cos = np.cos(angles)
         self._sin = np.sin(angles)
-        self._cutoff = cutoff
-        self._reach = cutoff + geometry.box_rbound  # MuJoCo: dist > cutoff + rbound drops it
+        self._cutoff = cutoff = spec.range_max
+        self._reach = cutoff + geometry.boxes.rbound  # MuJoCo: dist > cutoff + rbound drops it
         self._last_boxes = np.zeros(0, dtype=np.int64)  # boxes hit by the last scan
         self._has_spheres = bool(np.isfinite(geometry.body_center[:, 0]).any())
         # row (n, i): box n's axis i in the world (column i of its row-major xmat)
         self._box_rows = np.ascontiguousarray(
-            geometry.box_mat.reshape(-1, 3, 3).transpose(0, 2, 1).reshape(-1, 3)
+            geometry.boxes.mat.reshape(-1, 3, 3).transpose(0, 2, 1).reshape(-1, 3)
         )
         self._axes = self._box_rows.reshape(-1, 3, 3)  # [n, i, j]: box axis i, world j
-        ids = np.concatenate([geometry.box_ids, geometry.plane_ids]).astype(np.int64)
+        ids = np.concatenate([geometry.boxes.ids, geometry.planes.ids]).astype(np.int64)
         self._row_of = np.zeros(int(ids.max()) + 1 if len(ids) else 1, dtype=np.int64)
         self._row_of[ids] = np.arange(len(ids))
-        self._all_aabb = np.concatenate([geometry.box_aabb, geometry.plane_aabb])
-        self._all_pos = np.concatenate([geometry.box_pos, geometry.plane_pos])
-        self._all_mat = np.concatenate([geometry.box_mat, geometry.plane_mat])
+        self._all_aabb = np.concatenate([geometry.boxes.aabb, geometry.planes.aabb])
+        self._all_pos = np.concatenate([geometry.boxes.pos, geometry.planes.pos])
+        self._all_mat = np.concatenate([geometry.boxes.mat, geometry.planes.mat])
 
-    def cast(
-        self, pnt: F64, rot: F64, vec: F64, geom: NDArray[np.int32], dist: F64
-    ) -> NDArray[np.bool_]:
+    def cast(self, pnt: F64, rot: F64, vec: F64, geom: NDArray[np.int32], dist: F64) -> Mask:
         """Fill ``geom`` (-1: none) and ``dist`` (-1: none) per beam as ``mj_multiRay``
         would for the static geoms; ``rot`` is the lidar frame (columns: its axes),
         ``vec`` the beams in the world (``rot @ (cos, sin, 0)``). Returns the beams whose
         result is not certain to be MuJoCo's: cast those with MuJoCo."""
         nb = self._nb
         body_ok = self._body_ok(pnt, vec)
-        found: list[tuple[I64, F64, I64, NDArray[np.bool_]]] = []
+        found: _Found = []
         self._planes(pnt, vec, body_ok, found)
         bound = self._boxes(pnt, rot, vec, body_ok, found)
         best_t = np.full(nb, np.inf)
@@ -378,7 +369,7 @@ class StaticRayCaster:
 
     # -- the parts --------------------------------------------------------------------
 
-    def _body_ok(self, pnt: F64, vec: F64) -> NDArray[np.bool_] | None:
+    def _body_ok(self, pnt: F64, vec: F64) -> Mask | None:
         """(bodies, beams): does the beam pass MuJoCo's bounding sphere of the body?"""
         if not self._has_spheres:
             return None
@@ -391,24 +382,18 @@ class StaticRayCaster:
         ok |= ~np.isfinite(g.body_center[:, 0])[:, None]
         return ok
 
-    def _planes(
-        self,
-        pnt: F64,
-        vec: F64,
-        body_ok: NDArray[np.bool_] | None,
-        found: list[tuple[I64, F64, I64, NDArray[np.bool_]]],
-    ) -> None:
+    def _planes(self, pnt: F64, vec: F64, body_ok: Mask | None, found: _Found) -> None:
         g = self._g
         beams = np.arange(self._nb)
-        for k in range(len(g.plane_ids)):
-            d = g.plane_pos[k] - pnt  # (MuJoCo 4.0 never drops a plane by the cutoff)
-            mat = g.plane_mat[k]
+        for k in range(len(g.planes.ids)):
+            d = g.planes.pos[k] - pnt  # (MuJoCo 4.0 never drops a plane by the cutoff)
+            mat = g.planes.mat[k]
             lvec2 = mat[2] * vec[:, 0] + mat[5] * vec[:, 1] + mat[8] * vec[:, 2]
             # ray_plane's first test, and: a beam too shallow to meet the (finite)
             # rectangle, |lvec_z| < h / sqrt(h^2 + R^2), h the lidar's height over the
             # plane, R the rectangle's half-diagonal plus the lidar's offset in the plane
             steep = -_MINVAL
-            size = g.plane_size[k]
+            size = g.planes.size[k]
             height = -(mat[2] * d[0] + mat[5] * d[1] + mat[8] * d[2])
             if size[0] > 0 and size[1] > 0 and height > 0:
                 offset = math.sqrt(max(0.0, float(d @ d) - height * height))
@@ -416,41 +401,34 @@ class StaticRayCaster:
                 steep = min(steep, -0.99 * height / math.hypot(height, reach))
             down = np.flatnonzero(lvec2 <= steep)
             if body_ok is not None:
-                down = down[body_ok[g.plane_body[k], down]]
+                down = down[body_ok[g.planes.body[k], down]]
             if len(down) == 0:
                 continue
             m = len(down)
             t = ray_plane(
-                np.broadcast_to(g.plane_pos[k], (m, 3)),
+                np.broadcast_to(g.planes.pos[k], (m, 3)),
                 np.broadcast_to(mat, (m, 9)),
-                np.broadcast_to(g.plane_size[k], (m, 3)),
+                np.broadcast_to(g.planes.size[k], (m, 3)),
                 pnt,
                 vec[down],
             )
-            ids = np.full(m, g.plane_ids[k], dtype=np.int64)
+            ids = np.full(m, g.planes.ids[k], dtype=np.int64)
             found.append((beams[down], t, ids, np.zeros(m, dtype=np.bool_)))
 
-    def _boxes(
-        self,
-        pnt: F64,
-        rot: F64,
-        vec: F64,
-        body_ok: NDArray[np.bool_] | None,
-        found: list[tuple[I64, F64, I64, NDArray[np.bool_]]],
-    ) -> F64:
+    def _boxes(self, pnt: F64, rot: F64, vec: F64, body_ok: Mask | None, found: _Found) -> F64:
         """Cast the boxes; returns the per-beam bound used to drop pairs (inf: none)."""
         g = self._g
         nb = self._nb
         bound = np.full(nb, np.inf)
-        if len(g.box_ids) == 0:
+        if len(g.boxes.ids) == 0:
             return bound
-        dif = g.box_pos - pnt
+        dif = g.boxes.pos - pnt
         d0, d1, d2 = dif[:, 0], dif[:, 1], dif[:, 2]
         d3 = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         local = dif @ rot  # box centres in the lidar frame (pruning only: any rounding)
         frames = (self._box_rows @ rot).reshape(-1, 3, 3)  # [n, i, a]: lidar axis a
         az = frames[:, :, 2]
-        size = g.box_size
+        size = g.boxes.size
         # the box's half-extent across the scan plane; it must reach the plane
         across = size[:, 0] * np.abs(az[:, 0]) + size[:, 1] * np.abs(az[:, 1])
         across += size[:, 2] * np.abs(az[:, 2])
@@ -487,7 +465,7 @@ class StaticRayCaster:
         slab = _Slabs(lp, size, frames[:, :, 0], frames[:, :, 1], self._cos, self._sin)
         # first the boxes that stopped a beam last scan and the nearest ones, not the
         # wide ones (an order only: their clear hits bound the beams for the others)
-        n = len(g.box_ids)
+        n = len(g.boxes.ids)
         first = np.zeros(n, dtype=np.bool_)
         if n > _NEAR_FIRST:
             first[np.argpartition(lower, _NEAR_FIRST)[:_NEAR_FIRST]] = True
@@ -520,42 +498,29 @@ class StaticRayCaster:
             limit = bound[beam]
             go = (clear & (first_hit - _SLACK <= limit)) | (graze & (lower[box] <= limit))
             if body_ok is not None:
-                go &= body_ok[g.box_body[box], beam]
+                go &= body_ok[g.boxes.body[box], beam]
             box, beam, clear = box[go], beam[go], clear[go]
             if len(box) == 0:
                 return bound
             face, side, deep = slab.faces(box, beam, clear)
         gid = box
+        pos, mat, size = g.boxes.pos[gid], g.boxes.mat[gid], g.boxes.size[gid]
         t = np.empty(len(box))
         lite = face >= 0
         if lite.any():
             t[lite] = _entry_face(
-                g.box_pos[gid[lite]],
-                g.box_mat[gid[lite]],
-                g.box_size[gid[lite]],
-                pnt,
-                vec[beam[lite]],
-                face[lite],
-                side[lite],
+                pos[lite], mat[lite], size[lite], pnt, vec[beam[lite]], face[lite], side[lite]
             )
         rest = ~lite
         if rest.any():
-            t[rest] = ray_box(
-                g.box_pos[gid[rest]],
-                g.box_mat[gid[rest]],
-                g.box_size[gid[rest]],
-                pnt,
-                vec[beam[rest]],
-            )
-        found.append((beam, t, g.box_ids[gid].astype(np.int64), deep))
-        hit = np.zeros(len(g.box_ids), dtype=np.bool_)
+            t[rest] = ray_box(pos[rest], mat[rest], size[rest], pnt, vec[beam[rest]])
+        found.append((beam, t, g.boxes.ids[gid].astype(np.int64), deep))
+        hit = np.zeros(len(g.boxes.ids), dtype=np.bool_)
         hit[gid[t >= 0]] = True
         self._last_boxes = np.flatnonzero(hit)  # sorted, each once
         return bound
 
-    def _winners_unsure(
-        self, pnt: F64, vec: F64, won: NDArray[np.bool_], best_id: NDArray[np.int64]
-    ) -> NDArray[np.bool_]:
+    def _winners_unsure(self, pnt: F64, vec: F64, won: Mask, best_id: NDArray[np.int64]) -> Mask:
         """Beams whose winner MuJoCo's bounding angles might have skipped."""
         beams = np.flatnonzero(won)
         ids, which = np.unique(best_id[beams], return_inverse=True)

@@ -12,10 +12,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from otonav.params import LIDAR_BEAMS, LIDAR_RANGE
+
 __all__ = [
     "BoxObstacle",
     "GroundTruth",
     "ImuSample",
+    "LidarSpec",
     "PolygonObstacle",
     "RangeScan",
     "RobotGeometry",
@@ -81,20 +84,59 @@ class RangeScan:
         angles = self.angle_min + self.angle_increment * np.arange(self.ranges.size)
         return np.asarray(angles, dtype=np.float64)
 
-    def beam_index(self, angle: float) -> int:
-        """Index of the beam closest to ``angle`` (rad, laser frame).
 
-        A full-circle scan wraps around; a partial one clamps to its first/last beam.
-        """
-        n = self.ranges.size
-        if n == 0:
-            raise ValueError("empty scan has no beams")
-        if n == 1 or self.angle_increment == 0.0:
-            return 0
-        k = round((angle - self.angle_min) / self.angle_increment)
-        if abs(self.angle_increment) * n >= 2.0 * math.pi - 1e-9:
-            return k % n
-        return min(max(k, 0), n - 1)
+@dataclass(frozen=True, slots=True)
+class LidarSpec:
+    """A planar lidar's beams: ``beams`` over ``fov`` rad centred ahead (a full circle:
+    from -pi, the last one an increment short of +pi, no beam twice; narrower: from
+    -fov/2 to +fov/2, both ends a beam); returns in [``range_min``, ``range_max``] m."""
+
+    beams: int = LIDAR_BEAMS
+    range_min: float = LIDAR_RANGE[0]
+    range_max: float = LIDAR_RANGE[1]
+    fov: float = 2.0 * math.pi
+
+    def __post_init__(self) -> None:
+        if self.beams < 1:
+            raise ValueError(f"lidar_beams must be >= 1, got {self.beams}")
+        if not 0.0 <= self.range_min < self.range_max:
+            raise ValueError(
+                f"need 0 <= lidar_range_min < lidar_range_max, got "
+                f"{self.range_min}, {self.range_max}"
+            )
+        if not 0.0 < self.fov <= 2.0 * math.pi:
+            raise ValueError(f"lidar_fov must be in (0, 2 pi] rad, got {self.fov}")
+
+    @property
+    def angle_min(self) -> float:
+        return -self.fov / 2.0
+
+    @property
+    def increment(self) -> float:
+        full = self.fov >= 2.0 * math.pi
+        return self.fov / (self.beams if full or self.beams < 2 else self.beams - 1)
+
+    def angles(self) -> NDArray[np.float64]:
+        """Each beam's angle, rad, in the laser frame."""
+        return np.asarray(self.angle_min + self.increment * np.arange(self.beams))
+
+    def scan(self, dist: NDArray[np.float64], hit: NDArray[np.bool_] | bool = True) -> RangeScan:
+        """The scan of ``dist`` (m) along each beam, where ``hit`` (a return): REP 117's
+        +inf for no return within range_max, -inf for one too close to measure (so
+        nobody reads it as free space)."""
+        valid = hit & (dist >= self.range_min) & (dist <= self.range_max)
+        too_close = hit & (dist < self.range_min)
+        ranges = np.where(valid, dist, np.where(too_close, -np.inf, np.inf)).astype(np.float32)
+        ranges.flags.writeable = False
+        angle_min, increment = self.angle_min, self.increment
+        return RangeScan(
+            angle_min=angle_min,
+            angle_max=angle_min + increment * (self.beams - 1),
+            angle_increment=increment,
+            range_min=self.range_min,
+            range_max=self.range_max,
+            ranges=ranges,
+        )
 
 
 @dataclass(frozen=True, slots=True)
@@ -144,6 +186,11 @@ class RobotGeometry:
     0.06 m ahead of the axle, wheels reaching y = +-0.1225 m)."""
     wheel_joints: tuple[str, str] = ("left_wheel", "right_wheel")
     """The wheel joints' names in the model (/joint_states)."""
+    wheel_signs: tuple[float, float] = (1.0, 1.0)
+    """Each wheel joint's own sign: +1 if its positive turn rolls the robot forward, -1
+    if its axis points the other way (a mirrored joint). The HAL's wheel readings are
+    positive-forward; /joint_states reports each joint in its own sign, as
+    robot_state_publisher expects."""
 
     @property
     def footprint_radius(self) -> float:

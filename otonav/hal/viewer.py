@@ -23,9 +23,6 @@ from otonav.errors import UsageError
 
 __all__ = [
     "NO_DISPLAY_FIX",
-    "VIEWER_AZIMUTH",
-    "VIEWER_DISTANCE",
-    "VIEWER_ELEVATION",
     "NoDisplayError",
     "ViewerHandle",
     "check_display",
@@ -33,12 +30,8 @@ __all__ = [
 ]
 
 NO_DISPLAY_FIX: Final = "run without --gui, or under xvfb-run"
-VIEWER_DISTANCE: Final = 4.0
-"""m from the tracked robot to the viewer's camera."""
-VIEWER_ELEVATION: Final = -40.0
-"""degrees: the tracking camera looks down at the robot from this angle."""
-VIEWER_AZIMUTH: Final = 135.0
-"""degrees, MuJoCo's convention: the tracking camera's heading around the robot."""
+# The tracking camera: m from the robot, degrees looking down, heading (MuJoCo's).
+_DISTANCE, _ELEVATION, _AZIMUTH = 4.0, -40.0, 135.0
 _VIEWER_THREAD: Final = "_launch_internal"  # target of launch_passive's thread
 
 # Initialise GLFW as the viewer would; on failure print GLFW's last error, exit 3.
@@ -174,9 +167,8 @@ def launch_viewer(
     if tracking is not None:
         with handle.lock():
             handle.cam.type, handle.cam.trackbodyid = tracking
-            handle.cam.distance = VIEWER_DISTANCE
-            handle.cam.elevation = VIEWER_ELEVATION
-            handle.cam.azimuth = VIEWER_AZIMUTH
+            handle.cam.distance, handle.cam.elevation = _DISTANCE, _ELEVATION
+            handle.cam.azimuth = _AZIMUTH
     elapsed = time.perf_counter() - started
     new = [t for t in threading.enumerate() if t not in before]
     threads = [t for t in new if _VIEWER_THREAD in t.name] or new

@@ -18,7 +18,15 @@ from pydantic import (
 )
 
 from otonav import limits
-from otonav.params import BaseConfig, GuardConfig, NavConfig, SafetyConfig, Section
+from otonav.params import (
+    LIDAR_BEAMS,
+    LIDAR_RANGE,
+    BaseConfig,
+    GuardConfig,
+    NavConfig,
+    SafetyConfig,
+    Section,
+)
 
 
 def _within(lo: float, hi: float, unit: str = "", *, open_low: bool = False) -> AfterValidator:
@@ -73,11 +81,11 @@ class WorldConfig(Section):
     timestep: float = Field(0.002, ge=limits.MIN_TIMESTEP_S, le=limits.MAX_TIMESTEP_S)
     """Physics step, s: one tick of sim time. Bounded by the cost of a step below and by
     the fastest timer (the judge's 100 Hz) above: see ``otonav.limits``."""
-    lidar_beams: PositiveInt = Field(360, le=limits.MAX_LIDAR_BEAMS)
+    lidar_beams: PositiveInt = Field(LIDAR_BEAMS, le=limits.MAX_LIDAR_BEAMS)
     """Beams over a full circle, at most 3600 (0.1 degree, the finest 2D lidars)."""
-    lidar_range_min: float = Field(0.12, ge=0.0)
+    lidar_range_min: float = Field(LIDAR_RANGE[0], ge=0.0)
     """m, returns closer than this read as -inf (below range), < ``lidar_range_max``."""
-    lidar_range_max: PositiveFloat = Field(8.0, le=limits.MAX_LIDAR_RANGE_M)
+    lidar_range_max: PositiveFloat = Field(LIDAR_RANGE[1], le=limits.MAX_LIDAR_RANGE_M)
     """m, at most 1 km: ranges are float32 in the recording."""
     lidar_fov: float = Field(2.0 * math.pi, gt=0.0, le=2.0 * math.pi)
     """rad, the lidar's field of view, centred ahead, in (0, 2 pi] (BARN's Jackal: 4.71,

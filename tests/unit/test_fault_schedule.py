@@ -2,59 +2,59 @@
 
 from __future__ import annotations
 
-from otonav.hal.sim.emulator import BusFaults
-from otonav.hal.sim.schedule import FaultPlan, FaultSchedule, Window
+import pytest
+
+from otonav.hal import FakeHardware
+from otonav.hal.can import protocol as p
+from otonav.hal.can.bus import CAN_ERR_BUSOFF, CAN_ERR_RESTARTED, open_endpoint
+from otonav.hal.sim import AxisParams, DriveEmulator
+from otonav.hal.sim.schedule import FaultPlan, Window
 from otonav.stack import StackConfig
 from otonav.stack.faults import fault_plan
 from otonav.stack.overrides import apply_overrides
 
 
-class Recorder:
-    """Stands in for the emulator: records what the schedule asks of it."""
-
-    def __init__(self) -> None:
-        self.faults = BusFaults()
-        self.calls: list[tuple[str, object]] = []
-        self.state: dict[str, object] = {"bus_off": False, "heartbeat": (0, False)}
-
-    def _change(self, what: str, value: object) -> None:
-        if self.state[what] != value:  # as the emulator: asking again changes nothing
-            self.state[what] = value
-            self.calls.append((what, value))
-
-    def set_bus_off(self, off: bool) -> None:
-        self._change("bus_off", off)
-
-    def silence_heartbeat(self, node: int, silent: bool) -> None:
-        self._change("heartbeat", (node, silent))
-
-    def inject_axis_error(self, node: int, code: int) -> None:
-        self.calls.append(("axis_error", (node, code)))
-
-
 def test_each_fault_starts_and_ends_at_its_time() -> None:
+    """The emulator applies its plan at its 10 ms exchanges, watched from the host's
+    end of a virtual bus: the drop rate, bus-off and its restart (error frames), the
+    axis error (once), a drive's heartbeat stopping."""
     plan = FaultPlan(
         drop_rate=0.5, drop=Window(1.0, 2.0), bus_off=Window(3.0, 3.5),
         axis_error_node=1, axis_error_at=4.0, heartbeat_node=0, heartbeat_lost=Window(5.0),
     )  # fmt: skip
-    schedule, emulator = FaultSchedule(plan), Recorder()
-    seen = {}
-    for k in range(0, 601):
-        t = k * 0.01
-        schedule.apply(emulator, t)  # type: ignore[arg-type]
-        seen[round(t, 2)] = (emulator.faults.drop_rate, list(emulator.calls))
-    assert seen[0.99][0] == 0.0
-    assert seen[1.0][0] == 0.5
-    assert seen[1.99][0] == 0.5
-    assert seen[2.0][0] == 0.0
-    calls = seen[6.0][1]
-    assert ("bus_off", True) in calls
-    assert calls.index(("bus_off", True)) < calls.index(("bus_off", False))
-    assert calls.count(("axis_error", (1, 0x20))) == 1  # once, at 4 s
-    assert ("axis_error", (1, 0x20)) not in seen[3.99][1]
-    assert ("heartbeat", (0, True)) in calls
-    assert ("heartbeat", (0, True)) not in seen[4.99][1]
-    assert schedule.next_time == float("inf")
+    world = FakeHardware()
+    host = open_endpoint("virtual", "test-fault-schedule")
+    emulator = DriveEmulator(
+        open_endpoint("virtual", "test-fault-schedule"),
+        world, AxisParams(0), AxisParams(1), schedule=plan,
+    )  # fmt: skip
+    drop_rate: dict[float, float] = {}
+    bus_errors: list[tuple[float, int]] = []
+    heartbeats: dict[int, list[float]] = {0: [], 1: []}
+    axis_errors: list[float] = []
+    try:
+        for _ in range(601):
+            t = round(world.ticks * world.tick, 2)
+            emulator.exchange(world.ticks)
+            drop_rate[t] = emulator.faults.drop_rate
+            if emulator.drive(1).error and (not axis_errors or axis_errors[-1] < t - 0.015):
+                axis_errors.append(t)
+                emulator.drive(1).clear_errors()  # an injected error comes only once
+            for frame in host.poll():
+                if frame.is_error:
+                    bus_errors.append((t, frame.arbitration_id))
+                elif frame.arbitration_id & 0x1F == p.CMD_HEARTBEAT:
+                    heartbeats[frame.arbitration_id >> 5].append(t)
+            world.advance(5)
+    finally:
+        emulator.close()
+        host.close()
+    assert (drop_rate[0.99], drop_rate[1.0], drop_rate[1.99], drop_rate[2.0]) == (0, 0.5, 0.5, 0)
+    assert bus_errors == [(3.0, CAN_ERR_BUSOFF), (3.5, CAN_ERR_RESTARTED)]
+    assert axis_errors == [4.0]
+    assert max(heartbeats[0]) == pytest.approx(4.9)  # the last before 5 s
+    assert max(heartbeats[1]) == pytest.approx(6.0)
+    assert not [t for t in heartbeats[0] + heartbeats[1] if 3.0 <= t < 3.5]  # bus off
 
 
 def test_the_config_keys_make_the_plan() -> None:

@@ -7,13 +7,18 @@ import math
 import numpy as np
 import pytest
 
-from otonav.hal import BoxObstacle, FakeHardware, WheelSetpoint
+from otonav.hal import BoxObstacle, FakeHardware, RangeScan, WheelSetpoint
 from otonav.hal.fake import cast_rays_2d
 
 pytestmark = pytest.mark.unit
 
 R = 0.05  # wheel radius, m
 B = 0.22  # wheel separation, m
+
+
+def beam(scan: RangeScan, angle: float) -> int:
+    """The beam of a full-circle ``scan`` nearest ``angle`` (rad, laser frame)."""
+    return round((angle - scan.angle_min) / scan.angle_increment) % scan.ranges.size
 
 
 def test_straight_drive_moves_v_times_t() -> None:
@@ -80,7 +85,7 @@ def test_scan_sees_box_at_the_analytic_range_and_beam() -> None:
     assert scan.ranges.size == 360
     assert scan.angle_min == pytest.approx(-math.pi)
     assert scan.angle_max == pytest.approx(math.pi - scan.angle_increment)
-    ahead = scan.beam_index(0.0)
+    ahead = beam(scan, 0.0)
     assert ahead == 180
     assert scan.angles[ahead] == pytest.approx(0.0, abs=1e-12)
     assert scan.ranges[ahead] == pytest.approx(2.0 - 0.1 - 0.06, abs=1e-6)
@@ -93,8 +98,8 @@ def test_scan_sees_box_at_the_analytic_range_and_beam() -> None:
 def test_scan_rotates_with_the_robot() -> None:
     hw = FakeHardware(start=(1.0, 1.0, math.pi / 2), obstacles=[BoxObstacle(1.0, 3.0, 0.2, 0.1)])
     scan = hw.read_scan()
-    assert scan.ranges[scan.beam_index(0.0)] == pytest.approx(2.0 - 0.1 - 0.06, abs=1e-6)
-    assert np.isposinf(scan.ranges[scan.beam_index(math.pi / 2)])
+    assert scan.ranges[beam(scan, 0.0)] == pytest.approx(2.0 - 0.1 - 0.06, abs=1e-6)
+    assert np.isposinf(scan.ranges[beam(scan, math.pi / 2)])
 
 
 def test_scan_range_limits_are_inf() -> None:

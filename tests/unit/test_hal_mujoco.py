@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from otonav.hal import BoxObstacle, RobotHardwareInterface, WheelSetpoint
+from otonav.hal import BoxObstacle, RangeScan, RobotHardwareInterface, WheelSetpoint
 from otonav.hal.description import RobotDescription
 from otonav.hal.mujoco import MujocoInterface, SceneError, compile_scene, scene_names
 
@@ -20,6 +20,11 @@ START = (0.0, 0.0)
 GOAL = (4.0, 1.5)
 SPEED = 6.0  # rad/s = 0.3 m/s on 0.05 m wheels
 SCAN_EVERY = 50  # ticks: 10 Hz at dt 0.002
+
+
+def beam(scan: RangeScan, angle: float) -> int:
+    """The beam of a full-circle ``scan`` nearest ``angle`` (rad, laser frame)."""
+    return round((angle - scan.angle_min) / scan.angle_increment) % scan.ranges.size
 
 
 def drive_and_brake(
@@ -204,10 +209,10 @@ def test_lidar_sees_an_extra_obstacle_at_the_expected_range() -> None:
     hw = MujocoInterface("empty", extra_obstacles=[box])
     assert box in hw.obstacles()
     scan = hw.read_scan()
-    ahead = scan.beam_index(0.0)
+    ahead = beam(scan, 0.0)
     assert scan.ranges[ahead] == pytest.approx(1.5 - 0.1 - 0.06, abs=0.005)
     assert hw.geom_name(int(hw.scan_hit_geoms()[ahead])) == "obstacle_extra_0"
-    behind = scan.beam_index(math.pi)
+    behind = beam(scan, math.pi)
     assert scan.ranges[behind] == pytest.approx(5.0 + 0.06, abs=0.005)
 
 
@@ -222,8 +227,20 @@ def test_lidar_range_limits_give_inf() -> None:
     )
     scan = near.read_scan()
     # REP 117: too close to measure is -inf (it was +inf, which reads as "free").
-    assert np.isneginf(scan.ranges[scan.beam_index(0.0)])  # 0.34 m < range_min 0.5
-    assert scan.ranges[scan.beam_index(math.pi)] == pytest.approx(5.06, abs=0.005)
+    assert np.isneginf(scan.ranges[beam(scan, 0.0)])  # 0.34 m < range_min 0.5
+    assert scan.ranges[beam(scan, math.pi)] == pytest.approx(5.06, abs=0.005)
+
+
+def test_a_beam_that_meets_nothing_reads_plus_inf(tmp_path: Path) -> None:
+    """REP 117 through MuJoCo's -1 for a miss: +inf (free), never -inf (too close)."""
+    scene = tmp_path / "open.xml"
+    scene.write_text(
+        '<mujoco><worldbody><geom name="floor" type="plane" size="20 20 0.1"/></worldbody></mujoco>'
+    )
+    hw = MujocoInterface(scene, lidar_beams=36)
+    scan = hw.read_scan()
+    assert (hw.scan_hit_geoms() == -1).all()
+    assert np.isposinf(scan.ranges).all()
 
 
 def _mirrored(ranges: np.ndarray) -> np.ndarray:
@@ -247,7 +264,7 @@ def test_lidar_handedness_a_box_at_plus_y_is_hit_by_the_plus_half_pi_beam(yaw: f
     box = BoxObstacle(left_x, left_y, 0.2, 0.2, yaw)
     hw = MujocoInterface("empty", extra_obstacles=[box], lidar_range_max=3.0, start=(0, 0, yaw))
     scan = hw.read_scan()
-    left, right = scan.beam_index(math.pi / 2), scan.beam_index(-math.pi / 2)
+    left, right = beam(scan, math.pi / 2), beam(scan, -math.pi / 2)
     assert scan.angles[left] == pytest.approx(math.pi / 2)
     assert hw.geom_name(int(hw.scan_hit_geoms()[left])) == "obstacle_extra_0"
     expected = 1.5 - 0.2  # the box's near face, along the beam

@@ -16,7 +16,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from otonav.bench.clutter import clutter_scenario
-from otonav.hal.mujoco import MujocoInterface, static_geoms
+from otonav.hal.mujoco import MujocoInterface, lidar
 from otonav.hal.mujoco._lib import mujoco
 from otonav.hal.raycast import ray_box, ray_plane
 
@@ -129,12 +129,12 @@ def _pair(
     scene: Path, monkeypatch: pytest.MonkeyPatch, **kw: Any
 ) -> tuple[MujocoInterface, MujocoInterface]:
     """The same world twice: the numpy caster on, and MuJoCo casting everything."""
-    monkeypatch.setattr(static_geoms, "MIN_STATIC_BOXES", 0)
+    monkeypatch.setattr(lidar, "MIN_STATIC_BOXES", 0)
     fast = MujocoInterface(scene, **kw)
-    monkeypatch.setattr(static_geoms, "MIN_STATIC_BOXES", 10**9)
+    monkeypatch.setattr(lidar, "MIN_STATIC_BOXES", 10**9)
     ref = MujocoInterface(scene, **kw)
-    assert fast._caster is not None
-    assert ref._caster is None
+    assert fast._lidar._caster is not None
+    assert ref._lidar._caster is None
     return fast, ref
 
 
@@ -161,7 +161,7 @@ def _same_scan(fast: MujocoInterface, ref: MujocoInterface) -> None:
 
     assert np.array_equal(a.ranges, b.ranges)
     assert np.array_equal(fast.scan_hit_geoms(), ref.scan_hit_geoms())
-    assert np.array_equal(fast._ray_dist, ref._ray_dist)  # every float64, bit for bit
+    assert np.array_equal(fast._lidar._dist, ref._lidar._dist)  # every float64, bit for bit
     assert np.array_equal(fast.scan_floor_mask(), ref.scan_floor_mask())
 
 
@@ -242,29 +242,29 @@ def test_the_clutter_course_scans_as_mujoco_along_a_drive() -> None:
     scenario = clutter_scenario(1000)
     boxes = [b.to_obstacle() for b in scenario.obstacles]
     fast = MujocoInterface("empty", extra_obstacles=boxes, start=(-3.0, 0.0, 0.0))
-    assert fast._caster is not None  # 1000 >= MIN_STATIC_BOXES
-    ref_geom = np.empty(fast._nbeams, dtype=np.int32)
-    ref_dist = np.empty(fast._nbeams)
+    assert fast._lidar._caster is not None  # 1000 >= MIN_STATIC_BOXES
+    ref_geom = np.empty(fast._lidar.spec.beams, dtype=np.int32)
+    ref_dist = np.empty(fast._lidar.spec.beams)
     unsure = 0
-    cast = fast._caster.cast
+    cast = fast._lidar._caster.cast
     for step in range(30):
         _pose(fast, -3.0 + 0.2 * step, 0.3 * math.sin(step), 0.05, 0.1 * step, 0.0, 0.0)
         fast.read_scan()
-        got_geom, got_dist = fast.scan_hit_geoms(), fast._ray_dist.copy()
-        fast._mujoco_cast(fast._ray_vec_flat, ref_geom, ref_dist, static=True)
+        got_geom, got_dist = fast.scan_hit_geoms(), fast._lidar._dist.copy()
+        fast._lidar._cast(fast._lidar._vec_flat, ref_geom, ref_dist, static=True)
         assert np.array_equal(got_geom, ref_geom)
         assert np.array_equal(got_dist, ref_dist)
         rot = fast._data.site_xmat[fast._lidar_site].reshape(3, 3)
-        unsure += int(cast(fast._ray_origin, rot, fast._ray_vec, ref_geom, ref_dist).sum())
+        unsure += int(cast(fast._lidar._origin, rot, fast._lidar._vec, ref_geom, ref_dist).sum())
     assert unsure == 0
 
 
 def test_small_worlds_keep_one_mujoco_call() -> None:
     """Below MIN_STATIC_BOXES MuJoCo casts everything (cheaper there), as before."""
-    few = [b.to_obstacle() for b in clutter_scenario(static_geoms.MIN_STATIC_BOXES - 5).obstacles]
-    assert MujocoInterface("empty", extra_obstacles=few)._caster is None
-    many = [b.to_obstacle() for b in clutter_scenario(static_geoms.MIN_STATIC_BOXES).obstacles]
-    assert MujocoInterface("empty", extra_obstacles=many)._caster is not None
+    few = [b.to_obstacle() for b in clutter_scenario(lidar.MIN_STATIC_BOXES - 5).obstacles]
+    assert MujocoInterface("empty", extra_obstacles=few)._lidar._caster is None
+    many = [b.to_obstacle() for b in clutter_scenario(lidar.MIN_STATIC_BOXES).obstacles]
+    assert MujocoInterface("empty", extra_obstacles=many)._lidar._caster is not None
 
 
 def _with(path: Path, extra: str) -> Path:
@@ -290,7 +290,7 @@ def test_moving_geoms_are_cast_by_mujoco_and_merged(
         '<geom name="door" type="box" size="0.05 0.4 0.25" group="0"/></body>',
     )
     fast, ref = _pair(scene, monkeypatch)
-    assert fast._cast_moving
+    assert fast._lidar._cast_moving
     door = int(mujoco.mj_name2id(fast._model, mujoco.mjtObj.mjOBJ_GEOM, "door"))
     for x in (0.0, 0.5, 1.5):
         for world in (fast, ref):
@@ -312,6 +312,6 @@ def test_worlds_the_caster_does_not_model_stay_with_mujoco(
 ) -> None:
     """A static geom of another type, or a mocap body (its 'static' geoms move): MuJoCo
     casts everything, as before."""
-    monkeypatch.setattr(static_geoms, "MIN_STATIC_BOXES", 0)
+    monkeypatch.setattr(lidar, "MIN_STATIC_BOXES", 0)
     world = MujocoInterface(_with(tmp_path / "w.xml", extra))
-    assert world._caster is None
+    assert world._lidar._caster is None

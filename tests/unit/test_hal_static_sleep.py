@@ -12,7 +12,7 @@ import pytest
 
 from otonav.bench.clutter import clutter_scenario
 from otonav.hal import WheelSetpoint
-from otonav.hal.mujoco import MujocoInterface, static_geoms, static_sleep
+from otonav.hal.mujoco import MujocoInterface, lidar, static_sleep
 from otonav.hal.mujoco._lib import mujoco
 
 
@@ -20,7 +20,7 @@ def _clutter(
     n: int, monkeypatch: pytest.MonkeyPatch, *, anchor: bool, caster: bool, **kw: object
 ) -> MujocoInterface:
     monkeypatch.setattr(static_sleep, "MIN_STATIC_GEOMS", 100 if anchor else 10**9)
-    monkeypatch.setattr(static_geoms, "MIN_STATIC_BOXES", 400 if caster else 10**9)
+    monkeypatch.setattr(lidar, "MIN_STATIC_BOXES", 400 if caster else 10**9)
     boxes = [b.to_obstacle() for b in clutter_scenario(n).obstacles]
     return MujocoInterface("empty", extra_obstacles=boxes, **kw)  # type: ignore[arg-type]
 
@@ -44,7 +44,7 @@ def _drive(
             sa, sb = a.read_scan(), b.read_scan()
             assert np.array_equal(sa.ranges, sb.ranges), k
             assert np.array_equal(a.scan_hit_geoms(), b.scan_hit_geoms()), k
-            assert np.array_equal(a._ray_dist, b._ray_dist), k  # every float64
+            assert np.array_equal(a._lidar._dist, b._lidar._dist), k  # every float64
 
 
 @pytest.mark.parametrize("start", [(-3.0, 0.0, 0.0), (-3.0, 1.3, 0.3)])
@@ -57,16 +57,16 @@ def test_the_1000_box_course_is_what_it_was_bit_for_bit(
     wheels, IMU and scans. From (-3, 1.3) the robot drives into the boxes (contacts)."""
     fast = _clutter(1000, monkeypatch, anchor=True, caster=True, start=start)
     ref = _clutter(1000, monkeypatch, anchor=False, caster=False, start=start)
-    assert fast.mj_model.nbody == ref.mj_model.nbody + 1  # type: ignore[attr-defined]
-    assert fast._caster is not None
-    assert ref._caster is None
+    assert fast._model.nbody == ref._model.nbody + 1
+    assert fast._lidar._caster is not None
+    assert ref._lidar._caster is None
     _drive((fast, ref), 2500)
     if start[1] > 0:  # it did meet the boxes: box contacts, the same in both
-        m: Any = fast.mj_model
+        m: Any = fast._model
         boxes = {g for g in range(m.ngeom) if fast.geom_name(g).startswith("obstacle")}
         touched = []
         for world in (fast, ref):
-            d: Any = world.mj_data
+            d: Any = world._data
             touched.append({int(g) for c in d.contact[: d.ncon] for g in (c.geom1, c.geom2)})
         assert touched[0] & boxes
         assert touched[0] == touched[1]
@@ -77,19 +77,19 @@ def test_static_geoms_are_no_longer_placed_each_step(monkeypatch: pytest.MonkeyP
     pose overwritten stays overwritten) and still places the robot's."""
     for anchor in (True, False):
         world = _clutter(300, monkeypatch, anchor=anchor, caster=False)
-        m, d = world.mj_model, world.mj_data
-        box = next(g for g in range(m.ngeom) if world.geom_name(g).startswith("obstacle"))  # type: ignore[attr-defined]
-        wheel = next(g for g in range(m.ngeom) if int(m.geom_bodyid[g]) != 0)  # type: ignore[attr-defined]
-        kept = d.geom_xpos[box].copy()  # type: ignore[attr-defined]
-        d.geom_xpos[box] = (9.0, 9.0, 9.0)  # type: ignore[attr-defined]
-        d.geom_xpos[wheel] = (9.0, 9.0, 9.0)  # type: ignore[attr-defined]
+        m, d = world._model, world._data
+        box = next(g for g in range(m.ngeom) if world.geom_name(g).startswith("obstacle"))
+        wheel = next(g for g in range(m.ngeom) if int(m.geom_bodyid[g]) != 0)
+        kept = d.geom_xpos[box].copy()
+        d.geom_xpos[box] = (9.0, 9.0, 9.0)
+        d.geom_xpos[wheel] = (9.0, 9.0, 9.0)
         mujoco.mj_kinematics(m, d)
-        assert tuple(d.geom_xpos[wheel]) != (9.0, 9.0, 9.0)  # type: ignore[attr-defined]
+        assert tuple(d.geom_xpos[wheel]) != (9.0, 9.0, 9.0)
         if anchor:
-            assert tuple(d.geom_xpos[box]) == (9.0, 9.0, 9.0)  # type: ignore[attr-defined]
-            d.geom_xpos[box] = kept  # type: ignore[attr-defined]
+            assert tuple(d.geom_xpos[box]) == (9.0, 9.0, 9.0)
+            d.geom_xpos[box] = kept
         else:
-            assert np.array_equal(d.geom_xpos[box], kept)  # type: ignore[attr-defined]
+            assert np.array_equal(d.geom_xpos[box], kept)
 
 
 def test_only_worlds_with_many_static_geoms_are_anchored() -> None:
@@ -99,10 +99,10 @@ def test_only_worlds_with_many_static_geoms_are_anchored() -> None:
     many = [b.to_obstacle() for b in clutter_scenario(n).obstacles]
     for boxes, expect in ((few, False), (many, True)):
         world = MujocoInterface("empty", extra_obstacles=boxes)
-        m = world.mj_model
+        m = world._model
         found = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, static_sleep.ANCHOR) >= 0
         assert found is expect
-        assert bool(m.opt.enableflags & mujoco.mjtEnableBit.mjENBL_SLEEP) is expect  # type: ignore[attr-defined]
+        assert bool(m.opt.enableflags & mujoco.mjtEnableBit.mjENBL_SLEEP) is expect
 
 
 def _scene_with_a_loose_box(path: Path, flags: str = "") -> Path:
@@ -133,13 +133,13 @@ def test_other_trees_never_sleep(tmp_path: Path, monkeypatch: pytest.MonkeyPatch
     monkeypatch.setattr(static_sleep, "MIN_STATIC_GEOMS", 10**9)
     ref = MujocoInterface(scene, start=(0.0, 0.0, 0.4))
     _drive((fast, ref), 1500, scan_every=25)
-    m, d, dr = fast.mj_model, fast.mj_data, ref.mj_data
-    nq, nv = ref.mj_model.nq, ref.mj_model.nv  # type: ignore[attr-defined]
-    assert np.array_equal(d.qpos[:nq], dr.qpos[:nq])  # type: ignore[attr-defined]
-    assert np.array_equal(d.qvel[:nv], dr.qvel[:nv])  # type: ignore[attr-defined]
+    m, d, dr = fast._model, fast._data, ref._data
+    nq, nv = ref._model.nq, ref._model.nv
+    assert np.array_equal(d.qpos[:nq], dr.qpos[:nq])
+    assert np.array_equal(d.qvel[:nv], dr.qvel[:nv])
     anchor = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, static_sleep.ANCHOR)
-    awake = [int(a) for a in d.tree_awake]  # type: ignore[attr-defined]
-    anchor_tree = int(m.body_treeid[anchor])  # type: ignore[attr-defined]
+    awake = [int(a) for a in d.tree_awake]
+    anchor_tree = int(m.body_treeid[anchor])
     assert awake[anchor_tree] == 0
     assert all(a == 1 for t, a in enumerate(awake) if t != anchor_tree)
     assert len(awake) == 3  # robot, loose box, anchor
@@ -148,9 +148,9 @@ def test_other_trees_never_sleep(tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 def test_a_scene_that_sleeps_itself_is_left_alone(tmp_path: Path) -> None:
     scene = _scene_with_a_loose_box(tmp_path / "sleeps.xml", '<flag sleep="enable"/>')
     world = MujocoInterface(scene)
-    m = world.mj_model
+    m = world._model
     assert mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, static_sleep.ANCHOR) < 0
-    assert m.opt.enableflags & mujoco.mjtEnableBit.mjENBL_SLEEP  # type: ignore[attr-defined]
+    assert m.opt.enableflags & mujoco.mjtEnableBit.mjENBL_SLEEP
 
 
 def test_the_static_geom_count(tmp_path: Path) -> None:

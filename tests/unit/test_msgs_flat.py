@@ -212,8 +212,8 @@ def test_the_odometry_history_reads_flat_messages_without_building_them() -> Non
     for k in range(12):
         args = (k, 500_000_000 * (k % 2), 0.1 * k, -0.05 * k, 0.3 * k - 1.0, 0.2, 0.01 * k)
         messages.append(flat_odometry(*args))
-        flats.add(messages[-1])
-        eagers.add(eager_odometry(*args))
+        flats.extend([messages[-1]])
+        eagers.extend([eager_odometry(*args)])
     assert flats.latest == eagers.latest
     assert flats.latest is not None
     assert flats.latest[0] == 11.5

@@ -7,15 +7,20 @@ from __future__ import annotations
 import math
 import shutil
 import struct
+import zipfile
 from dataclasses import replace
 from pathlib import Path
 
+import anyio
 import numpy as np
 import pytest
 
-from otonav.hal import BoxObstacle, WheelSetpoint
+from otonav.actors import Bridge, topics
+from otonav.hal import BoxObstacle, WheelSetpoint, description
 from otonav.hal.description import Mount, RobotDescription, builtin_robot
-from otonav.hal.mujoco import MujocoInterface, SceneError
+from otonav.hal.mujoco import MujocoInterface, SceneError, scene_path
+from otonav.msgs import JointState, WheelCommand
+from otonav.runtime import System, virtual_loop_factory
 from otonav.scenario.verdict import lidar_over_obstacles
 
 PATHFINDER = Path(__file__).resolve().parents[2] / "examples" / "my_robot"
@@ -58,7 +63,7 @@ def variant(tmp_path: Path, old: str, new: str) -> RobotDescription:
 
 def old_scene(tmp_path: Path, scene: str) -> Path:
     """A built-in scene as scenes were written before: including robot.xml."""
-    assets = Path(MujocoInterface("empty").scene_file).parent
+    assets = Path(MujocoInterface("empty")._label).parent
     shutil.copy(assets / "robot.xml", tmp_path / "robot.xml")
     text = (assets / f"{scene}.xml").read_text()
     attached = '<compiler angle="radian"/>\n  <option timestep="0.002" integrator="implicitfast"/>'
@@ -336,7 +341,7 @@ def test_a_vendor_model_runs_as_written_whichever_base_frame_is_named(base: str)
 
 
 def test_a_condim_1_caster_without_priority_is_made_frictionless(tmp_path: Path) -> None:
-    assets = Path(MujocoInterface("empty").scene_file).parent
+    assets = Path(MujocoInterface("empty")._label).parent
     text = (assets / "robots" / "burger.xml").read_text()
     old = 'condim="1" priority="1"'
     assert old in text
@@ -547,3 +552,56 @@ def test_the_speed_asked_is_capped_by_the_wheels_control_range() -> None:
     assert reach.asked_omega == pytest.approx(6.67 * 0.033 / 0.08)
     assert 0.8 < reach.v / reach.asked_v < 0.9
     assert world.geometry_sources()["reach"].endswith("(the wheels' control range: 6.67 rad/s)")
+
+
+def test_joint_states_report_a_mirrored_joint_in_its_own_sign() -> None:
+    """Pathfinder's right hinge turns about -y: rolling forward it turns negative, and
+    robot_state_publisher (and MuJoCo's qpos) expect that sign on /joint_states."""
+    world = MujocoInterface("empty", robot=pathfinder())
+    assert world.geometry.wheel_signs == (1.0, -1.0)
+    right_dof = world._wheel_qvel[1]
+    states: list[JointState] = []
+
+    async def main() -> None:
+        async with System([Bridge(world)]) as system:
+            sub = system.subscribe(topics.JOINT_STATES, JointState, topics.SENSOR_QOS)
+            wheels = system.publisher(topics.WHEEL_CMD, WheelCommand, topics.COMMAND_QOS)
+            await wheels.publish(WheelCommand(left=3.0, right=3.0))
+            with anyio.move_on_after(1.0):
+                async for message in sub:
+                    states.append(message)
+
+    anyio.run(main, backend_options={"loop_factory": virtual_loop_factory(world, wall_ceiling=30)})
+    assert world.ground_truth().x > 0.1  # it rolled forward
+    last = states[-1]
+    assert last.velocity[0] == pytest.approx(3.0, rel=0.05)
+    assert last.velocity[1] == pytest.approx(-3.0, rel=0.05)
+    assert last.position[0] > 1.0
+    assert last.position[1] < -1.0
+    assert math.copysign(1.0, world._data.qvel[right_dof]) == -1.0  # the model's own sign
+
+
+def test_a_zipped_package_copies_the_whole_assets_tree_for_its_scenes_and_robots(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Installed as a zip, the assets are no real files: MuJoCo gets a copy of the whole
+    tree, so the Burger in ``robots/`` loads as it does from a folder."""
+    shipped = description.assets_dir()
+    archive = tmp_path / "otonav.zip"
+    with zipfile.ZipFile(archive, "w") as z:
+        for file in shipped.rglob("*"):
+            if file.is_file():
+                z.write(file, f"otonav/hal/assets/{file.relative_to(shipped).as_posix()}")
+    monkeypatch.setattr(
+        description, "_shipped", lambda: zipfile.Path(archive, "otonav/hal/assets/")
+    )
+    monkeypatch.setattr(description, "_copy", [])
+    with scene_path("obstacles") as path:
+        assert not path.is_relative_to(shipped)
+        copied = path.parent / "robots" / "burger.xml"
+        assert copied.read_bytes() == (shipped / "robots" / "burger.xml").read_bytes()
+    burger = builtin_robot("burger")
+    assert Path(burger.model) == copied
+    world = MujocoInterface("obstacles", robot=burger)
+    assert world.geometry.wheel_radius == pytest.approx(0.033)
+    assert world.geometry.wheel_joints == ("wheel_left_joint", "wheel_right_joint")

@@ -8,7 +8,8 @@ module imports :mod:`mujoco` (an import-linter contract; ADR 0056). Its modules:
 - ``prepare``: the robot's description put into the scene's ``MjSpec``;
 - ``derive``: the robot's geometry read from the compiled world;
 - ``world``: :class:`MujocoInterface`, the HAL over the compiled world;
-- ``static_geoms``: the static geoms the lidar's numpy caster takes (ADR 0057);
+- ``lidar``: its lidar, and the static geoms the numpy caster takes (ADR 0057);
+- ``shapes``: its static geoms as the judge measures them;
 - ``static_sleep``: static geoms placed once, not at every step (ADR 0062).
 
 The viewer's window (:class:`~otonav.hal.viewer.ViewerHandle`, the display check) lives

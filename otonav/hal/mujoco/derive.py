@@ -28,7 +28,6 @@ class _Probe:
     wheel_radius: float  # m, rough (bounding sphere of the left wheel's geoms)
     top: float  # m, the highest point of the robot above its base's origin
     bottom: float  # m, the lowest point of its collision geoms above the floor
-    floor: float  # m, that lowest point relative to the base's origin
     resting: tuple[int, ...]  # the geoms other than the wheels' on the floor: casters
 
 
@@ -64,7 +63,6 @@ def _probe(parts: _RobotSpec) -> _Probe:
         wheel_radius=radius,
         top=max(highs, default=0.0) - float(data.xpos[base][2]),
         bottom=bottom,
-        floor=bottom - float(data.xpos[base][2]),
         resting=tuple(
             g
             for g, low in lows.items()
@@ -107,14 +105,19 @@ def _geom_half(model: Any, geom: int) -> tuple[NDArray[np.float64], NDArray[np.f
     return centre, half
 
 
+def _mesh_vertices(model: Any, geom: int) -> NDArray[np.float64]:
+    """A mesh geom's vertices in its own frame."""
+    mesh = int(model.geom_dataid[geom])
+    start, count = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
+    return np.asarray(model.mesh_vert[start : start + count], dtype=np.float64)
+
+
 def _geom_corners(model: Any, data: Any, geom: int) -> NDArray[np.float64]:
     """Points that bound ``geom``, world frame: a mesh's own vertices (its bounding box
     turns with the mesh's principal axes, arbitrary about a wheel's axle, and reached
     ~14 mm under a tyre), else the 8 corners of its bounding box."""
     if int(model.geom_type[geom]) == mujoco.mjtGeom.mjGEOM_MESH:
-        mesh = int(model.geom_dataid[geom])
-        start, count = int(model.mesh_vertadr[mesh]), int(model.mesh_vertnum[mesh])
-        local = np.asarray(model.mesh_vert[start : start + count], dtype=np.float64)
+        local = _mesh_vertices(model, geom)
     else:
         centre, half = _geom_half(model, geom)
         local = _SIGNS * half + centre
@@ -180,6 +183,7 @@ class _Derivation:
         return result
 
     def geometry(self, joints: tuple[int, int], lidar: int, imu: int) -> RobotGeometry:
+        signs = (self.wheel_sign(joints[0]), self.wheel_sign(joints[1]))
         radius = self.wheel_radius(joints[0])
         separation = self.separation(*joints)
         laser = self.site_offset(lidar, "lidar")
@@ -194,6 +198,7 @@ class _Derivation:
             imu_offset=(float(imu_pos[0]), float(imu_pos[1]), float(imu_pos[2])),
             footprint=footprint,
             wheel_joints=(self.robot.left_wheel, self.robot.right_wheel),
+            wheel_signs=signs,
         )
 
     def _given(self, key: str, value: object) -> bool:
@@ -255,9 +260,7 @@ class _Derivation:
         elif kind == mujoco.mjtGeom.mjGEOM_ELLIPSOID and aligned:
             radius = float(max(size[i] for i in range(3) if i != k))
         elif kind == mujoco.mjtGeom.mjGEOM_MESH:
-            mesh = int(m.geom_dataid[geom])
-            start, count = int(m.mesh_vertadr[mesh]), int(m.mesh_vertnum[mesh])
-            verts = np.asarray(m.mesh_vert[start : start + count], dtype=np.float64)
+            verts = _mesh_vertices(m, geom)
             unit = axis / np.linalg.norm(axis)
             off_axle = verts - np.outer(verts @ unit, unit)
             radius = float(np.max(np.linalg.norm(off_axle, axis=1)))

@@ -45,10 +45,7 @@ class _RobotSpec:
         self.robot = robot
         self.file = file_label
         self.sources: dict[str, str] = {}
-        self.wheel_acts: dict[str, Any] = {}
         self.ctrl_scale: dict[str, float] = {}
-        self.lidar_site = ""
-        self.imu_site = ""
         self.base = self._mover(self._body(robot.base, "base"))
         self.joints = {
             "left_wheel": self._wheel(robot.left_wheel, "left_wheel"),
@@ -173,7 +170,6 @@ class _RobotSpec:
                 f"{kind} actuator {act.name or '(unnamed)'!r} driven as a velocity loop, "
                 f"kv {act.gainprm[0]:.4g}, +-{torque:.3g} N m"
             )
-        self.wheel_acts[key] = act
         self.ctrl_scale[key] = float(act.gear[0])
 
     @staticmethod

@@ -5,15 +5,13 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
-from importlib import resources
-from importlib.resources.abc import Traversable
 from pathlib import Path
 from typing import Any, Final
 
 from otonav.errors import UsageError
+from otonav.hal.description import assets_dir
 from otonav.hal.mujoco._lib import mujoco
 from otonav.hal.types import BoxObstacle
 
@@ -35,16 +33,11 @@ class SceneError(UsageError):
 # -- scenes ----------------------------------------------------------------------------
 
 
-def _assets() -> Traversable:
-    return resources.files("otonav.hal").joinpath("assets")
-
-
 def scene_names() -> tuple[str, ...]:
     """Names of the built-in scenes (the MJCF files shipped in ``otonav/hal/assets``)."""
-    root = _assets()
     names = (
         entry.name.removesuffix(".xml")
-        for entry in root.iterdir()
+        for entry in assets_dir().iterdir()
         if entry.name.endswith(".xml") and entry.name != _ROBOT_FRAGMENT
     )
     return tuple(sorted(names))
@@ -52,23 +45,11 @@ def scene_names() -> tuple[str, ...]:
 
 @contextmanager
 def scene_path(scene: str | os.PathLike[str]) -> Iterator[Path]:
-    """Context manager yielding a real filesystem path for a scene name or MJCF path.
-
-    Built-in scenes are read through :mod:`importlib.resources`; if the package is not
-    on a filesystem (e.g. zipped), the assets are copied to a temporary directory for
-    the duration of the ``with`` block, so ``<include file="robot.xml"/>`` resolves.
-    """
+    """Context manager yielding a real filesystem path for a scene name or MJCF path
+    (a built-in scene's from :func:`~otonav.hal.description.assets_dir`, a real folder
+    even when the package is zipped)."""
     if isinstance(scene, str) and scene in scene_names():
-        root = _assets()
-        filename = f"{scene}.xml"
-        if isinstance(root, Path):
-            yield root / filename
-            return
-        with tempfile.TemporaryDirectory(prefix="otonav-assets-") as tmp:
-            for entry in root.iterdir():
-                if entry.name.endswith(".xml"):
-                    (Path(tmp) / entry.name).write_bytes(entry.read_bytes())
-            yield Path(tmp) / filename
+        yield assets_dir() / f"{scene}.xml"
         return
     path = Path(scene)
     if not path.is_file():

@@ -1,15 +1,8 @@
-"""MuJoCo implementation of :class:`~otonav.hal.interface.RobotHardwareInterface`.
-
-Part of ``otonav.hal.mujoco``, the only code in otonav that touches MuJoCo; nothing
-outside it sees a MuJoCo type (``mujoco`` has no type stubs, so its objects are ``Any``
-here and never escape through a public signature).
-
-A scene is a built-in name (see :func:`scene_names`) or a path to an MJCF file. The
-robot is found by name: body ``chassis`` (free joint, base_link), hinge joints
-``left_wheel``/``right_wheel``, actuators ``left_motor``/``right_motor``, sites ``imu``
-and ``lidar``, sensors ``imu_gyro``, ``imu_accel``, ``imu_quat``. Static box geoms named
-``obstacle*`` and ``wall*`` are the world's obstacles and walls. Robot geoms live in
-geom group 1; the lidar casts only against groups 0 and 2.
+"""MuJoCo implementation of :class:`~otonav.hal.interface.RobotHardwareInterface`: a
+scene (a built-in name, see :func:`scene_names`, or an MJCF file) with the robot of a
+:class:`~otonav.hal.description.RobotDescription` put in it. No MuJoCo type escapes
+through a public signature (``mujoco`` has no type stubs: its objects are ``Any`` here).
+Robot geoms live in geom group 1; the lidar casts only against groups 0 and 2.
 
 Time: ``advance(n)`` is the only thing that steps physics; ``ticks`` is an integer
 counter (``data.time`` accumulates float error and is not used). Readings taken after an
@@ -43,16 +36,18 @@ from numpy.typing import NDArray
 from otonav.hal.description import RobotDescription, builtin_robot
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.mujoco._lib import mujoco, viewer_module
-from otonav.hal.mujoco.derive import _actuator_of, _collides, _Derivation, _probe, _site_sensor
+from otonav.hal.mujoco.derive import _actuator_of, _Derivation, _probe, _site_sensor
 from otonav.hal.mujoco.identify import SECONDS, _Robot, identify
+from otonav.hal.mujoco.lidar import Lidar
 from otonav.hal.mujoco.prepare import ROBOT_PREFIX, _load_robot, _merge_options, _RobotSpec
 from otonav.hal.mujoco.scene import SceneError, _add_box, _compile, _load_spec
-from otonav.hal.mujoco.static_geoms import ray_caster
+from otonav.hal.mujoco.shapes import _static_shapes, _tallest_obstacle, _yaw_of_quat
 from otonav.hal.mujoco.static_sleep import anchor_static_geoms, anchored
 from otonav.hal.types import (
     BoxObstacle,
     GroundTruth,
     ImuSample,
+    LidarSpec,
     PolygonObstacle,
     RangeScan,
     Reach,
@@ -60,16 +55,15 @@ from otonav.hal.types import (
     RoundObstacle,
     WheelSetpoint,
     WheelState,
-    convex_hull,
 )
 from otonav.hal.viewer import ViewerHandle, check_display, launch_viewer
 
 __all__ = ["MujocoInterface"]
 
-_RAY_GROUPS: Final = np.array([1, 0, 1, 0, 0, 0], dtype=np.uint8)  # groups 0 and 2
 _SETTLE_TIME: Final = 0.25  # s of physics run at construction, before tick 0
 _MOUNT_ABOVE: Final = 0.02  # m: a default lidar sits this far above the robot's top
 _REST_TOLERANCE: Final = 1e-3  # m: a model resting within this of the floor is not moved
+_LIDAR: Final = LidarSpec()  # the default lidar
 
 
 _IDENTIFIED: dict[object, Reach] = {}
@@ -77,79 +71,74 @@ _IDENTIFIED: dict[object, Reach] = {}
 sweep's runs of one robot identify it once per process (~0.1 s each otherwise)."""
 
 
-def _mtime(path: str) -> int:
-    return os.stat(path).st_mtime_ns
-
-
-def _mesh_footprint(m: Any, d: Any, g: int) -> PolygonObstacle | None:
-    """A mesh geom's vertices in the world (``d`` through ``mj_kinematics``), projected
-    on the floor: their convex hull (None: fewer than 3 corners)."""
-    mesh = int(m.geom_dataid[g])
-    start, count = int(m.mesh_vertadr[mesh]), int(m.mesh_vertnum[mesh])
-    local = np.asarray(m.mesh_vert[start : start + count], dtype=np.float64)
-    world = local @ np.asarray(d.geom_xmat[g]).reshape(3, 3).T + np.asarray(d.geom_xpos[g])
-    hull = convex_hull([(float(x), float(y)) for x, y in world[:, :2]])
-    return PolygonObstacle(hull) if len(hull) >= 3 else None
-
-
-def _yaw_of_quat(w: float, x: float, y: float, z: float) -> float:
-    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
-
-
 class MujocoInterface(RobotHardwareInterface):
     """The otonav robot simulated by MuJoCo.
 
     ``scene``: built-in scene name (``"empty"``, ``"obstacles"``) or an MJCF path.
-    ``lidar_beams`` beams over ``lidar_fov`` rad centred ahead (a full circle: from -pi,
-    the last one an increment short of +pi; narrower: from -fov/2 to +fov/2); ranges in
-    [``lidar_range_min``, ``lidar_range_max``] m, otherwise +inf. ``timestep`` (s)
-    overrides the scene's. ``extra_obstacles`` become 0.5 m tall static boxes named
-    ``obstacle_extra_<i>``. ``start`` is the robot's pose (x, y, yaw)
-    in the world plane before it settles.
+    ``lidar_beams`` beams over ``lidar_fov`` rad centred ahead, ranges in
+    [``lidar_range_min``, ``lidar_range_max``] m, otherwise +inf (:class:`LidarSpec`).
+    ``timestep`` (s) overrides the scene's. ``extra_obstacles`` become 0.5 m tall static
+    boxes named ``obstacle_extra_<i>``. ``start`` is the robot's pose (x, y, yaw) in the
+    world plane before it settles.
     """
 
     def __init__(
         self,
         scene: str | os.PathLike[str] = "obstacles",
         *,
-        lidar_beams: int = 360,
-        lidar_range_min: float = 0.12,
-        lidar_range_max: float = 8.0,
-        lidar_fov: float = 2.0 * math.pi,
+        lidar_beams: int = _LIDAR.beams,
+        lidar_range_min: float = _LIDAR.range_min,
+        lidar_range_max: float = _LIDAR.range_max,
+        lidar_fov: float = _LIDAR.fov,
         timestep: float | None = None,
         extra_obstacles: Sequence[BoxObstacle] = (),
         start: tuple[float, float, float] = (0.0, 0.0, 0.0),
         robot: RobotDescription | None = None,
     ) -> None:
-        if lidar_beams < 1:
-            raise ValueError(f"lidar_beams must be >= 1, got {lidar_beams}")
-        if not 0.0 <= lidar_range_min < lidar_range_max:
-            raise ValueError(
-                f"need 0 <= lidar_range_min < lidar_range_max, got "
-                f"{lidar_range_min}, {lidar_range_max}"
-            )
-        if not 0.0 < lidar_fov <= 2.0 * math.pi:
-            raise ValueError(f"lidar_fov must be in (0, 2 pi] rad, got {lidar_fov}")
+        lidar = LidarSpec(lidar_beams, float(lidar_range_min), float(lidar_range_max), lidar_fov)
         if timestep is not None and not timestep > 0.0:
             raise ValueError(f"timestep must be positive, got {timestep}")
-
-        spec, label = _load_spec(scene)
-        self._label = label
-        robot = robot if robot is not None else builtin_robot("otonav")
-        self._robot = robot
+        spec, self._label = _load_spec(scene)
+        self._spec = spec
+        self._robot = robot if robot is not None else builtin_robot("otonav")
         if timestep is not None:
             spec.option.timestep = timestep
         for i, box in enumerate(extra_obstacles):
             _add_box(spec, f"obstacle_extra_{i}", box)
+        parts, prefix, robot_file, mover = self._put_robot(spec)
+        # Static geoms placed once, not at every step (ADR 0062): the same physics.
+        anchor = anchor_static_geoms(spec)
+        self._model: Any = _compile(
+            spec, f"{self._label} with {robot_file}" if prefix else self._label
+        )
+        self._data: Any = mujoco.MjData(self._model)
+        if anchor and not anchored(self._model, self._data):
+            raise RuntimeError(
+                f"{self._label}: the static-geom anchor did not fall asleep (ADR 0062)"
+            )
+        self._bind(parts, prefix, robot_file, mover)
+        self._shapes = _static_shapes(self._model)
+        self._reach: dict[tuple[float, float], Reach] = {}
+        self._settle(start)
+        # The static boxes and planes are cast in numpy (ADR 0057), MuJoCo casts the rest.
+        self._lidar = Lidar(
+            self._model, self._data, lidar, site=self._lidar_site, body=self._chassis
+        )
+
+    def _put_robot(self, spec: Any) -> tuple[_RobotSpec, str, str, str]:
+        """The robot prepared in ``spec`` (its own file's, attached, or the scene's own):
+        its parts, the prefix of its names in the world, the file it came from and the
+        body that moves (``robot.base``, or above it)."""
+        robot = self._robot
         if spec.body(robot.base) is not None:
             # The scene has the robot in it already (a scene that includes robot.xml).
-            robot_spec, robot_file, prefix = spec, label, ""
+            robot_spec, robot_file, prefix = spec, self._label, ""
         else:
             included = builtin_robot("otonav").base
             if spec.body(included) is not None:  # an old scene with our robot in it
                 raise SceneError(
-                    f"MJCF file {label} includes otonav's robot (body {included!r}); remove "
-                    f'its <include file="robot.xml"/> to run robot.model: {robot.label}'
+                    f"MJCF file {self._label} includes otonav's robot (body {included!r}); "
+                    f'remove its <include file="robot.xml"/> to run robot.model: {robot.label}'
                 )
             robot_spec, robot_file = _load_robot(robot)
             prefix = ROBOT_PREFIX
@@ -157,24 +146,23 @@ class MujocoInterface(RobotHardwareInterface):
         probe = _probe(parts)
         parts.casters(probe.resting)
         parts.prepare(probe.mass, probe.wheel_radius)
-        lidar_site = parts.mount("lidar", robot.lidar, (0.0, 0.0, probe.top + _MOUNT_ABOVE))
-        imu_site = parts.mount("imu", robot.imu, (0.0, 0.0, 0.0))
-        parts.imu_sensors(imu_site)
-        self._ctrl_scale = (parts.ctrl_scale["left_wheel"], parts.ctrl_scale["right_wheel"])
-        mover = str(parts.base.name)  # the body that moves: robot.base, or above it
+        self._sites = (  # the names of the lidar's and the IMU's sites
+            parts.mount("lidar", robot.lidar, (0.0, 0.0, probe.top + _MOUNT_ABOVE)),
+            parts.mount("imu", robot.imu, (0.0, 0.0, 0.0)),
+        )
+        parts.imu_sensors(self._sites[1])
+        mover = str(parts.base.name)
         if prefix:
             if abs(probe.bottom) > _REST_TOLERANCE:
                 parts.base.pos[2] -= probe.bottom  # rest on the floor, not in or above it
             _merge_options(spec, robot_spec)
             spec.worldbody.add_frame().attach_body(parts.base, prefix, "")
-        # Static geoms placed once, not at every step (ADR 0062): the same physics.
-        anchor = anchor_static_geoms(spec)
-        self._model: Any = _compile(spec, label if not prefix else f"{label} with {robot_file}")
-        self._data: Any = mujoco.MjData(self._model)
-        m = self._model
-        if anchor and not anchored(m, self._data):
-            raise RuntimeError(f"{label}: the static-geom anchor did not fall asleep (ADR 0062)")
-        obj = mujoco.mjtObj
+        return parts, prefix, robot_file, mover
+
+    def _bind(self, parts: _RobotSpec, prefix: str, robot_file: str, mover: str) -> None:
+        """The compiled robot's ids (bodies, joints, actuators, sites, sensors), its
+        geometry derived from the model and what identification needs."""
+        m, robot, obj = self._model, self._robot, mujoco.mjtObj
 
         def ident(kind: Any, name: str) -> int:
             found = int(mujoco.mj_name2id(m, kind, prefix + name))
@@ -192,24 +180,21 @@ class MujocoInterface(RobotHardwareInterface):
         self._wheel_qvel = (int(m.jnt_dofadr[left_joint]), int(m.jnt_dofadr[right_joint]))
         self._left_act = _actuator_of(m, left_joint)
         self._right_act = _actuator_of(m, right_joint)
-        self._lidar_site = ident(obj.mjOBJ_SITE, lidar_site)
-        self._imu_site = ident(obj.mjOBJ_SITE, imu_site)
-        self._gyro = _site_sensor(m, mujoco.mjtSensor.mjSENS_GYRO, self._imu_site)
-        self._accel = _site_sensor(m, mujoco.mjtSensor.mjSENS_ACCELEROMETER, self._imu_site)
-        self._quat = _site_sensor(m, mujoco.mjtSensor.mjSENS_FRAMEQUAT, self._imu_site)
+        self._lidar_site = ident(obj.mjOBJ_SITE, self._sites[0])
+        imu_site = ident(obj.mjOBJ_SITE, self._sites[1])
+        self._gyro = _site_sensor(m, mujoco.mjtSensor.mjSENS_GYRO, imu_site)
+        self._accel = _site_sensor(m, mujoco.mjtSensor.mjSENS_ACCELEROMETER, imu_site)
+        self._quat = _site_sensor(m, mujoco.mjtSensor.mjSENS_FRAMEQUAT, imu_site)
 
         derived = _Derivation(m, ident(obj.mjOBJ_BODY, robot.base), parts)
-        self._wheel_sign = (derived.wheel_sign(left_joint), derived.wheel_sign(right_joint))
+        self._geometry = derived.geometry((left_joint, right_joint), self._lidar_site, imu_site)
+        self._wheel_sign = self._geometry.wheel_signs
         self._mirrored = self._wheel_sign != (1.0, 1.0)
         self._ctrl_scale = (
-            self._ctrl_scale[0] * self._wheel_sign[0],
-            self._ctrl_scale[1] * self._wheel_sign[1],
-        )
-        self._geometry = derived.geometry(
-            (left_joint, right_joint), self._lidar_site, self._imu_site
+            parts.ctrl_scale["left_wheel"] * self._wheel_sign[0],
+            parts.ctrl_scale["right_wheel"] * self._wheel_sign[1],
         )
         self._sources = {**parts.sources, **derived.sources}
-        self._spec = spec
         self._identity = _Robot(
             body=prefix + mover,
             left=prefix + robot.left_wheel,
@@ -218,128 +203,22 @@ class MujocoInterface(RobotHardwareInterface):
             radius=self._geometry.wheel_radius,
             separation=self._geometry.wheel_separation,
         )
-        self._reach: dict[tuple[float, float], Reach] = {}
-        self._static_shapes()
-        self._is_floor = np.asarray(m.geom_type == mujoco.mjtGeom.mjGEOM_PLANE, dtype=np.bool_)
 
-        # Lidar: beam directions in the site frame and preallocated ray buffers.
-        self._range_min = float(lidar_range_min)
-        self._range_max = float(lidar_range_max)
-        # A full circle: beams from -pi, the last one increment short of +pi (no beam
-        # twice). A narrower field of view (issue 42): centred ahead, both ends a beam.
-        full = lidar_fov >= 2.0 * math.pi
-        self._angle_min = -lidar_fov / 2.0
-        self._angle_increment = lidar_fov / (
-            lidar_beams if full or lidar_beams < 2 else lidar_beams - 1
-        )
-        angles = self._angle_min + self._angle_increment * np.arange(lidar_beams)
-        self._beams_local = np.zeros((lidar_beams, 3))
-        self._beams_local[:, 0] = np.cos(angles)
-        self._beams_local[:, 1] = np.sin(angles)
-        self._ray_vec = np.zeros((lidar_beams, 3))
-        self._ray_vec_flat = self._ray_vec.reshape(-1)  # a view: filled by matmul(out=)
-        self._ray_origin = np.zeros(3)
-        self._ray_geom = np.full(lidar_beams, -1, dtype=np.int32)
-        self._ray_dist = np.full(lidar_beams, -1.0)
-        self._nbeams = lidar_beams
-
-        # Place the robot at its start pose (x, y, yaw) in the world plane.
+    def _settle(self, start: tuple[float, float, float]) -> None:
+        """Place the robot at its start pose (x, y, yaw) in the world plane and let it
+        settle onto its wheels and caster (contacts start at zero force), so that tick 0
+        is a robot at rest: the IMU reads +g, not free fall."""
         x0, y0, yaw0 = start
-        p = self._base_qpos
-        self._data.qpos[p] = x0
-        self._data.qpos[p + 1] = y0
-        self._data.qpos[p + 3 : p + 7] = (math.cos(yaw0 / 2), 0.0, 0.0, math.sin(yaw0 / 2))
-        # Let the robot settle onto its wheels and caster (contacts start at zero force)
-        # so tick 0 is a robot at rest: the IMU reads +g, not free fall.
-        mujoco.mj_step(m, self._data, nstep=max(1, round(_SETTLE_TIME / self.tick)))
+        p, qpos = self._base_qpos, self._data.qpos
+        qpos[p] = x0
+        qpos[p + 1] = y0
+        qpos[p + 3 : p + 7] = (math.cos(yaw0 / 2), 0.0, 0.0, math.sin(yaw0 / 2))
+        mujoco.mj_step(self._model, self._data, nstep=max(1, round(_SETTLE_TIME / self.tick)))
         self._data.time = 0.0
-        self._ticks = 0
         self._stale = True
-        self._closed = False
         self._sync()
-        # The static boxes and planes are cast in numpy (ADR 0057), MuJoCo casts the rest.
-        self._caster, self._cast_moving = ray_caster(
-            m,
-            self._data,
-            groups=_RAY_GROUPS,
-            exclude_body=self._chassis,
-            angle_min=self._angle_min,
-            increment=self._angle_increment,
-            beams=lidar_beams,
-            cutoff=self._range_max,
-        )
-        if self._caster is not None:
-            self._moving_geom = np.full(lidar_beams, -1, dtype=np.int32)
-            self._moving_dist = np.full(lidar_beams, -1.0)
 
     # -- model facts ----------------------------------------------------------------------
-
-    def _static_shapes(self) -> None:
-        """Every static geom the robot can touch (welded to the world, colliding, not a
-        plane), as what the judge measures (issue 42): boxes (``wall*`` ones are the
-        walls), upright cylinders, capsules and spheres as disks; the rest unjudged."""
-        m, d = self._model, None
-        kinds = mujoco.mjtGeom
-        obstacles: list[BoxObstacle] = []
-        walls: list[BoxObstacle] = []
-        rounds: list[RoundObstacle] = []
-        polygons: list[PolygonObstacle] = []
-        unjudged: list[str] = []
-        for g in range(m.ngeom):
-            body = int(m.geom_bodyid[g])
-            kind = int(m.geom_type[g])
-            if int(m.body_weldid[body]) != 0 or kind == kinds.mjGEOM_PLANE or not _collides(m, g):
-                continue
-            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g) or f"geom {g}"
-            if body == 0:  # the model's floats, as before (no rounding through mj_forward)
-                x, y = float(m.geom_pos[g][0]), float(m.geom_pos[g][1])
-                w, qx, qy, qz = (float(v) for v in m.geom_quat[g])
-                yaw = _yaw_of_quat(w, qx, qy, qz)
-                upright = 1.0 - 2.0 * (qx * qx + qy * qy)
-            else:  # a body welded to the world: where its kinematics put the geom
-                if d is None:
-                    d = mujoco.MjData(m)
-                    mujoco.mj_kinematics(m, d)
-                x, y = float(d.geom_xpos[g][0]), float(d.geom_xpos[g][1])
-                xmat = d.geom_xmat[g]
-                yaw, upright = math.atan2(float(xmat[3]), float(xmat[0])), float(xmat[8])
-            size = m.geom_size[g]
-            if kind == kinds.mjGEOM_BOX:
-                box = BoxObstacle(x, y, float(size[0]), float(size[1]), yaw)
-                (walls if name.startswith("wall") else obstacles).append(box)
-            elif kind == kinds.mjGEOM_SPHERE or (
-                kind in (kinds.mjGEOM_CYLINDER, kinds.mjGEOM_CAPSULE) and upright > 1.0 - 1e-6
-            ):
-                rounds.append(RoundObstacle(x, y, float(size[0])))
-            elif kind == kinds.mjGEOM_MESH:
-                if d is None:
-                    d = mujoco.MjData(m)
-                    mujoco.mj_kinematics(m, d)
-                hull = _mesh_footprint(m, d, g)
-                if hull is not None:
-                    polygons.append(hull)
-                else:  # a mesh edge-on to the floor: no area to measure from
-                    unjudged.append(f"{name} (MESH)")
-            else:
-                unjudged.append(f"{name} ({mujoco.mjtGeom(kind).name.removeprefix('mjGEOM_')})")
-        self._obstacles, self._walls = tuple(obstacles), tuple(walls)
-        self._rounds, self._unjudged = tuple(rounds), tuple(unjudged)
-        self._polygons = tuple(polygons)
-
-    @property
-    def scene_file(self) -> str:
-        """The MJCF file this world was built from."""
-        return self._label
-
-    @property
-    def mj_model(self) -> object:
-        """The compiled ``mujoco.MjModel`` (for a viewer inside ``otonav.hal`` only)."""
-        return self._model
-
-    @property
-    def mj_data(self) -> object:
-        """The live ``mujoco.MjData`` (for a viewer inside ``otonav.hal`` only)."""
-        return self._data
 
     def open_viewer(self, *, track: bool = True) -> ViewerHandle:
         """Open MuJoCo's passive viewer (no side panels) on this world.
@@ -366,15 +245,8 @@ class MujocoInterface(RobotHardwareInterface):
     def tick(self) -> float:
         return float(self._model.opt.timestep)
 
-    @property
-    def ticks(self) -> int:
-        return self._ticks
-
     def advance(self, n: int) -> None:
-        self._check_open()
-        if n < 0:
-            raise ValueError(f"cannot advance by a negative number of ticks ({n})")
-        if n == 0:
+        if not self._steps(n):
             return
         mujoco.mj_step(self._model, self._data, nstep=n)
         self._ticks += n
@@ -436,88 +308,15 @@ class MujocoInterface(RobotHardwareInterface):
 
     def read_scan(self) -> RangeScan:
         self._sync()
-        d = self._data
-        rot = d.site_xmat[self._lidar_site].reshape(3, 3)
-        np.matmul(self._beams_local, rot.T, out=self._ray_vec)
-        self._ray_origin[:] = d.site_xpos[self._lidar_site]
-        if self._caster is None:
-            self._mujoco_cast(self._ray_vec_flat, self._ray_geom, self._ray_dist, static=True)
-        else:
-            self._cast_static_apart(rot)
-        dist = self._ray_dist
-        hit = self._ray_geom >= 0
-        valid = hit & (dist >= self._range_min) & (dist <= self._range_max)
-        # REP 117: no return within range_max is +inf; a return closer than range_min
-        # (too close to measure) is -inf, so nobody reads it as free space.
-        too_close = hit & (dist < self._range_min)
-        ranges = np.where(valid, dist, np.where(too_close, -np.inf, np.inf)).astype(np.float32)
-        ranges.flags.writeable = False
-        return RangeScan(
-            angle_min=self._angle_min,
-            angle_max=self._angle_min + self._angle_increment * (self._nbeams - 1),
-            angle_increment=self._angle_increment,
-            range_min=self._range_min,
-            range_max=self._range_max,
-            ranges=ranges,
-        )
-
-    def _mujoco_cast(
-        self,
-        vec: NDArray[np.float64],
-        geom: NDArray[np.int32],
-        dist: NDArray[np.float64],
-        *,
-        static: bool,
-    ) -> None:
-        mujoco.mj_multiRay(
-            self._model,
-            self._data,
-            self._ray_origin,
-            vec,
-            _RAY_GROUPS,
-            1 if static else 0,
-            self._chassis,
-            geom,
-            dist,
-            None,
-            len(geom),
-            self._range_max,
-        )
-
-    def _cast_static_apart(self, rot: NDArray[np.float64]) -> None:
-        """The numpy caster for the static geoms, MuJoCo for the moving ones (none:
-        no call) and for any beam the caster is not sure of: the same returns as one
-        ``mj_multiRay`` over everything (ADR 0057)."""
-        assert self._caster is not None
-        geom, dist = self._ray_geom, self._ray_dist
-        unsure = self._caster.cast(self._ray_origin, rot, self._ray_vec, geom, dist)
-        if self._cast_moving:
-            mg, md = self._moving_geom, self._moving_dist
-            self._mujoco_cast(self._ray_vec_flat, mg, md, static=False)
-            # one cast keeps the nearest, the first (lower id) of equal distances
-            take = (md >= 0) & ((dist < 0) | (md < dist) | ((md == dist) & (mg < geom)))
-            geom[take] = mg[take]
-            dist[take] = md[take]
-        if unsure.any():
-            beams = np.flatnonzero(unsure)
-            sub_geom = np.full(len(beams), -1, dtype=np.int32)
-            sub_dist = np.full(len(beams), -1.0)
-            vec = np.ascontiguousarray(self._ray_vec[beams]).reshape(-1)
-            self._mujoco_cast(vec, sub_geom, sub_dist, static=True)
-            geom[beams] = sub_geom
-            dist[beams] = sub_dist
+        return self._lidar.scan()
 
     def scan_hit_geoms(self) -> NDArray[np.int32]:
         """Geom id hit by each beam of the last :meth:`read_scan` (-1: miss). A copy."""
-        return self._ray_geom.copy()
+        return self._lidar.hit_geoms()
 
     def scan_floor_mask(self) -> NDArray[np.bool_]:
         """Per beam of the last :meth:`read_scan`: did it hit a floor plane within range?"""
-        geoms, dist = self._ray_geom, self._ray_dist
-        in_range = (geoms >= 0) & (dist >= self._range_min) & (dist <= self._range_max)
-        mask = np.zeros(self._nbeams, dtype=np.bool_)
-        mask[in_range] = self._is_floor[geoms[in_range]]
-        return mask
+        return self._lidar.floor_mask()
 
     def scan_floor_hits(self) -> int:
         """How many beams of the last :meth:`read_scan` hit a floor plane within range.
@@ -567,14 +366,7 @@ class MujocoInterface(RobotHardwareInterface):
         return self._robot
 
     def tallest_obstacle(self) -> float | None:
-        m, tops = self._model, []  # the boxes, not the arena's walls
-        for g in range(m.ngeom):
-            name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_GEOM, g) or ""
-            if name.startswith("obstacle") and int(m.geom_bodyid[g]) == 0:
-                tops.append(float(m.geom_pos[g][2] + m.geom_rbound[g]))
-                if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_BOX:  # upright: its half height
-                    tops[-1] = float(m.geom_pos[g][2] + m.geom_size[g][2])
-        return max(tops, default=None)
+        return _tallest_obstacle(self._model)
 
     def reach(self, v: float, omega: float) -> Reach:
         """Identified in sim time on a copy of the world with only the robot in it
@@ -586,7 +378,14 @@ class MujocoInterface(RobotHardwareInterface):
             radius, half_track = self._geometry.wheel_radius, self._geometry.wheel_separation / 2
             asked = (min(v, wheel * radius), min(omega, wheel * radius / half_track))
             robot, scene = self._robot, self._label  # the scene: its floor's friction
-            key = (repr(robot), _mtime(robot.model), scene, self.tick, self._identity, asked)
+            key = (
+                repr(robot),
+                os.stat(robot.model).st_mtime_ns,
+                scene,
+                self.tick,
+                self._identity,
+                asked,
+            )
             found = _IDENTIFIED.get(key) or identify(self._spec, self._identity, *asked)
             _IDENTIFIED[key] = found
             self._reach[(v, omega)] = found
@@ -609,23 +408,16 @@ class MujocoInterface(RobotHardwareInterface):
         return top
 
     def obstacles(self) -> tuple[BoxObstacle, ...]:
-        return self._obstacles
+        return self._shapes.obstacles
 
     def walls(self) -> tuple[BoxObstacle, ...]:
-        return self._walls
+        return self._shapes.walls
 
     def round_obstacles(self) -> tuple[RoundObstacle, ...]:
-        return self._rounds
+        return self._shapes.rounds
 
     def polygon_obstacles(self) -> tuple[PolygonObstacle, ...]:
-        return self._polygons
+        return self._shapes.polygons
 
     def unjudged_geoms(self) -> tuple[str, ...]:
-        return self._unjudged
-
-    def close(self) -> None:
-        self._closed = True
-
-    def _check_open(self) -> None:
-        if self._closed:
-            raise RuntimeError(f"MujocoInterface for {self._label} is closed")
+        return self._shapes.unjudged

@@ -25,7 +25,7 @@ from __future__ import annotations
 import heapq
 import math
 import struct
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -33,7 +33,7 @@ from otonav.hal.can import protocol as p
 from otonav.hal.can.bus import CAN_ERR_BUSOFF, CAN_ERR_RESTARTED, CanEndpoint, RawFrame
 from otonav.hal.interface import RobotHardwareInterface
 from otonav.hal.sim.odrive import AxisModel, AxisParams
-from otonav.hal.sim.schedule import FaultPlan, FaultSchedule
+from otonav.hal.sim.schedule import BusFaults, FaultPlan
 from otonav.hal.types import WheelSetpoint
 
 __all__ = ["BusFaults", "DriveEmulator", "DriveMount"]
@@ -55,22 +55,6 @@ class DriveMount:
             raise ValueError(f"DriveMount needs sign +-1 and gear_ratio > 0, got {self}")
 
 
-@dataclass(slots=True)
-class BusFaults:
-    """Bus-level fault injection, applied to frames in both directions.
-
-    ``drop_rate``: probability (0..1) that a frame is lost. ``delay``: seconds every
-    frame is held back, plus up to ``jitter`` seconds more (uniform; frames may then
-    arrive out of order, as behind a congested gateway).
-    """
-
-    drop_rate: float = 0.0
-    delay: float = 0.0
-    jitter: float = 0.0
-    dropped: int = field(default=0)
-    delayed: int = field(default=0)
-
-
 class _Drive:
     __slots__ = (
         "axis",
@@ -79,14 +63,12 @@ class _Drive:
         "heartbeat_id",
         "heartbeat_silent",
         "k",
-        "mount",
         "node_id",
         "sign",
     )
 
     def __init__(self, params: AxisParams, mount: DriveMount) -> None:
         self.axis = AxisModel(params)
-        self.mount = mount
         self.sign, self.gear = mount.sign, mount.gear_ratio
         self.node_id = params.node_id
         self.heartbeat_silent = False
@@ -128,7 +110,10 @@ class DriveEmulator:
         self._by_node = {d.node_id: d for d in self.drives}
         self.faults = BusFaults()
         # Faults on a timetable (hal.sim.faults); None: only what a caller injects.
-        self._schedule = FaultSchedule(schedule) if schedule and not schedule.empty else None
+        self._plan = schedule if schedule and not schedule.empty else None
+        self._edges = self._plan.times() if self._plan else []  # each start and end, s
+        self._next_edge = 0  # the first not yet applied
+        self._axis_error_done = False
         for node in (schedule.axis_error_node, schedule.heartbeat_node) if schedule else ():
             if node is not None and node not in self._by_node:
                 raise ValueError(
@@ -145,8 +130,6 @@ class DriveEmulator:
         # Delayed frames: (due tick, seq, outbound?, frame, sim time it was sent).
         self._held: list[tuple[int, int, bool, RawFrame, float]] = []
         self._last_cmd = (math.nan, math.nan)
-        self.frames_sent = 0
-        self.frames_received = 0
 
     # -- fault injection -----------------------------------------------------------------
 
@@ -162,19 +145,15 @@ class DriveEmulator:
         """Drive ``node_id`` reports ``code`` and disarms, until Clear_Errors."""
         self._by_node[node_id].axis.raise_error(code)
 
-    def set_bus_off(self, off: bool, now_tick: int | None = None) -> None:
+    def set_bus_off(self, off: bool) -> None:
         """The bus goes bus-off (nothing passes; the host's controller reports
         CAN_ERR_BUSOFF) or restarts (CAN_ERR_RESTARTED), like SocketCAN with restart-ms."""
         if off == self._bus_off:
             return
-        t = (self._world.ticks if now_tick is None else now_tick) * self._tick
+        t = self._world.ticks * self._tick
         error = CAN_ERR_BUSOFF if off else CAN_ERR_RESTARTED
         self._endpoint.send(RawFrame(error, bytes(8), is_error=True), t)
         self._bus_off = off
-
-    @property
-    def bus_off(self) -> bool:
-        return self._bus_off
 
     def close(self) -> None:
         """Leave the bus. Idempotent."""
@@ -197,15 +176,13 @@ class DriveEmulator:
         (a Set_Input_Vel in PASSTHROUGH); in VEL_RAMP a Set_Input_Vel alone moves
         nothing before time passes (the ramp is ``vel_ramp_rate * dt`` and dt is 0)."""
         t = now * self._tick
-        if self._schedule is not None:
-            self._schedule.apply(self, t)
+        if self._next_edge < len(self._edges) and t >= self._edges[self._next_edge]:
+            self._apply_plan(t)
         changed = False
         incoming = self._endpoint.poll()
         if incoming and not self._bus_off:  # nothing crosses a bus-off bus
-            faults = self.faults
-            lossy = faults.drop_rate > 0.0 or faults.delay > 0.0 or faults.jitter > 0.0
+            lossy = self.faults.lossy
             for frame in incoming:
-                self.frames_received += 1
                 if lossy and self._lose_or_hold(frame, now, outbound=False):
                     continue
                 changed |= self._handle(frame, t)
@@ -220,7 +197,6 @@ class DriveEmulator:
                 # adapter's buffer, a socket nobody drains), which SocketCAN's receive
                 # timestamps show. The host judges the data's age by it (issue 27).
                 self._endpoint.send(frame, sent_at)
-                self.frames_sent += 1
             else:
                 changed |= self._handle(frame, t)
         if now == self._updated_at and not changed:
@@ -250,6 +226,24 @@ class DriveEmulator:
 
     # -- internals -----------------------------------------------------------------------
 
+    def _apply_plan(self, t: float) -> None:
+        """Bring the faults to what the plan says at ``t`` (an edge is due)."""
+        while self._next_edge < len(self._edges) and self._edges[self._next_edge] <= t:
+            self._next_edge += 1
+        plan, faults = self._plan, self.faults
+        assert plan is not None
+        faults.drop_rate = plan.drop_rate if plan.drop.holds(t) else 0.0
+        on = plan.delayed.holds(t)
+        faults.delay, faults.jitter = (plan.delay, plan.jitter) if on else (0.0, 0.0)
+        if plan.bus_off is not None:
+            self.set_bus_off(plan.bus_off.holds(t))
+        if plan.heartbeat_node is not None:
+            self.silence_heartbeat(plan.heartbeat_node, plan.heartbeat_lost.holds(t))
+        node = plan.axis_error_node
+        if node is not None and not self._axis_error_done and t >= plan.axis_error_at:
+            self._axis_error_done = True
+            self.inject_axis_error(node, plan.axis_error_code)
+
     def _lose_or_hold(self, frame: RawFrame, now: int, *, outbound: bool) -> bool:
         """Apply drop/delay to ``frame``: True if it is not to be used now."""
         faults = self.faults
@@ -264,18 +258,12 @@ class DriveEmulator:
             due = now + max(1, round((faults.delay + extra) / self._tick))
             self._seq += 1
             heapq.heappush(self._held, (due, self._seq, outbound, frame, now * self._tick))
-            faults.delayed += 1
             return True
         return False
 
     def _transmit(self, frame: RawFrame, now: int, t: float) -> None:
-        faults = self.faults
-        if (
-            faults.drop_rate > 0.0 or faults.delay > 0.0 or faults.jitter > 0.0
-        ) and self._lose_or_hold(frame, now, outbound=True):
-            return
-        self._endpoint.send(frame, t)
-        self.frames_sent += 1
+        if not (self.faults.lossy and self._lose_or_hold(frame, now, outbound=True)):
+            self._endpoint.send(frame, t)
 
     def _handle(self, frame: RawFrame, t: float) -> bool:
         """Apply one command frame; True if it may have changed an axis' state or
@@ -313,8 +301,7 @@ class DriveEmulator:
         kl, kr = left.k, right.k
         data_l = _pack_two_f32(position_l * kl, velocity_l * kl)
         data_r = _pack_two_f32(position_r * kr, velocity_r * kr)
-        faults = self.faults
-        if faults.drop_rate > 0.0 or faults.delay > 0.0 or faults.jitter > 0.0:
+        if self.faults.lossy:
             self._transmit(RawFrame(left.encoder_id, data_l), now, t)
             self._transmit(RawFrame(right.encoder_id, data_r), now, t)
             return
@@ -322,7 +309,6 @@ class DriveEmulator:
         send = self._endpoint.send_data
         send(left.encoder_id, data_l, t)
         send(right.encoder_id, data_r, t)
-        self.frames_sent += 2
 
     def _send_heartbeats(self, now: int, t: float) -> None:
         for drive in self.drives:

@@ -2,38 +2,36 @@
 (and, where it can end, an end) in seconds of sim time, so that a config file, the CLI
 (``--set hal.sim.faults...``) and a sweep can ask for them, not only Python.
 
-The emulator asks :meth:`FaultSchedule.apply` at each exchange (every encoder period,
-10 ms by default): a fault starts or ends at the first exchange at or after its time.
+The drive emulator applies its plan at each exchange (every encoder period, 10 ms by
+default): a fault starts or ends at the first exchange at or after its time.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
-from typing import Protocol
 
 from otonav.hal.can.protocol import AxisError
 
-__all__ = ["FaultPlan", "FaultSchedule", "FaultTarget", "Window"]
+__all__ = ["BusFaults", "FaultPlan", "Window"]
 
 
-class _Faults(Protocol):
-    drop_rate: float
-    delay: float
-    jitter: float
+@dataclass(slots=True)
+class BusFaults:
+    """Bus-level fault injection, applied to frames in both directions.
 
+    ``drop_rate``: probability (0..1) that a frame is lost. ``delay``: seconds every
+    frame is held back, plus up to ``jitter`` seconds more (uniform; frames may then
+    arrive out of order, as behind a congested gateway). ``dropped``: frames lost so far.
+    """
 
-class FaultTarget(Protocol):
-    """What a schedule drives: the drive emulator (:mod:`otonav.hal.sim.emulator`)."""
+    drop_rate: float = 0.0
+    delay: float = 0.0
+    jitter: float = 0.0
+    dropped: int = 0
 
     @property
-    def faults(self) -> _Faults: ...
-
-    def set_bus_off(self, off: bool) -> None: ...
-
-    def silence_heartbeat(self, node_id: int, silent: bool = True) -> None: ...
-
-    def inject_axis_error(self, node_id: int, code: int = ...) -> None: ...
+    def lossy(self) -> bool:
+        return self.drop_rate > 0.0 or self.delay > 0.0 or self.jitter > 0.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -88,37 +86,3 @@ class FaultPlan:
         if self.axis_error_node is not None:
             edges.append(self.axis_error_at)
         return sorted(set(edges))
-
-
-class FaultSchedule:
-    """Applies a :class:`FaultPlan` to an emulator as sim time passes."""
-
-    def __init__(self, plan: FaultPlan) -> None:
-        self.plan = plan
-        self._edges = plan.times()
-        self._next = 0  # index of the next edge not yet applied
-        self._axis_error_done = False
-
-    @property
-    def next_time(self) -> float:
-        """The next instant at which the faults change (inf: none left)."""
-        return self._edges[self._next] if self._next < len(self._edges) else math.inf
-
-    def apply(self, emulator: FaultTarget, t: float) -> None:
-        """Bring the emulator's faults to what the plan says at ``t`` (s of sim time)."""
-        if t < self.next_time:
-            return
-        while self._next < len(self._edges) and self._edges[self._next] <= t:
-            self._next += 1
-        plan, faults = self.plan, emulator.faults
-        faults.drop_rate = plan.drop_rate if plan.drop.holds(t) else 0.0
-        on = plan.delayed.holds(t)
-        faults.delay, faults.jitter = (plan.delay, plan.jitter) if on else (0.0, 0.0)
-        if plan.bus_off is not None:
-            emulator.set_bus_off(plan.bus_off.holds(t))
-        if plan.heartbeat_node is not None:
-            emulator.silence_heartbeat(plan.heartbeat_node, plan.heartbeat_lost.holds(t))
-        node = plan.axis_error_node
-        if node is not None and not self._axis_error_done and t >= plan.axis_error_at:
-            self._axis_error_done = True
-            emulator.inject_axis_error(node, plan.axis_error_code)
