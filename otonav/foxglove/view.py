@@ -289,7 +289,6 @@ class _TopicState:
     channel: Any
     latched: bool
     sent: int = 0
-    sent_bytes: int = 0
 
 
 class LiveView(Actor):
@@ -513,7 +512,6 @@ class LiveView(Actor):
                 stamp = round(instant * 1e9)
                 channel.log(data, log_time=stamp)
                 state.sent += 1
-                state.sent_bytes += len(data)
                 self.sent_bytes += len(data)
                 if state.latched:
                     server.latch(channel, data, stamp)
@@ -531,7 +529,3 @@ class LiveView(Actor):
             clients_seen=len(server.clients_seen),
             client_dropped=server.dropped,
         )
-
-    def topic_statistics(self) -> dict[str, tuple[int, int]]:
-        """topic -> (messages sent, messages dropped by its tap)."""
-        return {name: (s.sent, s.tap.dropped) for name, s in self._topics.items()}

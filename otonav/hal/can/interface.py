@@ -126,7 +126,6 @@ class CanBusInterface(RobotHardwareInterface):
         self._sensors = sensors
         self._peer = peer
         self._axes = (left, right)
-        self._node_ids = (left.node_id, right.node_id)
         self._scale = (left.turns_per_rad(), right.turns_per_rad())
         self._vel_ids = (
             p.arbitration_id(left.node_id, p.CMD_SET_INPUT_VEL),
@@ -152,7 +151,6 @@ class CanBusInterface(RobotHardwareInterface):
         self._wheels: WheelState | None = WheelState(0.0, 0.0, 0.0, 0.0)
         self._log: deque[tuple[float, RawFrame]] = deque(maxlen=frame_log)
         self._log_limit = frame_log
-        self._logged = 0
         self.frames_dropped_from_log = 0
         self.log_frames = True
         """Keep the frames sent and received for :meth:`take_frames`."""
@@ -442,7 +440,3 @@ class CanBusInterface(RobotHardwareInterface):
                 if self._peer is not None:
                     self._peer.close()
                 self._sensors.close()
-
-    def _check_open(self) -> None:
-        if self._closed:
-            raise RuntimeError("CanBusInterface is closed")
