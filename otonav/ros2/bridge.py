@@ -1,6 +1,6 @@
 """The ROS 2 bridge: otonav's topics on DDS as a ROS 2 node on Cyclone DDS has them.
 
-Out: every topic of the system (or ``Ros2Options.outputs``) is mirrored on its DDS topic
+Out: every topic of the system is mirrored on its DDS topic
 (``/odom`` -> ``rt/odom``, type ``nav_msgs::msg::dds_::Odometry_``, QoS as the topic's
 publishers offer it, mapped as rmw_cyclonedds maps it: :mod:`otonav.ros2.naming`). A
 mirror is a mailbox that writes as the message is published: the CDR encoding of the
@@ -34,7 +34,7 @@ import contextlib
 import math
 import os
 import re
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -88,8 +88,6 @@ class Ros2Options:
     """DDS domain, 0..232 (None: ``ROS_DOMAIN_ID``, else 0)."""
     inputs: tuple[str, ...] = (topics.GOAL,)
     """Topics ROS 2 nodes may publish into the stack."""
-    outputs: tuple[str, ...] | None = None
-    """Topics mirrored out (None: every topic of the system)."""
     period: float = 0.01
     """s of sim time between two reads of the inputs."""
     wait_for_peers: float | None = None
@@ -113,12 +111,11 @@ class Ros2Options:
         wait = self.wait_for_peers
         if wait is not None and not (wait > 0 and math.isfinite(wait)):
             raise Ros2Error(f"--ros2-wait {wait}: must be a number of seconds > 0")
-        for key, names in (("--ros2-in", self.inputs), ("ros2 outputs", self.outputs or ())):
-            for name in names:
-                try:
-                    dds_topic(name)
-                except Ros2Error as exc:
-                    raise Ros2Error(f"{key} {exc}") from None
+        for name in self.inputs:
+            try:
+                dds_topic(name)
+            except Ros2Error as exc:
+                raise Ros2Error(f"--ros2-in {exc}") from None
         for name, period in self.lockstep:
             if name not in self.inputs:
                 raise Ros2Error(
@@ -309,8 +306,7 @@ class Ros2Bridge(Actor):
             self._wait_for_peers(self.options.wait_for_peers)
 
     def _mirror(self, topic: Topic[Any]) -> None:
-        outputs = self.options.outputs
-        if topic.name in self._mirrors or (outputs is not None and topic.name not in outputs):
+        if topic.name in self._mirrors:
             return
         mirror = _Mirror(topic, Endpoint(self.name, f"out{topic.name}"))
         topic.subscriptions.append(mirror)
@@ -662,23 +658,16 @@ def _node_name(actor: str) -> str:
     return name if name and not name[0].isdigit() else f"_{name}"
 
 
-def bridge_for(
-    section: Ros2Config,
-    *,
-    domain_id: int | None = None,
-    inputs: Sequence[str] = (),
-    env: Mapping[str, str] | None = None,
-    base_frame: str = "base_link",
-) -> Ros2Bridge:
-    """The bridge the stack config's ``ros2`` section asks for (``domain_id`` and
-    ``inputs`` override it: the CLI's flags). The one way every surface makes it."""
+def bridge_for(section: Ros2Config, *, base_frame: str = "base_link") -> Ros2Bridge:
+    """The bridge the stack config's ``ros2`` section asks for: the one way every surface
+    makes it."""
     options = Ros2Options(
-        domain_id=domain_id if domain_id is not None else section.domain_id,
-        inputs=tuple(inputs or section.inputs),
+        domain_id=section.domain_id,
+        inputs=tuple(section.inputs),
         wait_for_peers=section.wait,
         lockstep=tuple((answer.topic, answer.period) for answer in section.lockstep),
         lockstep_timeout=section.lockstep_timeout,
         twist_stamped=section.twist_stamped,
         base_frame=base_frame,
     )
-    return Ros2Bridge(options, env=env)
+    return Ros2Bridge(options)
