@@ -529,3 +529,7 @@ class LiveView(Actor):
             clients_seen=len(server.clients_seen),
             client_dropped=server.dropped,
         )
+
+    def topic_statistics(self) -> dict[str, tuple[int, int]]:
+        """topic -> (messages sent, messages dropped by its tap)."""
+        return {name: (s.sent, s.tap.dropped) for name, s in self._topics.items()}
