@@ -135,12 +135,8 @@ class CanBusInterface(RobotHardwareInterface):
         # node id and turns per rad. Everything else (heartbeats, other nodes, error
         # frames) takes the slow path.
         self._encoder_axis = {
-            p.arbitration_id(axis.node_id, p.CMD_GET_ENCODER_ESTIMATES): (
-                i,
-                axis.node_id,
-                self._scale[i],
-            )
-            for i, axis in enumerate((left, right))
+            p.arbitration_id(axis.node_id, p.CMD_GET_ENCODER_ESTIMATES): (i, axis.node_id, scale)
+            for i, (axis, scale) in enumerate(zip((left, right), self._scale, strict=True))
         }
         self.monitor = DriveMonitor(
             (NodeLabel(left.node_id, left.label), NodeLabel(right.node_id, right.label)),
