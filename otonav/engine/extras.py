@@ -96,10 +96,12 @@ def open_extras(config: StackConfig) -> Extras:
 
 
 def _live_view(config: StackConfig) -> LiveView:
-    from otonav.foxglove import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
+    from otonav.foxglove import LiveView, LiveViewError, LiveViewOptions
 
     section = config.foxglove
     try:
+        from otonav.foxglove import FoxgloveServer
+
         options = LiveViewOptions(
             host=section.host, port=section.port, wait_for_subscriber=section.wait_for_subscriber
         )

@@ -26,7 +26,7 @@ from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
 from otonav.actors import topics
-from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewOptions
+from otonav.foxglove import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.msgs import Point, Pose, PoseStamped
 from otonav.record.cdr import encode
 from otonav.record.reader import read_messages

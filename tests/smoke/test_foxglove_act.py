@@ -19,7 +19,7 @@ from websockets.typing import Subprotocol
 
 from otonav.actors import topics
 from otonav.embed import HOST_QOS, open_live_stack
-from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewOptions
+from otonav.foxglove import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.msgs import Odometry, PoseStamped
 from otonav.record.reader import read_messages
 from otonav.record.schemas import schema_for

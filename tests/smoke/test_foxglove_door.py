@@ -34,8 +34,8 @@ from websockets.typing import Subprotocol
 
 from otonav.actors import AvoidingNavigator, topics
 from otonav.embed import LiveStack, open_live_stack
+from otonav.foxglove import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.foxglove.protocol import CONTROL_BACKLOG
-from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.msgs import PoseStamped
 from otonav.record.reader import read_messages
 from otonav.record.schemas import schema_for

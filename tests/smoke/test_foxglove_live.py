@@ -23,7 +23,7 @@ from websockets.typing import Subprotocol
 
 from otonav.cli import main as cli_main
 from otonav.embed import open_live_stack
-from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
+from otonav.foxglove import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
 from otonav.msgs import LaserScan
 from otonav.record.reader import read_messages, summarize
 from otonav.runtime import SENSOR_DATA_QOS, Actor, Output, RealTime, run_blocking

@@ -16,7 +16,7 @@ import pytest
 
 from otonav.actors import topics
 from otonav.embed import open_live_stack
-from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewOptions
+from otonav.foxglove import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.record.reader import read_messages
 from otonav.runtime import RealTime, until
 from otonav.stack import StackConfig
