@@ -467,7 +467,7 @@ def _announce(args: argparse.Namespace, extras: Extras) -> None:
     if bridge is not None:
         options = bridge.options
         if options.lockstep:
-            answers = ", ".join(f"{name} every {period:g} s" for name, period in options.lockstep)
+            answers = ", ".join(f"{a.topic} every {a.period:g} s" for a in options.lockstep)
             timing = f"in lockstep: sim time waits for {answers}"
         else:
             timing = "paced to the wall clock"

@@ -82,11 +82,10 @@ def open_extras(config: StackConfig) -> Extras:
         if config.foxglove.enabled:
             extras.view = _live_view(config)
         if config.ros2.enabled:
-            from otonav.ros2 import Ros2Error, bridge_for
+            from otonav.ros2 import Ros2Bridge, Ros2Error
 
             try:
-                base = robot_frames(config.robot).base
-                extras.ros2 = bridge_for(config.ros2, base_frame=base)
+                extras.ros2 = Ros2Bridge(config.ros2, base_frame=robot_frames(config.robot).base)
             except Ros2Error as exc:
                 raise ExtrasError(str(exc)) from None
     except BaseException:

@@ -217,9 +217,7 @@ PINNED: dict[str, tuple[str, ...]] = {
     "otonav.ros2": (
         "Ros2Bridge",
         "Ros2Error",
-        "Ros2Options",
         "Ros2Statistics",
-        "bridge_for",
     ),
     "otonav.runtime": (
         "Actor",
