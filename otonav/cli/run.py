@@ -453,7 +453,7 @@ def _announce(args: argparse.Namespace, extras: Extras) -> None:
     server = extras.foxglove
     if server is not None:
         hint = ""
-        if not (args.realtime or args.gui) and server.options.wait_for_subscriber is None:
+        if not (args.realtime or args.gui) and server.config.wait_for_subscriber is None:
             hint = (
                 "; in virtual time the run may be over before a client connects: --foxglove-wait S"
             )

@@ -95,15 +95,11 @@ def open_extras(config: StackConfig) -> Extras:
 
 
 def _live_view(config: StackConfig) -> LiveView:
-    from otonav.foxglove import LiveView, LiveViewError, LiveViewOptions
+    from otonav.foxglove import LiveView, LiveViewError
 
-    section = config.foxglove
     try:
         from otonav.foxglove import FoxgloveServer
 
-        options = LiveViewOptions(
-            host=section.host, port=section.port, wait_for_subscriber=section.wait_for_subscriber
-        )
-        return LiveView(FoxgloveServer(options))
+        return LiveView(FoxgloveServer(config.foxglove))
     except LiveViewError as exc:
         raise ExtrasError(str(exc)) from None

@@ -51,9 +51,11 @@ from websockets.asyncio.server import Server, ServerConnection, serve
 from websockets.exceptions import ConnectionClosed
 from websockets.typing import Subprotocol
 
-from otonav.foxglove.options import LiveViewError, LiveViewOptions
+from otonav.actors import topics
+from otonav.foxglove.errors import LiveViewError
 from otonav.msgs import Message
 from otonav.record.schemas import schema_for
+from otonav.stack.config import FoxgloveConfig
 
 SUBPROTOCOLS = (Subprotocol("foxglove.sdk.v1"), Subprotocol("foxglove.websocket.v1"))
 """What the handshake accepts: the protocol's current name, then its original one."""
@@ -144,18 +146,30 @@ class Channel:
 
 
 class FoxgloveServer:
-    """A Foxglove WebSocket server on ``options.host:options.port`` (0: any free port),
-    serving from its own thread once made (:meth:`close` stops it); raises
+    """A Foxglove WebSocket server on ``config.host:config.port`` (the stack config's
+    ``foxglove`` section; port 0: any free one), serving from its own thread once made
+    (:meth:`close` stops it), with ``backlog`` data messages queued per client before its
+    oldest is dropped, and clients publishing on the ``client_publish`` topics (none:
+    they only watch); ``subscriptions``: how many channel subscriptions a
+    ``config.wait_for_subscriber`` waits for. Raises
     :class:`~otonav.foxglove.LiveViewError` when the address cannot be bound. The live
     view sets its sinks: ``client_sink(channel, payload)`` takes a client's message (None,
     or one line why not), ``parameter_sink`` answers ``getParameters``/``setParameters``
     (``get_parameters(names)``, ``set_parameters(changes, reply)``), ``refusal_sink(source,
     text)`` hears of malformed frames and disconnected clients; all on the server's thread."""
 
-    def __init__(self, options: LiveViewOptions = LiveViewOptions()) -> None:
-        self.options = options
+    def __init__(
+        self,
+        config: FoxgloveConfig | None = None,
+        *,
+        backlog: int = 256,
+        client_publish: tuple[str, ...] = (topics.GOAL,),
+        subscriptions: int = 1,
+    ) -> None:
+        self.config = options = config if config is not None else FoxgloveConfig()
+        self.backlog, self.client_publish, self.awaited = backlog, client_publish, subscriptions
         self.capabilities = ["time", "clientPublish", "parameters"]
-        if not options.client_publish:
+        if not client_publish:
             self.capabilities.remove("clientPublish")
         self.client_sink: Callable[[ClientChannel, bytes], str | None] | None = None
         self.parameter_sink: Any = None
@@ -203,11 +217,11 @@ class FoxgloveServer:
             raise self._error
         assert self._server is not None
         self.port: int = self._server.sockets[0].getsockname()[1]
-        """The bound port (the one picked when ``options.port`` was 0)."""
+        """The bound port (the one picked when ``config.port`` was 0)."""
 
     @property
     def url(self) -> str:
-        return f"ws://{self.options.host}:{self.port}"
+        return f"ws://{self.config.host}:{self.port}"
 
     @property
     def subscriptions(self) -> dict[int, set[int]]:
@@ -270,7 +284,7 @@ class FoxgloveServer:
     def _queue_data(self, client: _Client, frame: bytes) -> None:  # under the lock
         if client.closing is not None:
             return
-        if len(client.data) >= self.options.backlog:
+        if len(client.data) >= self.backlog:
             client.data.popleft()
             client.dropped += 1
             self.dropped += 1
@@ -373,7 +387,7 @@ class FoxgloveServer:
                 "name": "otonav",
                 "capabilities": self.capabilities,
                 # what clients may publish in (clientPublish)
-                "supportedEncodings": ["cdr", "json"] if self.options.client_publish else [],
+                "supportedEncodings": ["cdr", "json"] if self.client_publish else [],
                 "metadata": {},
             }
             self._queue_control(client, json.dumps(info))
@@ -426,7 +440,7 @@ class FoxgloveServer:
             if not isinstance(message, dict):
                 raise TypeError(f"expected a JSON object, not {type(message).__name__}")
             op = message["op"]
-            if op in ("advertise", "unadvertise") and self.options.client_publish:
+            if op in ("advertise", "unadvertise") and self.client_publish:
                 self._client_advertise(client, op, message)
             elif op in ("getParameters", "setParameters"):
                 self._parameter_op(client, op, message)
@@ -469,7 +483,7 @@ class FoxgloveServer:
             )
         opcode, channel_id = _CLIENT_DATA.unpack_from(raw)
         channel = client.advertised.get(channel_id)
-        if opcode != 0x01 or channel is None or not self.options.client_publish:
+        if opcode != 0x01 or channel is None or not self.client_publish:
             self._status(client, 2, f"client message on unadvertised channel {channel_id}")
             return
         sink = self.client_sink

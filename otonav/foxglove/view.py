@@ -18,7 +18,7 @@ Two parts (docs/adr/0031-live-view-over-foxglove-sdk.md, amended by 0032):
   again to each client that subscribes to them, since the protocol has no latching.
 
 It also acts (docs/adr/0044): clients may publish (``clientPublish``) on the topics of
-``LiveViewOptions.client_publish`` (``/goal`` by default: Foxglove's Publish panel or
+the server's ``client_publish`` (``/goal`` by default: Foxglove's Publish panel or
 3D panel sends a goal), in CDR or JSON, each message decoded and checked against the
 topic's type on the server's thread and published from the loop's; and, once
 :meth:`LiveView.serve_parameters` is given the system's actors, read and set
@@ -122,14 +122,15 @@ class LiveView(Actor):
         self,
         server: FoxgloveServer,
         *,
-        depth: int | None = None,
-        period: float | None = None,
+        depth: int = 64,
+        period: float = 0.02,
         name: str = "foxglove",
     ) -> None:
+        """``depth``: messages each topic's tap keeps between two flushes before dropping
+        its oldest; ``period``: s of sim time between flushes (50 Hz at 1x)."""
         super().__init__(name)
         self.server = server
-        self.depth = depth or server.options.depth
-        self.period = period or server.options.period
+        self.depth, self.period = depth, period
         self._topics: dict[str, _TopicState] = {}
         self.sent_bytes = 0
         self._client_publishers: dict[str, Publisher[Any]] = {}
@@ -150,7 +151,7 @@ class LiveView(Actor):
         for topic in list(bus.topics.values()):
             self._tap(topic)
         bus.add_topic_listener(self._tap)
-        for name in self.server.options.client_publish:
+        for name in self.server.client_publish:
             used = bus.topics.get(name)
             if used is None:
                 continue  # nobody uses it in this system: refused when a client sends
@@ -297,14 +298,9 @@ class LiveView(Actor):
         for changes, reply in early:
             self._apply_parameters(changes, reply)
         self.server.client_sink = self._take_client_message
-        options = self.server.options
-        if options.wait_for_subscriber is not None:
-            # A worker thread waits; sim time holds still meanwhile (run_blocking).
-            await run_blocking(
-                self.server.wait_for_subscriptions,
-                options.wait_for_subscriptions,
-                options.wait_for_subscriber,
-            )
+        wait = self.server.config.wait_for_subscriber
+        if wait is not None:  # a worker thread waits; sim time holds still (run_blocking)
+            await run_blocking(self.server.wait_for_subscriptions, self.server.awaited, wait)
 
     async def run(self) -> None:
         rate = self.clock.rate(1.0 / self.period)

@@ -206,7 +206,6 @@ PINNED: dict[str, tuple[str, ...]] = {
         "FoxgloveServer",
         "LiveView",
         "LiveViewError",
-        "LiveViewOptions",
     ),
     "otonav.record.cdr": (
         "ENCAPSULATION",
