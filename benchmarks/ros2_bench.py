@@ -25,9 +25,10 @@ import time
 from pathlib import Path
 
 from otonav.cli.loading import load_scenario
-from otonav.ros2 import Ros2Bridge, Ros2Options
+from otonav.ros2 import Ros2Bridge
 from otonav.scenario import run_scenario
 from otonav.stack import StackConfig
+from otonav.stack.config import Ros2Config
 
 PEER = Path(__file__).resolve().parents[1] / "tests" / "smoke" / "ros2_peer.py"
 
@@ -36,7 +37,7 @@ def _run(kind: str, domain: int, env: dict[str, str], out: Path) -> tuple[float,
     extra: tuple[Ros2Bridge, ...] = ()
     if kind != "off":
         wait = 20.0 if kind == "read" else None
-        bridge = Ros2Bridge(Ros2Options(domain_id=domain, wait_for_peers=wait), env=env)
+        bridge = Ros2Bridge(Ros2Config(domain_id=domain, wait=wait), env=env)
         extra = (bridge,)
     start = time.perf_counter()
     verdict = run_scenario(

@@ -46,11 +46,12 @@ def _env(domain: int) -> dict[str, str]:
 
 
 _BRIDGE_ONLY = (
-    "import dataclasses, json, pathlib, sys; from otonav.ros2 import Ros2Bridge, Ros2Options; "
+    "import dataclasses, json, pathlib, sys; from otonav.ros2 import Ros2Bridge; "
+    "from otonav.stack.config import Ros2Config; "
     "from otonav.scenario import ScenarioConfig, run_scenario; "
     "from otonav.stack import StackConfig; out = pathlib.Path(sys.argv[1]); "
     "v = run_scenario(ScenarioConfig(), StackConfig(), out_dir=out, plot=False, "
-    "extra_actors=(Ros2Bridge(Ros2Options(domain_id=int(sys.argv[2]))),)); "
+    "extra_actors=(Ros2Bridge(Ros2Config(domain_id=int(sys.argv[2]))),)); "
     "(out / 'summary.json').write_text(json.dumps(dataclasses.asdict(v), default=str))"
 )
 """A paced --ros2 run would measure the pacing: the bridge alone runs in virtual time."""

@@ -396,50 +396,53 @@ def _extras(stack: Any) -> Extras:
         raise ConfigFileError(str(exc)) from None
 
 
+_SECTION_FLAGS = {
+    "--foxglove-host": ("foxglove", "host", "foxglove_host"),
+    "--foxglove-port": ("foxglove", "port", "foxglove_port"),
+    "--foxglove-wait": ("foxglove", "wait_for_subscriber", "foxglove_wait"),
+    "--ros2-domain": ("ros2", "domain_id", "ros2_domain"),
+    "--ros2-in": ("ros2", "inputs", "ros2_inputs"),
+    "--lockstep": ("ros2", "lockstep", "lockstep"),
+    "--ros2-wait": ("ros2", "wait", "ros2_wait"),
+}
+"""Each ``--foxglove-*``/``--ros2*`` flag: the config section and field it sets, and its
+argument's dest."""
+
+
 def _with_flags(args: argparse.Namespace, stack: Any) -> Any:
     """The stack config with the ``--foxglove*`` and ``--ros2*`` flags applied to its
     ``foxglove`` and ``ros2`` sections, checked as the config is (one line naming the
     flag and what is valid)."""
     from pydantic import ValidationError
 
-    from otonav.stack.config import FoxgloveConfig
     from otonav.stack.files import ConfigFileError, describe_validation_error
 
-    fox: dict[str, Any] = {
-        key: value
-        for key, value in (
-            ("host", args.foxglove_host),
-            ("port", args.foxglove_port),
-            ("wait_for_subscriber", args.foxglove_wait),
-        )
-        if value is not None
-    }
-    if fox and not (args.foxglove or stack.foxglove.enabled):
-        named = "/".join(f"--foxglove-{k.split('_')[0]}" for k in fox)
-        raise ConfigFileError(f"{named}: only with --foxglove (or foxglove.enabled)")
     update: dict[str, Any] = {}
-    if args.foxglove or fox:
+    for name in ("foxglove", "ros2"):
+        section = getattr(stack, name)
+        given = {
+            flag: getattr(args, dest)
+            for flag, (owner, _field, dest) in _SECTION_FLAGS.items()
+            if owner == name and getattr(args, dest) not in (None, [])
+        }
+        if not (getattr(args, name) or section.enabled):
+            if given:
+                raise ConfigFileError(f"{'/'.join(given)}: only with --{name} (or {name}.enabled)")
+            continue
+        if name == "foxglove" and not (given or args.foxglove):
+            continue
+        fields = {_SECTION_FLAGS[flag][1]: value for flag, value in given.items()}
+        if name == "ros2":
+            fields = _ros2_fields(args, section, fields)
         try:
-            update["foxglove"] = FoxgloveConfig.model_validate(
-                {**stack.foxglove.model_dump(), **fox, "enabled": True}
+            update[name] = type(section).model_validate(
+                {**section.model_dump(), **fields, "enabled": True}
             )
         except ValidationError as exc:
             field = str(exc.errors()[0]["loc"][0]) if exc.errors() else ""
-            flag = f"--foxglove-{field.split('_')[0]}" if field in fox else f"foxglove.{field}"
+            flags = [flag for flag, (o, f, _d) in _SECTION_FLAGS.items() if (o, f) == (name, field)]
+            flag = flags[0] if flags and field in fields else f"{name}.{field}"
             raise ConfigFileError(describe_validation_error(flag, exc)) from None
-    section = stack.ros2
-    if not (args.ros2 or section.enabled):
-        flags = {
-            "--ros2-domain": args.ros2_domain is not None,
-            "--ros2-in": bool(args.ros2_inputs),
-            "--lockstep": args.lockstep is not None,
-            "--ros2-wait": args.ros2_wait is not None,
-        }
-        given = [flag for flag, used in flags.items() if used]
-        if given:
-            raise ConfigFileError(f"{'/'.join(given)}: only with --ros2")
-    else:
-        update["ros2"] = _ros2_section(args, section)
     return stack.model_copy(update=update) if update else stack
 
 
@@ -450,7 +453,7 @@ def _announce(args: argparse.Namespace, extras: Extras) -> None:
     server = extras.foxglove
     if server is not None:
         hint = ""
-        if not (args.realtime or args.gui) and server.options.wait_for_subscriber is None:
+        if not (args.realtime or args.gui) and server.config.wait_for_subscriber is None:
             hint = (
                 "; in virtual time the run may be over before a client connects: --foxglove-wait S"
             )
@@ -464,7 +467,7 @@ def _announce(args: argparse.Namespace, extras: Extras) -> None:
     if bridge is not None:
         options = bridge.options
         if options.lockstep:
-            answers = ", ".join(f"{name} every {period:g} s" for name, period in options.lockstep)
+            answers = ", ".join(f"{a.topic} every {a.period:g} s" for a in options.lockstep)
             timing = f"in lockstep: sim time waits for {answers}"
         else:
             timing = "paced to the wall clock"
@@ -497,66 +500,45 @@ def _serve_parameters(extras: Extras, system: System) -> None:
     )
 
 
-def _ros2_section(args: argparse.Namespace, section: Any) -> Any:
-    """The stack's ``ros2`` section with ``--lockstep`` and ``--ros2-wait`` applied, checked
-    as the config is (one line naming the flag and what is valid)."""
-    from pydantic import ValidationError
+def _ros2_fields(args: argparse.Namespace, section: Any, fields: dict[str, Any]) -> dict[str, Any]:
+    """The ``ros2`` fields the flags set, as the section takes them: ``--lockstep``'s
+    TOPIC:PERIOD parsed, the domain and the inputs checked by the bridge's own rules, and
+    in lockstep a wait for the nodes (not with a paced run)."""
+    from otonav.ros2.naming import Ros2Error, dds_topic, domain_id
+    from otonav.stack.files import ConfigFileError
 
-    from otonav.stack.config import Ros2Config
-    from otonav.stack.files import ConfigFileError, describe_validation_error
-
-    update: dict[str, Any] = {}
-    given = [value for value in args.lockstep or () if value]
-    if given:
-        answers = []
-        for value in given:
-            topic, _, period = value.rpartition(":")
-            try:
-                answers.append({"topic": topic, "period": float(period)})
-            except ValueError:
-                raise ConfigFileError(
-                    f"--lockstep {value}: expected TOPIC:PERIOD, e.g. /cmd_vel_nav:0.05"
-                ) from None
-        update["lockstep"] = tuple(answers)
-    elif args.lockstep is not None and not section.lockstep:
+    given = [value for value in fields.pop("lockstep", ()) if value]
+    answers = []
+    for value in given:
+        topic, _, period = value.rpartition(":")
+        try:
+            answers.append({"topic": topic, "period": float(period)})
+        except ValueError:
+            raise ConfigFileError(
+                f"--lockstep {value}: expected TOPIC:PERIOD, e.g. /cmd_vel_nav:0.05"
+            ) from None
+    if answers:
+        fields["lockstep"] = tuple(answers)
+    if "inputs" in fields:
+        fields["inputs"] = tuple(fields["inputs"])
+    if args.lockstep is not None and not given and not section.lockstep:
         raise ConfigFileError(
             "--lockstep: say what your nodes answer with, e.g. --lockstep /cmd_vel_nav:0.05 "
             "(or ros2.lockstep in the stack config)"
         )
-    if args.ros2_wait is not None:
-        update["wait"] = args.ros2_wait
-    from otonav.ros2.naming import Ros2Error, dds_topic, domain_id
-
     try:  # the flags' own one-line messages (the bridge's checks)
-        if args.ros2_domain is not None:
-            update["domain_id"] = domain_id(args.ros2_domain, {})
-        for topic in args.ros2_inputs or ():
+        if "domain_id" in fields:
+            fields["domain_id"] = domain_id(fields["domain_id"], {})
+        for topic in fields.get("inputs", ()):
             dds_topic(topic)
     except Ros2Error as exc:
         prefix = "" if str(exc).startswith("--") else "--ros2-in "
         raise ConfigFileError(prefix + str(exc)) from None
-    if args.ros2_inputs:
-        update["inputs"] = tuple(args.ros2_inputs)
-    update["enabled"] = True
-    lockstep = update.get("lockstep", section.lockstep)
+    lockstep = fields.get("lockstep", section.lockstep)
     if lockstep and (args.realtime or args.gui or args.scale is not None):
         raise ConfigFileError(
             "--lockstep: not with --realtime, --gui or --scale (sim time follows the nodes)"
         )
-    if lockstep and update.get("wait", section.wait) is None:
-        update["wait"] = 30.0  # a node started a moment later must not miss the start
-    try:
-        return Ros2Config.model_validate({**section.model_dump(), **update})
-    except ValidationError as exc:
-        field = str(exc.errors()[0]["loc"][0]) if exc.errors() else ""
-        flag = _ROS2_FLAGS.get(field, "--ros2") if field in update else f"ros2.{field}"
-        raise ConfigFileError(describe_validation_error(flag, exc)) from None
-
-
-_ROS2_FLAGS = {
-    "lockstep": "--lockstep",
-    "wait": "--ros2-wait",
-    "domain_id": "--ros2-domain",
-    "inputs": "--ros2-in",
-}
-"""The flag that sets each field of the ``ros2`` section, for its one-line error."""
+    if lockstep and fields.get("wait", section.wait) is None:
+        fields["wait"] = 30.0  # a node started a moment later must not miss the start
+    return fields

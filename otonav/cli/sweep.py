@@ -285,20 +285,17 @@ def print_summary(summary: dict[str, Any], console: Console) -> None:
             console.print(f"    repro: {first['repro']}", soft_wrap=True)
 
 
-_PLAN_FLAGS = {"sweep": "SWEEP", **QUICK_FLAGS, "--actor": "actors"}
+_PLAN_FLAGS = {"SWEEP": "sweep", **QUICK_FLAGS, "--actor": "actors"}
 """What makes the plan (stored in sweep.json): the sweep file or the quick-form flags,
 and the launched nodes."""
 
 
 def _invocation(args: argparse.Namespace) -> dict[str, Any]:
     """The arguments that made this sweep's plan, as JSON (paths absolute)."""
-    stored: dict[str, Any] = {}
-    for flag, dest in _PLAN_FLAGS.items():
-        key = "sweep" if flag == "sweep" else dest
-        value = getattr(args, key)
-        if key in ("sweep", "config") and value is not None:
-            value = str(Path(value).resolve())
-        stored[key] = value
+    stored = {dest: getattr(args, dest) for dest in _PLAN_FLAGS.values()}
+    for dest in ("sweep", "config"):
+        if stored[dest] is not None:
+            stored[dest] = str(Path(stored[dest]).resolve())
     return stored
 
 
@@ -320,9 +317,9 @@ def _resume_plan(args: argparse.Namespace) -> None:
             setattr(args, key, Path(value) if key == "sweep" and value else value)
         return
     differ = [
-        f"{flag} (stored {stored.get(key)!r}, given {given[key]!r})"
+        f"{flag} (stored {stored.get(dest)!r}, given {given[dest]!r})"
         for flag, dest in _PLAN_FLAGS.items()
-        if given[(key := "sweep" if flag == "sweep" else dest)] != stored.get(key)
+        if given[dest] != stored.get(dest)
     ]
     if differ:
         raise ConfigFileError(

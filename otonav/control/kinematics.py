@@ -20,24 +20,20 @@ __all__ = (
 )
 
 
-def _require(values: dict[str, float], *, non_negative: bool = False) -> None:
-    """Each value finite (and >= 0), checked in order: a ValueError names the first not."""
-    for name, value in values.items():
+def _require(finite: dict[str, float], non_negative: dict[str, float] | None = None) -> None:
+    """Raise ValueError naming the first value not finite (or negative, of ``non_negative``)."""
+    for name, value in {**finite, **(non_negative or {})}.items():
         if not math.isfinite(value):
             raise ValueError(f"{name} must be finite, got {value!r}")
-        if non_negative and value < 0.0:
+    for name, value in (non_negative or {}).items():
+        if value < 0.0:
             raise ValueError(f"{name} must be >= 0, got {value!r}")
 
 
 @dataclass(frozen=True, slots=True)
 class DiffDriveGeometry:
-    """Geometry of a differential-drive base.
-
-    Attributes:
-        wheel_radius: wheel radius, m (> 0).
-        wheel_separation: distance between the two wheel contact points along the
-            body y axis (track width), m (> 0).
-    """
+    """Geometry of a differential-drive base: ``wheel_radius`` and ``wheel_separation``
+    (the track width: between the two wheel contact points along body y), m, > 0."""
 
     wheel_radius: float
     wheel_separation: float
@@ -51,13 +47,8 @@ class DiffDriveGeometry:
 
 @dataclass(frozen=True, slots=True)
 class Pose2D:
-    """Planar pose of ``base_link`` in the ``odom`` frame.
-
-    Attributes:
-        x: position along odom x, m.
-        y: position along odom y, m.
-        yaw: heading, rad, counter-clockwise from odom x.
-    """
+    """Planar pose of ``base_link`` in the ``odom`` frame: ``x``, ``y`` in m, ``yaw`` in
+    rad counter-clockwise from odom x."""
 
     x: float
     y: float
@@ -65,31 +56,15 @@ class Pose2D:
 
 
 def twist_to_wheels(v: float, omega: float, geom: DiffDriveGeometry) -> tuple[float, float]:
-    """Inverse kinematics: body twist to wheel angular speeds.
-
-    Args:
-        v: forward speed along body x, m/s.
-        omega: yaw rate about body z, rad/s (CCW positive).
-        geom: base geometry.
-
-    Returns:
-        ``(left, right)`` wheel angular speeds, rad/s; positive rolls the robot forward.
-    """
+    """Inverse kinematics: the body twist (``v`` m/s along body x, ``omega`` rad/s CCW)
+    as ``(left, right)`` wheel angular speeds, rad/s; positive rolls the robot forward."""
     half_track = 0.5 * omega * geom.wheel_separation
     return (v - half_track) / geom.wheel_radius, (v + half_track) / geom.wheel_radius
 
 
 def wheels_to_twist(left: float, right: float, geom: DiffDriveGeometry) -> tuple[float, float]:
-    """Forward kinematics: wheel angular speeds to body twist.
-
-    Args:
-        left: left wheel angular speed, rad/s (positive rolls forward).
-        right: right wheel angular speed, rad/s (positive rolls forward).
-        geom: base geometry.
-
-    Returns:
-        ``(v, omega)``: forward speed along body x in m/s and yaw rate in rad/s (CCW).
-    """
+    """Forward kinematics: wheel angular speeds (rad/s, positive rolls forward) as the
+    body twist ``(v, omega)``: m/s along body x, rad/s CCW."""
     r = geom.wheel_radius
     return 0.5 * r * (left + right), r * (right - left) / geom.wheel_separation
 
@@ -103,27 +78,18 @@ def _sinc(x: float) -> float:
 
 
 def integrate_odometry(pose: Pose2D, v: float, omega: float, dt: float) -> Pose2D:
-    """Advance a pose by a constant body twist held for ``dt``.
+    """``pose`` (odom frame) after the body twist ``(v, omega)`` (m/s, rad/s CCW) held
+    for ``dt`` s (>= 0), its yaw wrapped to [-pi, pi]; ValueError if an input is not
+    finite or ``dt`` is negative.
 
     Exact for constant ``(v, omega)``: the robot moves on a circular arc, whose chord
     has length ``v*dt*sinc(omega*dt/2)`` and points along the mid-arc heading
     ``yaw + omega*dt/2``. The chord form has no division by ``omega`` and reduces to a
-    straight line as ``omega -> 0``.
-
-    Args:
-        pose: start pose in the odom frame.
-        v: forward speed along body x, m/s.
-        omega: yaw rate, rad/s (CCW).
-        dt: duration, s (>= 0).
-
-    Returns:
-        The pose after ``dt``, yaw wrapped to [-pi, pi].
-
-    Raises:
-        ValueError: if any input is not finite or ``dt`` is negative.
-    """
-    _require({"pose.x": pose.x, "pose.y": pose.y, "pose.yaw": pose.yaw, "v": v, "omega": omega})
-    _require({"dt": dt}, non_negative=True)
+    straight line as ``omega -> 0``."""
+    _require(
+        {"pose.x": pose.x, "pose.y": pose.y, "pose.yaw": pose.yaw, "v": v, "omega": omega},
+        {"dt": dt},
+    )
     dtheta = omega * dt
     half = 0.5 * dtheta
     chord = v * dt * _sinc(half)
@@ -152,33 +118,21 @@ def limit_twist(
     max_accel: float,
     max_alpha: float,
 ) -> tuple[float, float]:
-    """Clamp a twist command to velocity limits, then to acceleration limits.
-
-    First ``v`` is clamped to ``[-max_v, max_v]`` and ``omega`` to
-    ``[-max_omega, max_omega]``; then each is clamped to within ``max_accel*dt``
-    (resp. ``max_alpha*dt``) of the previous command. If the previous command was
-    within the velocity limits, the result is within both bounds.
-
-    Args:
-        v: requested forward speed, m/s.
-        omega: requested yaw rate, rad/s.
-        prev_v: previously sent forward speed, m/s.
-        prev_omega: previously sent yaw rate, rad/s.
-        dt: time since the previous command, s (>= 0).
-        max_v: speed limit, m/s (>= 0).
-        max_omega: yaw-rate limit, rad/s (>= 0).
-        max_accel: linear acceleration limit, m/s^2 (>= 0).
-        max_alpha: angular acceleration limit, rad/s^2 (>= 0).
-
-    Returns:
-        ``(v, omega)`` limited, m/s and rad/s.
-
-    Raises:
-        ValueError: if an input is not finite or a limit or ``dt`` is negative.
-    """
-    _require({"v": v, "omega": omega, "prev_v": prev_v, "prev_omega": prev_omega})
-    _require({"dt": dt, "max_v": max_v, "max_omega": max_omega}, non_negative=True)
-    _require({"max_accel": max_accel, "max_alpha": max_alpha}, non_negative=True)
+    """The twist ``(v, omega)`` (m/s, rad/s) clamped to the velocity limits ``max_v``,
+    ``max_omega``, then to within ``max_accel*dt`` (resp. ``max_alpha*dt``) of the
+    previous command ``(prev_v, prev_omega)`` sent ``dt`` s ago. If the previous command
+    was within the velocity limits, the result is within both bounds. ValueError if an
+    input is not finite or a limit or ``dt`` is negative."""
+    _require(
+        {"v": v, "omega": omega, "prev_v": prev_v, "prev_omega": prev_omega},
+        {
+            "dt": dt,
+            "max_v": max_v,
+            "max_omega": max_omega,
+            "max_accel": max_accel,
+            "max_alpha": max_alpha,
+        },
+    )
     v = _clamp(v, -max_v, max_v)
     omega = _clamp(omega, -max_omega, max_omega)
     dv = max_accel * dt

@@ -8,26 +8,19 @@ import threading
 import weakref
 from collections.abc import Callable
 from pathlib import Path
-from typing import TypeVar
 
 import anyio
 import anyio.to_thread
 
-from otonav.engine._wait import _wait_done
-from otonav.runtime import (
-    Actor,
-)
+from otonav.engine.live import _wait_done
+from otonav.runtime import Actor
 from otonav.scenario import ScenarioConfig, Verdict, run_scenario
 from otonav.scenario.assembly import scenario_world
 from otonav.stack import StackConfig
 
-_T = TypeVar("_T")
-
 #: Simulations run at once through :func:`run_scenario_async` with the default limiter.
 DEFAULT_MAX_RUNS = 2
 
-
-# -- simulations on request ----------------------------------------------------------------
 
 _limiters: weakref.WeakKeyDictionary[asyncio.AbstractEventLoop, anyio.CapacityLimiter] = (
     weakref.WeakKeyDictionary()

@@ -82,11 +82,10 @@ def open_extras(config: StackConfig) -> Extras:
         if config.foxglove.enabled:
             extras.view = _live_view(config)
         if config.ros2.enabled:
-            from otonav.ros2 import Ros2Error, bridge_for
+            from otonav.ros2 import Ros2Bridge, Ros2Error
 
             try:
-                base = robot_frames(config.robot).base
-                extras.ros2 = bridge_for(config.ros2, base_frame=base)
+                extras.ros2 = Ros2Bridge(config.ros2, base_frame=robot_frames(config.robot).base)
             except Ros2Error as exc:
                 raise ExtrasError(str(exc)) from None
     except BaseException:
@@ -96,13 +95,11 @@ def open_extras(config: StackConfig) -> Extras:
 
 
 def _live_view(config: StackConfig) -> LiveView:
-    from otonav.foxglove import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
+    from otonav.foxglove import LiveView, LiveViewError
 
-    section = config.foxglove
     try:
-        options = LiveViewOptions(
-            host=section.host, port=section.port, wait_for_subscriber=section.wait_for_subscriber
-        )
-        return LiveView(FoxgloveServer(options))
+        from otonav.foxglove import FoxgloveServer
+
+        return LiveView(FoxgloveServer(config.foxglove))
     except LiveViewError as exc:
         raise ExtrasError(str(exc)) from None

@@ -12,8 +12,9 @@ from pathlib import Path
 from types import TracebackType
 from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
+import anyio
+
 from otonav.actors import topics
-from otonav.engine._wait import _wait_done
 from otonav.engine.extras import open_extras
 from otonav.hal import BoxObstacle, RobotHardwareInterface
 from otonav.msgs import Header, Message, Point, Pose, PoseStamped, Time
@@ -50,6 +51,20 @@ M = TypeVar("M")
 HOST_QOS = QoS(Reliability.BEST_EFFORT, depth=10)
 
 _HOST = "host"
+
+
+async def _wait_done(future: asyncio.Future[Any]) -> bool:
+    """Wait until ``future`` is done whatever cancels the caller meanwhile (anyio cancel
+    scopes are shielded, asyncio's ``task.cancel()`` is absorbed). Returns True when the
+    caller was cancelled while waiting; the caller re-raises then."""
+    cancelled = False
+    with anyio.CancelScope(shield=True):
+        while not future.done():
+            try:
+                await asyncio.wait((future,))
+            except asyncio.CancelledError:
+                cancelled = True
+    return cancelled
 
 
 # -- host subscriptions -------------------------------------------------------------------
@@ -155,7 +170,6 @@ class LiveStack:
         self._subscriptions: list[LiveSubscription[Any]] = []
         self._publishers: dict[tuple[str, type[Any], QoS], Publisher[Any]] = {}
         self._closing = False
-        self._closed = False
         self._close_done: asyncio.Future[None] | None = None
         self._failure: BaseException | None = None
         self._started = asyncio.Event()
@@ -309,7 +323,6 @@ class LiveStack:
             if self._task is not None:
                 cancelled = await _wait_done(self._task)
         finally:
-            self._closed = True
             try:
                 self._session.close()
             finally:

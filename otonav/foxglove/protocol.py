@@ -1,14 +1,14 @@
-"""A Foxglove WebSocket server (protocol v1) on ``websockets``, in its own thread.
-
-The only module that imports ``websockets`` (an import-linter contract); the live view
-(:mod:`otonav.foxglove.view`) is its one user.
+"""The Foxglove WebSocket server (protocol v1) on ``websockets``, in its own thread:
+:class:`FoxgloveServer`, which the live view (:mod:`otonav.foxglove.view`) feeds. The only
+module that imports ``websockets`` (an import-linter contract), and only when a server
+starts (``otonav.foxglove.FoxgloveServer`` imports it on first use).
 
 It speaks the part of the protocol a live view needs (docs/adr/0032, 0044):
 ``serverInfo`` with the ``time`` capability, ``advertise`` of channels (topic, ``cdr``
 encoding, ``ros2msg`` schema), ``subscribe``/``unsubscribe`` from clients, binary
-message data and time frames; with ``on_client_message``, ``clientPublish`` (clients
-``advertise`` their own channels and send binary ``clientMessageData``); with
-``parameters``, ``getParameters``/``setParameters`` answered by ``parameterValues``.
+message data and time frames; ``clientPublish`` (clients ``advertise`` their own channels
+and send binary ``clientMessageData``; unless ``client_publish`` is empty);
+``getParameters``/``setParameters`` answered by ``parameterValues``.
 The handshake accepts the protocol under both its names:
 ``foxglove.sdk.v1`` (what foxglove-sdk's servers accept, and current Foxglove apps offer)
 and ``foxglove.websocket.v1`` (the specification's name, which the @foxglove/ws-protocol
@@ -16,7 +16,7 @@ client library, roslibjs-foxglove and Lichtblick before its December 2025 change
 alone); the wire format is the same. foxglove-sdk 0.30.3, which served the live view
 before, accepts only the first: clients that offer only the second got a 400.
 
-Threads: the stack calls :meth:`Channel.log` and :meth:`ProtocolServer.broadcast_time`
+Threads: the stack calls :meth:`Channel.log` and :meth:`FoxgloveServer.broadcast_time`
 from its own thread. Each appends a ready frame to every subscribed client's queue
 under one lock and returns: nothing waits for a socket. The server's thread
 runs an asyncio loop with one writer task per client that sends what is queued. A
@@ -31,7 +31,7 @@ do), so each message is one frame per client whatever a client asks, and one sta
 answers a whole subscribe request; at most :data:`MAX_ADVERTISED` client channels and
 :data:`MAX_CHANGES` parameters per ``setParameters``. A malformed frame (ids that are not
 uint32, a non-object, deep JSON, a binary frame under 5 bytes) is answered by a status and
-reported to ``on_refused``; none ends the connection.
+reported to ``refusal_sink``; none ends the connection.
 """
 
 from __future__ import annotations
@@ -39,6 +39,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import json
+import os
 import struct
 import threading
 from collections import deque
@@ -49,6 +50,12 @@ from typing import Any
 from websockets.asyncio.server import Server, ServerConnection, serve
 from websockets.exceptions import ConnectionClosed
 from websockets.typing import Subprotocol
+
+from otonav.actors import topics
+from otonav.foxglove.errors import LiveViewError
+from otonav.msgs import Message
+from otonav.record.schemas import schema_for
+from otonav.stack.config import FoxgloveConfig
 
 SUBPROTOCOLS = (Subprotocol("foxglove.sdk.v1"), Subprotocol("foxglove.websocket.v1"))
 """What the handshake accepts: the protocol's current name, then its original one."""
@@ -84,23 +91,6 @@ class ClientChannel:
     schema_name: str
 
 
-class Parameters:
-    """What ``getParameters``/``setParameters`` ask (the ``parameters`` capability).
-    Called on the server's thread; :meth:`set` answers later through ``reply``."""
-
-    def get(self, names: list[str]) -> list[dict[str, Any]]:
-        """``[{"name", "value"}]`` of ``names`` (every parameter when empty)."""
-        raise NotImplementedError
-
-    def set(
-        self,
-        changes: list[tuple[str, Any]],
-        reply: Callable[[list[dict[str, Any]], str | None], None],
-    ) -> None:
-        """Apply ``changes``; then ``reply(values, error)`` (error: one line, or None)."""
-        raise NotImplementedError
-
-
 @dataclass(eq=False)
 class _Client:
     id: int
@@ -126,7 +116,7 @@ class Channel:
     __slots__ = ("_id", "_server", "definition", "schema_name", "topic")
 
     def __init__(
-        self, server: ProtocolServer, channel_id: int, topic: str, schema: tuple[str, str]
+        self, server: FoxgloveServer, channel_id: int, topic: str, schema: tuple[str, str]
     ) -> None:
         self._server = server
         self._id = channel_id
@@ -155,70 +145,111 @@ class Channel:
         }
 
 
-class ProtocolServer:
-    """Serves on ``host:port`` (0: any free port) from its own thread once made; raises
-    ``OSError`` when the address cannot be bound. ``on_subscribe(client, channel)`` and
-    ``on_unsubscribe(client, channel)`` are called from the server's thread."""
+class FoxgloveServer:
+    """A Foxglove WebSocket server on ``config.host:config.port`` (the stack config's
+    ``foxglove`` section; port 0: any free one), serving from its own thread once made
+    (:meth:`close` stops it), with ``backlog`` data messages queued per client before its
+    oldest is dropped, and clients publishing on the ``client_publish`` topics (none:
+    they only watch); ``subscriptions``: how many channel subscriptions a
+    ``config.wait_for_subscriber`` waits for. Raises
+    :class:`~otonav.foxglove.LiveViewError` when the address cannot be bound. The live
+    view sets its sinks: ``client_sink(channel, payload)`` takes a client's message (None,
+    or one line why not), ``parameter_sink`` answers ``getParameters``/``setParameters``
+    (``get_parameters(names)``, ``set_parameters(changes, reply)``), ``refusal_sink(source,
+    text)`` hears of malformed frames and disconnected clients; all on the server's thread."""
 
     def __init__(
         self,
-        host: str,
-        port: int,
+        config: FoxgloveConfig | None = None,
         *,
-        name: str,
-        backlog: int,
-        on_subscribe: Callable[[int, int], None] = lambda client, channel: None,
-        on_unsubscribe: Callable[[int, int], None] = lambda client, channel: None,
-        on_client_message: Callable[[ClientChannel, bytes], str | None] | None = None,
-        parameters: Parameters | None = None,
-        on_refused: Callable[[int, str], None] = lambda client, text: None,
+        backlog: int = 256,
+        client_publish: tuple[str, ...] = (topics.GOAL,),
+        subscriptions: int = 1,
     ) -> None:
-        self.name = name
-        self._on_refused = on_refused
-        """``(client, text)``: a frame refused as malformed, or a client disconnected."""
-        self._on_client_message = on_client_message
-        """``(channel, payload) -> None`` taken, or one line why not (sent as a status)."""
-        self._parameters = parameters
-        self.capabilities = ["time"]
-        if on_client_message is not None:
-            self.capabilities.append("clientPublish")
-        if parameters is not None:
-            self.capabilities.append("parameters")
-        self.backlog = backlog
-        self._on_subscribe = on_subscribe
-        self._on_unsubscribe = on_unsubscribe
+        self.config = options = config if config is not None else FoxgloveConfig()
+        self.backlog, self.client_publish, self.awaited = backlog, client_publish, subscriptions
+        self.capabilities = ["time", "clientPublish", "parameters"]
+        if not client_publish:
+            self.capabilities.remove("clientPublish")
+        self.client_sink: Callable[[ClientChannel, bytes], str | None] | None = None
+        self.parameter_sink: Any = None
+        self.refusal_sink: Callable[[str, str], None] = lambda source, text: None
         self._lock = threading.Lock()
+        self._changed = threading.Condition(self._lock)
         self._clients: dict[int, _Client] = {}
         self._channels: dict[int, Channel] = {}
+        self._by_topic: dict[str, Channel] = {}
+        self._latched: dict[int, tuple[bytes, int]] = {}
         self._subscribed_channels: dict[int, int] = {}
         """channel id -> how many subscriptions it has now."""
+        self._subscribed_total = 0
+        self.clients_seen: set[int] = set()
+        """Clients that subscribed to some channel (all so far)."""
         self._next_client = 1
         self._next_channel = 1
         self.dropped = 0
         """Data frames dropped for clients that did not keep up (all clients so far)."""
         self.disconnected = 0
         """Clients the server disconnected for going over a bound (all so far)."""
+        self.closed = False
         self._loop = asyncio.new_event_loop()
         self._server: Server | None = None
         self._ready = threading.Event()
         self._error: BaseException | None = None
         self._thread = threading.Thread(
-            target=self._run, args=(host, port), name="foxglove-server", daemon=True
+            target=self._run,
+            args=(options.host, options.port),
+            name="foxglove-server",
+            daemon=True,
         )
         self._thread.start()
         self._ready.wait()
+        if isinstance(self._error, OSError):
+            self._thread.join()
+            errno = self._error.errno
+            raise LiveViewError(
+                f"foxglove server on {options.host}:{options.port}: cannot start "
+                f"({os.strerror(errno) if errno else self._error}); pick another "
+                "--foxglove-port (0: any free one)"
+            ) from None
         if self._error is not None:
             self._thread.join()
             raise self._error
         assert self._server is not None
         self.port: int = self._server.sockets[0].getsockname()[1]
+        """The bound port (the one picked when ``config.port`` was 0)."""
+
+    @property
+    def url(self) -> str:
+        return f"ws://{self.config.host}:{self.port}"
+
+    @property
+    def subscriptions(self) -> dict[int, set[int]]:
+        """client id -> the channel ids it subscribes to now."""
+        with self._lock:
+            return {
+                c.id: set(c.subscriptions.values())
+                for c in self._clients.values()
+                if c.subscriptions
+            }
+
+    def wait_for_subscriptions(self, count: int = 1, timeout: float | None = None) -> bool:
+        """Block (a thread, never the loop) until clients made ``count`` channel
+        subscriptions in all since the server started; False on timeout."""
+        with self._changed:
+            return self._changed.wait_for(lambda: self._subscribed_total >= count, timeout)
 
     # -- the stack's side (any thread) ---------------------------------------------------
 
-    def channel(self, topic: str, schema: tuple[str, str]) -> Channel:
-        """A new channel, advertised to every client now and to each that connects."""
+    def channel(self, topic: str, msg_type: type[Message]) -> Channel:
+        """The channel of ``topic``, advertised to every client when first made and to
+        each that connects."""
+        channel = self._by_topic.get(topic)
+        if channel is not None:
+            return channel
         with self._lock:
-            channel = Channel(self, self._next_channel, topic, schema)
+            channel = Channel(self, self._next_channel, topic, schema_for(msg_type))
+            self._by_topic[topic] = channel
             self._next_channel += 1
             self._channels[channel.id()] = channel
             message = json.dumps({"op": "advertise", "channels": [channel.advertisement()]})
@@ -226,8 +257,15 @@ class ProtocolServer:
                 self._queue_control(client, message)
         return channel
 
-    def broadcast_time(self, time_ns: int) -> None:
-        frame = _TIME.pack(0x02, time_ns)
+    def latch(self, channel: Channel, data: bytes, log_time: int) -> None:
+        """Remember the newest message of a latched topic, for clients that subscribe later
+        (the protocol has no latching)."""
+        self._latched[channel.id()] = (data, log_time)
+
+    def broadcast_time(self, sim_time: float) -> None:
+        if self.closed:
+            return
+        frame = _TIME.pack(0x02, round(sim_time * 1e9))
         with self._lock:
             for client in self._clients.values():
                 self._queue_data(client, frame)
@@ -242,14 +280,6 @@ class ProtocolServer:
                     self._queue_data(
                         client, _MESSAGE_DATA.pack(0x01, subscription, log_time) + data
                     )
-
-    def send_to(self, client_id: int, channel_id: int, data: bytes, log_time: int) -> None:
-        """Queue one message for one client only (a latched topic's last message)."""
-        with self._lock:
-            client = self._clients.get(client_id)
-            subscription = None if client is None else client.by_channel.get(channel_id)
-            if client is not None and subscription is not None:
-                self._queue_data(client, _MESSAGE_DATA.pack(0x01, subscription, log_time) + data)
 
     def _queue_data(self, client: _Client, frame: bytes) -> None:  # under the lock
         if client.closing is not None:
@@ -285,7 +315,7 @@ class ProtocolServer:
             self._loop.call_soon_threadsafe(self._close_client, client, reason)
 
     def _close_client(self, client: _Client, reason: str) -> None:  # the server's thread
-        self._on_refused(client.id, f"disconnected: {reason}")
+        self.refusal_sink(f"foxglove client {client.id}", f"disconnected: {reason}")
 
         async def close() -> None:
             try:  # a client that does not read may never answer the close: abort it then
@@ -302,6 +332,7 @@ class ProtocolServer:
 
     def close(self) -> None:
         """Disconnect every client and stop the thread. Idempotent."""
+        self.closed = True
         if self._thread.is_alive():
             self._loop.call_soon_threadsafe(self._stop)
             self._thread.join()
@@ -353,10 +384,10 @@ class ProtocolServer:
             self._clients[client.id] = client
             info = {
                 "op": "serverInfo",
-                "name": self.name,
+                "name": "otonav",
                 "capabilities": self.capabilities,
                 # what clients may publish in (clientPublish)
-                "supportedEncodings": ["cdr", "json"] if self._on_client_message else [],
+                "supportedEncodings": ["cdr", "json"] if self.client_publish else [],
                 "metadata": {},
             }
             self._queue_control(client, json.dumps(info))
@@ -372,11 +403,8 @@ class ProtocolServer:
             writer.cancel()
             with self._lock:
                 del self._clients[client.id]
-                gone = list(client.subscriptions.values())
-                for channel_id in gone:
+                for channel_id in client.subscriptions.values():
                     self._unsubscribed(channel_id)
-            for channel_id in gone:
-                self._on_unsubscribe(client.id, channel_id)
 
     async def _write(self, client: _Client) -> None:
         lock, connection = self._lock, client.connection
@@ -412,9 +440,9 @@ class ProtocolServer:
             if not isinstance(message, dict):
                 raise TypeError(f"expected a JSON object, not {type(message).__name__}")
             op = message["op"]
-            if op in ("advertise", "unadvertise") and self._on_client_message is not None:
+            if op in ("advertise", "unadvertise") and self.client_publish:
                 self._client_advertise(client, op, message)
-            elif op in ("getParameters", "setParameters") and self._parameters is not None:
+            elif op in ("getParameters", "setParameters"):
                 self._parameter_op(client, op, message)
             elif op == "subscribe":
                 self._subscribe_all(client, _list(message, "subscriptions"))
@@ -426,7 +454,7 @@ class ProtocolServer:
         except (ValueError, KeyError, TypeError, AttributeError, RecursionError) as exc:
             text = f"bad message ({type(exc).__name__}: {exc})"
             self._status(client, 2, text)
-            self._on_refused(client.id, text[:MAX_STATUS_CHARS])
+            self.refusal_sink(f"foxglove client {client.id}", text[:MAX_STATUS_CHARS])
 
     def _client_advertise(self, client: _Client, op: str, message: dict[str, Any]) -> None:
         if op == "unadvertise":
@@ -455,15 +483,20 @@ class ProtocolServer:
             )
         opcode, channel_id = _CLIENT_DATA.unpack_from(raw)
         channel = client.advertised.get(channel_id)
-        if opcode != 0x01 or channel is None or self._on_client_message is None:
+        if opcode != 0x01 or channel is None or not self.client_publish:
             self._status(client, 2, f"client message on unadvertised channel {channel_id}")
             return
-        problem = self._on_client_message(channel, raw[_CLIENT_DATA.size :])
+        sink = self.client_sink
+        problem = (
+            f"{channel.topic}: not taken yet (the stack is starting)"
+            if sink is None
+            else sink(channel, raw[_CLIENT_DATA.size :])
+        )
         if problem is not None:
             self._status(client, 2, problem)
 
     def _parameter_op(self, client: _Client, op: str, message: dict[str, Any]) -> None:
-        assert self._parameters is not None
+        sink = self.parameter_sink
         request_id = message.get("id")
 
         def reply(values: list[dict[str, Any]], error: str | None) -> None:
@@ -478,13 +511,16 @@ class ProtocolServer:
 
         if op == "getParameters":
             names = [_text(n, "parameter name") for n in _list(message, "parameterNames")]
-            reply(self._parameters.get(names), None)
+            reply([] if sink is None else list(sink.get_parameters(names)), None)
         else:
             asked = _list(message, "parameters")
             if len(asked) > MAX_CHANGES:  # each is applied on the stack's thread
                 raise ValueError(f"{len(asked)} parameters in one request: at most {MAX_CHANGES}")
             changes = [(_text(p["name"], "parameter name"), p.get("value")) for p in asked]
-            self._parameters.set(changes, reply)
+            if sink is None:
+                reply([], "parameters: not served yet (the stack is starting)")
+            else:
+                sink.set_parameters(changes, reply)
 
     def _subscribe_all(self, client: _Client, subscriptions: list[Any]) -> None:
         """Subscribe to each ``{"id", "channelId"}``: one subscription per channel (as
@@ -495,7 +531,6 @@ class ProtocolServer:
             for sub in subscriptions
         ]  # all checked before any is taken
         problems: list[str] = []
-        taken: list[int] = []
         with self._lock:
             for sub_id, channel_id in asked:
                 problem = (
@@ -515,13 +550,17 @@ class ProtocolServer:
                 self._subscribed_channels[channel_id] = (
                     self._subscribed_channels.get(channel_id, 0) + 1
                 )
-                taken.append(channel_id)
+                self.clients_seen.add(client.id)
+                self._subscribed_total += 1
+                self._changed.notify_all()
+                latched = self._latched.get(channel_id)
+                if latched is not None:  # a latched topic's newest message, to this client
+                    data, log_time = latched
+                    self._queue_data(client, _MESSAGE_DATA.pack(0x01, sub_id, log_time) + data)
             if problems:
                 more = f" and {len(problems) - 3} more" if len(problems) > 3 else ""
                 text = f"subscriptions refused: {'; '.join(problems[:3])}{more}"
                 self._queue_control(client, _status(2, text))
-        for channel_id in taken:
-            self._on_subscribe(client.id, channel_id)
 
     def _unsubscribe(self, client: _Client, sub_id: int) -> None:
         with self._lock:
@@ -530,7 +569,6 @@ class ProtocolServer:
                 return
             del client.by_channel[channel_id]
             self._unsubscribed(channel_id)
-        self._on_unsubscribe(client.id, channel_id)
 
     def _unsubscribed(self, channel_id: int) -> None:  # under the lock
         left = self._subscribed_channels[channel_id] - 1

@@ -18,7 +18,7 @@ Two parts (docs/adr/0031-live-view-over-foxglove-sdk.md, amended by 0032):
   again to each client that subscribes to them, since the protocol has no latching.
 
 It also acts (docs/adr/0044): clients may publish (``clientPublish``) on the topics of
-``LiveViewOptions.client_publish`` (``/goal`` by default: Foxglove's Publish panel or
+the server's ``client_publish`` (``/goal`` by default: Foxglove's Publish panel or
 3D panel sends a goal), in CDR or JSON, each message decoded and checked against the
 topic's type on the server's thread and published from the loop's; and, once
 :meth:`LiveView.serve_parameters` is given the system's actors, read and set
@@ -30,13 +30,11 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
-import math
-import os
 import threading
 from collections import deque
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import anyio
 from pydantic import ValidationError
@@ -44,189 +42,13 @@ from pydantic import ValidationError
 from otonav.actors import topics
 from otonav.msgs import Log, Message, Time
 from otonav.record.cdr import decode, encode
-from otonav.record.schemas import schema_for
 from otonav.runtime import Actor, Bus, Durability, Output, QoS, Reliability, run_blocking
 from otonav.runtime.mailbox import Endpoint, Publisher, Subscription, Topic
 from otonav.stack.door import Refusals, refusal
 from otonav.stack.live_parameters import ActorParameters, ParameterError
 
-DEFAULT_HOST = "127.0.0.1"
-DEFAULT_PORT = 8765
-
-
-class LiveViewError(ValueError):
-    """The live view cannot start: one line saying why and what to do."""
-
-
-@dataclass(frozen=True, slots=True)
-class LiveViewOptions:
-    """Where to serve and how much to buffer."""
-
-    host: str = DEFAULT_HOST
-    """Interface to bind: loopback unless asked (``0.0.0.0`` serves every interface)."""
-    port: int = DEFAULT_PORT
-    """TCP port (Foxglove's convention, 8765); 0 picks a free one."""
-    backlog: int = 256
-    """Messages the server queues per client before dropping its oldest."""
-    depth: int = 64
-    """Messages each topic's tap keeps between two flushes before dropping its oldest."""
-    period: float = 0.02
-    """Seconds of sim time between flushes (50 Hz at 1x)."""
-    wait_for_subscriber: float | None = None
-    """Hold sim time at the start until a client subscribes, for at most this many
-    wall seconds (None: do not wait). Sim time does not move while it waits."""
-    wait_for_subscriptions: int = 1
-    """With ``wait_for_subscriber``: how many channel subscriptions to wait for."""
-    client_publish: tuple[str, ...] = (topics.GOAL,)
-    """Topics clients may publish on (``clientPublish``); empty: clients only watch."""
-
-    def __post_init__(self) -> None:
-        if not 0 <= self.port <= 65535:
-            raise LiveViewError(f"foxglove port {self.port}: must be 0..65535 (0: any free)")
-        if self.backlog < 1 or self.depth < 1:
-            raise LiveViewError("foxglove backlog and depth must be >= 1 message")
-        if not (self.period > 0 and math.isfinite(self.period)):
-            raise LiveViewError(f"foxglove period {self.period}: must be > 0 s of sim time")
-        wait = self.wait_for_subscriber
-        if wait is not None and not (wait > 0 and math.isfinite(wait)):
-            raise LiveViewError(f"--foxglove-wait {wait}: must be a number of seconds > 0")
-
-
-class FoxgloveServer:
-    """A Foxglove WebSocket server on ``options.host:options.port`` (started here;
-    :meth:`close` stops it). Raises :class:`LiveViewError` when the extra is not
-    installed or the address cannot be bound."""
-
-    def __init__(self, options: LiveViewOptions = LiveViewOptions()) -> None:
-        try:
-            from otonav.foxglove.protocol import Parameters, ProtocolServer
-        except ImportError:
-            raise LiveViewError(
-                "--foxglove needs the foxglove extra: pip install 'otonav[foxglove]'"
-            ) from None
-        self.options = options
-        self._lock = threading.Lock()
-        self._channels: dict[str, Any] = {}
-        self._latched: dict[int, tuple[bytes, int]] = {}
-        self.subscriptions: dict[int, set[int]] = {}
-        """client id -> channel ids it subscribes to."""
-        self.clients_seen: set[int] = set()
-        self._changed = threading.Condition(self._lock)
-        self._subscribed_total = 0
-        self.client_sink: Callable[[Any, bytes], str | None] | None = None
-        """Where client messages go (the live view sets it once wired)."""
-        self.parameter_sink: Any = None
-        """Who answers parameter requests (the live view, once given the actors)."""
-        self.refusal_sink: Callable[[str, str], None] = lambda source, text: None
-        """Told of malformed frames and disconnected clients (the live view counts them)."""
-        outer = self
-
-        class _Parameters(Parameters):
-            def get(self, names: list[str]) -> list[dict[str, Any]]:
-                sink = outer.parameter_sink
-                return [] if sink is None else list(sink.get_parameters(names))
-
-            def set(self, changes: list[tuple[str, Any]], reply: Any) -> None:
-                sink = outer.parameter_sink
-                if sink is None:
-                    reply([], "parameters: not served yet (the stack is starting)")
-                else:
-                    sink.set_parameters(changes, reply)
-
-        try:
-            self._server = ProtocolServer(
-                options.host,
-                options.port,
-                name="otonav",
-                backlog=options.backlog,
-                on_subscribe=self._subscribed,
-                on_unsubscribe=self._unsubscribed,
-                on_client_message=self._client_message if options.client_publish else None,
-                parameters=_Parameters(),
-                on_refused=lambda client, text: self.refusal_sink(
-                    f"foxglove client {client}", text
-                ),
-            )
-        except OSError as exc:
-            raise LiveViewError(
-                f"foxglove server on {options.host}:{options.port}: cannot start "
-                f"({os.strerror(exc.errno) if exc.errno else exc}); pick another "
-                "--foxglove-port (0: any free one)"
-            ) from None
-        self.closed = False
-
-    @property
-    def port(self) -> int:
-        """The bound port (the one picked when ``options.port`` was 0)."""
-        return self._server.port
-
-    @property
-    def url(self) -> str:
-        return f"ws://{self.options.host}:{self.port}"
-
-    @property
-    def dropped(self) -> int:
-        """Messages dropped for clients that did not keep up (their backlog was full)."""
-        return self._server.dropped
-
-    @property
-    def disconnected(self) -> int:
-        """Clients disconnected for going over a bound (unread replies)."""
-        return self._server.disconnected
-
-    def channel(self, topic: str, msg_type: type[Message]) -> Any:
-        """The channel of ``topic`` (advertised to clients when first made)."""
-        channel = self._channels.get(topic)
-        if channel is None:
-            channel = self._server.channel(topic, schema_for(msg_type))
-            self._channels[topic] = channel
-        return channel
-
-    def latch(self, channel: Any, data: bytes, log_time: int) -> None:
-        """Remember the newest message of a latched topic, for clients that subscribe later."""
-        self._latched[int(channel.id())] = (data, log_time)
-
-    def broadcast_time(self, sim_time: float) -> None:
-        if not self.closed:
-            self._server.broadcast_time(round(sim_time * 1e9))
-
-    def _subscribed(self, client: int, channel_id: int) -> None:
-        with self._lock:
-            self.clients_seen.add(client)
-            self.subscriptions.setdefault(client, set()).add(channel_id)
-            self._subscribed_total += 1
-            self._changed.notify_all()
-        latched = self._latched.get(channel_id)
-        if latched is not None:  # the protocol has no latching: send it to this client
-            self._server.send_to(client, channel_id, *latched)
-
-    def wait_for_subscriptions(self, count: int = 1, timeout: float | None = None) -> bool:
-        """Block (a thread, never the loop) until clients made ``count`` channel
-        subscriptions in all since the server started; False on timeout."""
-        with self._changed:
-            return self._changed.wait_for(lambda: self._subscribed_total >= count, timeout)
-
-    def _client_message(self, channel: Any, payload: bytes) -> str | None:
-        sink = self.client_sink
-        if sink is None:
-            return f"{channel.topic}: not taken yet (the stack is starting)"
-        return sink(channel, payload)
-
-    def _unsubscribed(self, client: int, channel_id: int) -> None:
-        with self._lock:
-            channels = self.subscriptions.get(client)
-            if channels is not None:
-                channels.discard(channel_id)
-                if not channels:
-                    del self.subscriptions[client]
-
-    def close(self) -> None:
-        """Stop serving (clients are disconnected). Idempotent."""
-        if self.closed:
-            return
-        self.closed = True
-        self._server.close()
-
+if TYPE_CHECKING:
+    from otonav.foxglove.protocol import FoxgloveServer
 
 _EARLY_CHANGES = 64
 """``setParameters`` requests kept while the stack starts (applied as it does)."""
@@ -289,7 +111,6 @@ class _TopicState:
     channel: Any
     latched: bool
     sent: int = 0
-    sent_bytes: int = 0
 
 
 class LiveView(Actor):
@@ -301,14 +122,15 @@ class LiveView(Actor):
         self,
         server: FoxgloveServer,
         *,
-        depth: int | None = None,
-        period: float | None = None,
+        depth: int = 64,
+        period: float = 0.02,
         name: str = "foxglove",
     ) -> None:
+        """``depth``: messages each topic's tap keeps between two flushes before dropping
+        its oldest; ``period``: s of sim time between flushes (50 Hz at 1x)."""
         super().__init__(name)
         self.server = server
-        self.depth = depth or server.options.depth
-        self.period = period or server.options.period
+        self.depth, self.period = depth, period
         self._topics: dict[str, _TopicState] = {}
         self.sent_bytes = 0
         self._client_publishers: dict[str, Publisher[Any]] = {}
@@ -329,7 +151,7 @@ class LiveView(Actor):
         for topic in list(bus.topics.values()):
             self._tap(topic)
         bus.add_topic_listener(self._tap)
-        for name in self.server.options.client_publish:
+        for name in self.server.client_publish:
             used = bus.topics.get(name)
             if used is None:
                 continue  # nobody uses it in this system: refused when a client sends
@@ -476,14 +298,9 @@ class LiveView(Actor):
         for changes, reply in early:
             self._apply_parameters(changes, reply)
         self.server.client_sink = self._take_client_message
-        options = self.server.options
-        if options.wait_for_subscriber is not None:
-            # A worker thread waits; sim time holds still meanwhile (run_blocking).
-            await run_blocking(
-                self.server.wait_for_subscriptions,
-                options.wait_for_subscriptions,
-                options.wait_for_subscriber,
-            )
+        wait = self.server.config.wait_for_subscriber
+        if wait is not None:  # a worker thread waits; sim time holds still (run_blocking)
+            await run_blocking(self.server.wait_for_subscriptions, self.server.awaited, wait)
 
     async def run(self) -> None:
         rate = self.clock.rate(1.0 / self.period)
@@ -513,7 +330,6 @@ class LiveView(Actor):
                 stamp = round(instant * 1e9)
                 channel.log(data, log_time=stamp)
                 state.sent += 1
-                state.sent_bytes += len(data)
                 self.sent_bytes += len(data)
                 if state.latched:
                     server.latch(channel, data, stamp)

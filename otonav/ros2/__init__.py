@@ -3,7 +3,7 @@
 (:mod:`otonav.ros2.naming`), and the one module that imports cyclonedds
 (:mod:`otonav.ros2.dds`, imported only when a bridge is made). docs/adr/0047."""
 
-from otonav.ros2.bridge import Ros2Bridge, Ros2Options, Ros2Statistics, bridge_for
+from otonav.ros2.bridge import Ros2Bridge, Ros2Statistics
 from otonav.ros2.naming import Ros2Error
 
-__all__ = ("Ros2Bridge", "Ros2Error", "Ros2Options", "Ros2Statistics", "bridge_for")
+__all__ = ("Ros2Bridge", "Ros2Error", "Ros2Statistics")

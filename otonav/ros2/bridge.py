@@ -1,13 +1,13 @@
 """The ROS 2 bridge: otonav's topics on DDS as a ROS 2 node on Cyclone DDS has them.
 
-Out: every topic of the system (or ``Ros2Options.outputs``) is mirrored on its DDS topic
+Out: every topic of the system is mirrored on its DDS topic
 (``/odom`` -> ``rt/odom``, type ``nav_msgs::msg::dds_::Odometry_``, QoS as the topic's
 publishers offer it, mapped as rmw_cyclonedds maps it: :mod:`otonav.ros2.naming`). A
 mirror is a mailbox that writes as the message is published: the CDR encoding of the
 recordings, handed to Cyclone, no copy through a queue. A topic nobody on DDS reads is
 not even encoded (latched ones are, for readers that come later).
 
-In: ``Ros2Options.inputs`` (``/goal`` by default; add ``/cmd_vel_nav`` or ``/cmd_vel``
+In: the section's ``inputs`` (``/goal`` by default; add ``/cmd_vel_nav`` or ``/cmd_vel``
 to drive the robot from your own nodes) are read from DDS every ``period`` s of sim time,
 decoded and published on the bus by a publisher of the bridge's own, with the QoS the
 topic's publishers offer (a latched /goal stays latched). The DDS reader requests what a
@@ -15,11 +15,11 @@ ROS 2 publisher offers by default (reliable, volatile), so ``ros2 topic pub`` an
 match it; a best-effort publisher does not (ROS 2's rule).
 
 Time: the bridge works on either loop; ``otonav run --ros2`` paces it to the wall clock
-(docs/adr/0047). With ``wait_for_peers`` (``--ros2-wait``) the start holds sim time until
+(docs/adr/0047). With ``wait`` (``--ros2-wait``) the start holds sim time until
 DDS peers are matched, so neither a virtual-time run (a test) nor a node started a
 moment later races past them.
 
-Lockstep (``Ros2Options.lockstep``, virtual time only; docs/adr/0065): ROS 2 nodes run
+Lockstep (the section's ``lockstep``, virtual time only; docs/adr/0065): ROS 2 nodes run
 in otonav's time, as fast as they can follow. /clock is written to DDS last at each
 instant, once every other actor has published what it had for that instant (the loop's
 idle watcher); at each instant where a declared answer is due (``period`` multiples),
@@ -31,10 +31,9 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
-import math
 import os
 import re
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, NamedTuple
 
@@ -66,70 +65,18 @@ from otonav.ros2.naming import (
 from otonav.ros2.parameters import rclpy_available
 from otonav.runtime import Actor, Bus, Durability, Output, QoS, Reliability, run_blocking
 from otonav.runtime.mailbox import Endpoint, Publisher, Subscription, Topic
+from otonav.stack.config import Ros2Config
 from otonav.stack.door import Refusals, refusal
 
 if TYPE_CHECKING:
     from otonav.ros2.dds import GraphWriter, Participant, RawReader, RawWriter
     from otonav.ros2.parameters import ParameterNodes
-    from otonav.stack.config import Ros2Config
 
-__all__ = ("LockstepTimeout", "Ros2Bridge", "Ros2Options", "Ros2Statistics", "bridge_for")
+__all__ = ("LockstepTimeout", "Ros2Bridge", "Ros2Statistics")
 
 
 class LockstepTimeout(RuntimeError):
     """A ROS 2 node did not answer within ``lockstep_timeout``: the run fails with it."""
-
-
-@dataclass(frozen=True, slots=True)
-class Ros2Options:
-    """What the bridge mirrors and takes, and on which DDS domain."""
-
-    domain_id: int | None = None
-    """DDS domain, 0..232 (None: ``ROS_DOMAIN_ID``, else 0)."""
-    inputs: tuple[str, ...] = (topics.GOAL,)
-    """Topics ROS 2 nodes may publish into the stack."""
-    outputs: tuple[str, ...] | None = None
-    """Topics mirrored out (None: every topic of the system)."""
-    period: float = 0.01
-    """s of sim time between two reads of the inputs."""
-    wait_for_peers: float | None = None
-    """Hold sim time at the start until a ROS 2 node subscribed to an output or publishes
-    an input (in lockstep: every answer has a publisher and /clock a subscriber), then
-    until no endpoint matched for 0.5 s (discovery settled), for at most this many wall
-    seconds each (None: do not wait)."""
-    lockstep: tuple[tuple[str, float], ...] = ()
-    """(topic, period): the answers of ROS 2 nodes in lockstep (empty: no lockstep)."""
-    lockstep_timeout: float = 5.0
-    """Wall seconds a node may take to answer in lockstep."""
-    twist_stamped: bool = False
-    """Twist topics (/cmd_vel, /cmd_vel_nav) are geometry_msgs/TwistStamped on DDS, in
-    and out (Jazzy's diff_drive_controller's default); otonav's own stay Twist."""
-    base_frame: str = "base_link"
-    """The frame a stamped Twist going out says (the robot's ``robot.frames.base``)."""
-
-    def __post_init__(self) -> None:
-        if not (self.period > 0 and math.isfinite(self.period)):
-            raise Ros2Error(f"ros2.period {self.period}: must be > 0 s of sim time")
-        wait = self.wait_for_peers
-        if wait is not None and not (wait > 0 and math.isfinite(wait)):
-            raise Ros2Error(f"--ros2-wait {wait}: must be a number of seconds > 0")
-        for key, names in (("--ros2-in", self.inputs), ("ros2 outputs", self.outputs or ())):
-            for name in names:
-                try:
-                    dds_topic(name)
-                except Ros2Error as exc:
-                    raise Ros2Error(f"{key} {exc}") from None
-        for name, period in self.lockstep:
-            if name not in self.inputs:
-                raise Ros2Error(
-                    f"ros2.lockstep {name}: not an input of the bridge, so no node can answer "
-                    f"on it; add --ros2-in {name} (inputs: {', '.join(self.inputs)})"
-                )
-            if not (period > 0 and math.isfinite(period)):
-                raise Ros2Error(f"ros2.lockstep {name}: period {period}: must be > 0 s")
-        timeout = self.lockstep_timeout
-        if not (timeout > 0 and math.isfinite(timeout)):
-            raise Ros2Error(f"ros2.lockstep_timeout {timeout}: must be a number of seconds > 0")
 
 
 class Ros2Statistics(NamedTuple):
@@ -238,14 +185,30 @@ class Ros2Bridge(Actor):
 
     def __init__(
         self,
-        options: Ros2Options = Ros2Options(),
+        options: Ros2Config | None = None,
         *,
+        base_frame: str = "base_link",
+        period: float = 0.01,
         env: Mapping[str, str] | None = None,
         name: str = "ros2",
     ) -> None:
+        """The bridge the stack config's ``ros2`` section asks for (``enabled`` aside);
+        ``base_frame``: what a stamped Twist going out says (``robot.frames.base``);
+        ``period``: s of sim time between two reads of the inputs. With ``wait``, sim time
+        holds at the start until a ROS 2 node subscribed to an output or publishes an input
+        (in lockstep: every answer has a publisher and /clock a subscriber), then until no
+        endpoint matched for 0.5 s (discovery settled), at most ``wait`` wall s each."""
         super().__init__(name)
         env = os.environ if env is None else env
-        self.options = options
+        self.options = options = options if options is not None else Ros2Config()
+        for answer in options.lockstep:
+            if answer.topic not in options.inputs:
+                raise Ros2Error(
+                    f"ros2.lockstep {answer.topic}: not an input of the bridge, so no node can "
+                    f"answer on it; add --ros2-in {answer.topic} (inputs: "
+                    f"{', '.join(options.inputs)})"
+                )
+        self.base_frame, self.period = base_frame, period
         self.domain_id = domain_id(options.domain_id, env)
         self.discovery: Discovery = discovery(env, lockstep=bool(options.lockstep))
         try:
@@ -304,13 +267,12 @@ class Ros2Bridge(Actor):
                 raise Ros2Error("ros2.lockstep: the system publishes no /clock to step by")
             clock.deferred = True  # written last at each instant: _settled
             self._clock_mirror = clock
-        if self.options.wait_for_peers is not None:
+        if self.options.wait is not None:
             self._open_endpoints()
-            self._wait_for_peers(self.options.wait_for_peers)
+            self._wait_for_peers(self.options.wait)
 
     def _mirror(self, topic: Topic[Any]) -> None:
-        outputs = self.options.outputs
-        if topic.name in self._mirrors or (outputs is not None and topic.name not in outputs):
+        if topic.name in self._mirrors:
             return
         mirror = _Mirror(topic, Endpoint(self.name, f"out{topic.name}"))
         topic.subscriptions.append(mirror)
@@ -327,10 +289,10 @@ class Ros2Bridge(Actor):
             return
         self._open_writer(topic, mirror)
         self._announce()
-        if self.options.lockstep and self.options.wait_for_peers is not None:
+        if self.options.lockstep and self.options.wait is not None:
             # The nodes' readers match it a moment later; in lockstep sim time holds
             # until they did (the loop is held: nothing else may move meanwhile).
-            self.participant.wait_quiet(_DISCOVERY_QUIET, self.options.wait_for_peers)
+            self.participant.wait_quiet(_DISCOVERY_QUIET, self.options.wait)
 
     def _wire_type(self, msg_type: type[Message]) -> type[Message]:
         """The type a topic has on DDS: TwistStamped for a Twist with ``twist_stamped``."""
@@ -339,7 +301,7 @@ class Ros2Bridge(Actor):
     def _stamped(self, twist: Twist) -> TwistStamped:
         clock = self._otonav_clock
         now = clock.now() if clock is not None else 0.0
-        header = Header(stamp=Time.from_seconds(now), frame_id=self.options.base_frame)
+        header = Header(stamp=Time.from_seconds(now), frame_id=self.base_frame)
         return TwistStamped(header=header, twist=twist)
 
     def _open_writer(self, topic: Topic[Any], mirror: _Mirror) -> None:
@@ -484,7 +446,7 @@ class Ros2Bridge(Actor):
                     "ros2.lockstep: needs the virtual-time loop (not with --realtime or --gui)"
                 )
             self._remove_watcher = add_watcher(self._settled)
-            wait = self.options.wait_for_peers
+            wait = self.options.wait
             if wait is not None and not self._unmatched:
                 # Writers made just now (the scenario's latched /goal, whose publisher
                 # did not exist while wiring) match the node's readers a moment later:
@@ -494,7 +456,7 @@ class Ros2Bridge(Actor):
 
     def _peers_matched(self) -> bool:
         if self.options.lockstep:
-            answers = {name for name, _period in self.options.lockstep}
+            answers = {answer.topic for answer in self.options.lockstep}
             clock = self._clock_mirror
             writer = clock.writer if clock is not None else None
             return all(
@@ -511,7 +473,7 @@ class Ros2Bridge(Actor):
     async def run(self) -> None:
         if self.options.lockstep:
             await self._run_lockstep()
-        rate = self.clock.rate(1.0 / self.options.period)
+        rate = self.clock.rate(1.0 / self.period)
         while True:
             await rate.sleep()
             self.take_inputs()
@@ -559,8 +521,8 @@ class Ros2Bridge(Actor):
     async def _run_lockstep(self) -> None:
         clock = self.clock
         entries = [
-            (next(e for e in self._inputs if e.name == name), period)
-            for name, period in self.options.lockstep
+            (next(e for e in self._inputs if e.name == answer.topic), answer.period)
+            for answer in self.options.lockstep
         ]
         counts = [0] * len(entries)
         timeout = self.options.lockstep_timeout
@@ -660,25 +622,3 @@ def _node_name(actor: str) -> str:
     """A ROS 2 node name for an actor (letters, digits and underscores, not a digit first)."""
     name = re.sub(r"[^A-Za-z0-9_]", "_", actor)
     return name if name and not name[0].isdigit() else f"_{name}"
-
-
-def bridge_for(
-    section: Ros2Config,
-    *,
-    domain_id: int | None = None,
-    inputs: Sequence[str] = (),
-    env: Mapping[str, str] | None = None,
-    base_frame: str = "base_link",
-) -> Ros2Bridge:
-    """The bridge the stack config's ``ros2`` section asks for (``domain_id`` and
-    ``inputs`` override it: the CLI's flags). The one way every surface makes it."""
-    options = Ros2Options(
-        domain_id=domain_id if domain_id is not None else section.domain_id,
-        inputs=tuple(inputs or section.inputs),
-        wait_for_peers=section.wait,
-        lockstep=tuple((answer.topic, answer.period) for answer in section.lockstep),
-        lockstep_timeout=section.lockstep_timeout,
-        twist_stamped=section.twist_stamped,
-        base_frame=base_frame,
-    )
-    return Ros2Bridge(options, env=env)

@@ -71,6 +71,8 @@ LOCALHOST_CONFIG: Final = (
 """rmw_cyclonedds_cpp's configuration for ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``,
 on the loopback interface, with Fast DDS's type information ignored."""
 NETWORK_CONFIG: Final = f"<CycloneDDS><Domain>{_FAST_DDS_TYPES}</Domain></CycloneDDS>"
+"""Cyclone's defaults (multicast on its interfaces), with Fast DDS's type information
+ignored."""
 LOCKSTEP_CONFIG: Final = (
     "<CycloneDDS><Domain><Internal>"
     '<HeartbeatInterval min="1ms" minsched="1ms">1ms</HeartbeatInterval>'
@@ -79,8 +81,6 @@ LOCKSTEP_CONFIG: Final = (
 """In lockstep, a writer's heartbeat every 1 ms instead of 100: the bridge waits for the
 node's acknowledgement of /odom before each /clock it answers (docs/adr/0065), and a
 reader acknowledges only when a heartbeat asks."""
-"""Cyclone's defaults (multicast on its interfaces), with Fast DDS's type information
-ignored."""
 
 
 class Ros2Error(UsageError):

@@ -72,7 +72,7 @@ def play(
     path = Path(recording)
     summary = summarize(path)  # one line for a file that is not a readable recording
     if summary.truncated:
-        raise RecordingError(f"{path}: not finished (no index); `otonav inspect` salvages it")
+        raise RecordingError(f"{path}: not finished (no index); `otonav salvage` indexes it")
     where = discovery(env)
     dds_domain = domain_id(domain, env)
     from otonav.ros2.dds import Participant

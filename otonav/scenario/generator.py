@@ -371,31 +371,42 @@ def generate_world(seed: int, params: WorldParams = SPARSE) -> GeneratedWorld:
         if open_path is not None or not p.resample_unreachable or attempts >= p.max_attempts:
             break
     reachable = open_path is not None and not p.walled_in
-    budget = budget_for(
-        open_path.length_m
-        if open_path is not None
-        else math.dist(start[:2], goal) * 2,  # no path at all: twice the straight line
-        p,
-    )
+    boxes = (*walls, *clutter, *ring)
+    return make_world(p, seed, boxes, start, goal, open_path, reachable, attempts)
+
+
+def make_world(
+    params: WorldParams,
+    seed: int,
+    obstacles: tuple[BoxSpec, ...],
+    start: tuple[float, float, float],
+    goal: tuple[float, float],
+    path: GridPath | None,
+    reachable: bool,
+    attempts: int,
+) -> GeneratedWorld:
+    """The world's scenario and labels; its budget from ``path`` (no path at all:
+    twice the straight line)."""
+    length = path.length_m if path is not None else None
     scenario = ScenarioConfig(
-        name=f"{p.name}-{seed}",
+        name=f"{params.name}-{seed}",
         scene="empty",
-        obstacles=tuple([*walls, *clutter, *ring]),
+        obstacles=obstacles,
         start=StartSpec(x=start[0], y=start[1], yaw=start[2]),
         goal=GoalSpec(x=goal[0], y=goal[1]),
-        goal_tolerance=p.goal_tolerance,
-        sim_budget=budget,
-        min_clearance=p.clearance,
+        goal_tolerance=params.goal_tolerance,
+        sim_budget=budget_for(math.dist(start[:2], goal) * 2 if length is None else length, params),
+        min_clearance=params.clearance,
         seed=seed,
         expect="reached" if reachable else "unreachable",
     )
     return GeneratedWorld(
         scenario=scenario,
         seed=seed,
-        params=p,
+        params=params,
         reachable=reachable,
-        shortest_path_m=open_path.length_m if open_path is not None else None,
-        path=open_path.points if open_path is not None else (),
+        shortest_path_m=length,
+        path=path.points if path is not None else (),
         attempts=attempts,
     )
 

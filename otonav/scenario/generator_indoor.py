@@ -33,12 +33,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from otonav.scenario.config import BoxSpec, GoalSpec, ScenarioConfig, StartSpec
+from otonav.scenario.config import BoxSpec
 from otonav.scenario.generator import (
     EMPTY_ARENA_HALF,
     GeneratedWorld,
     WorldParams,
-    budget_for,
+    _r,
+    make_world,
     plan_path,
 )
 
@@ -54,10 +55,6 @@ _H = EMPTY_ARENA_HALF
 
 Layout = tuple[list[BoxSpec], tuple[float, float, float], tuple[float, float], list[BoxSpec]]
 """(walls, start (x, y, yaw), goal, the boxes that close the goal in: walled-in only)."""
-
-
-def _r(x: float) -> float:
-    return round(float(x), 3)
 
 
 def _wall(x0: float, y0: float, x1: float, y1: float) -> BoxSpec:
@@ -241,27 +238,4 @@ def generate_indoor(seed: int, family: str, max_attempts: int = 50) -> Generated
         if path is not None or attempts >= max_attempts:
             break
     reachable = path is not None and not closing
-    budget = budget_for(
-        path.length_m if path is not None else 2 * math.dist(start[:2], goal), params
-    )
-    scenario = ScenarioConfig(
-        name=f"{family}-{seed}",
-        scene="empty",
-        obstacles=tuple([*walls, *closing]),
-        start=StartSpec(x=start[0], y=start[1], yaw=start[2]),
-        goal=GoalSpec(x=goal[0], y=goal[1]),
-        goal_tolerance=params.goal_tolerance,
-        sim_budget=budget,
-        min_clearance=params.clearance,
-        seed=seed,
-        expect="reached" if reachable else "unreachable",
-    )
-    return GeneratedWorld(
-        scenario=scenario,
-        seed=seed,
-        params=params,
-        reachable=reachable,
-        shortest_path_m=path.length_m if path is not None else None,
-        path=path.points if path is not None else (),
-        attempts=attempts,
-    )
+    return make_world(params, seed, (*walls, *closing), start, goal, path, reachable, attempts)

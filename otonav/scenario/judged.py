@@ -139,13 +139,7 @@ def judged_run(
     verdict, once the artifacts are written; any other exception propagates after them.
     ``sim_time()`` is the run's sim time (after ``run`` returned or raised). The one
     ending of every judged runner (virtual and real time)."""
-    scenario, stack, hal, judge, session = (
-        parts.scenario,
-        parts.stack,
-        parts.hal,
-        parts.judge,
-        parts.session,
-    )
+    scenario, stack, judge, session = parts.scenario, parts.stack, parts.judge, parts.session
     wall_start = time.perf_counter()
     ended = "completed"
     crash: ActorCrashedError | None = None
@@ -161,7 +155,7 @@ def judged_run(
         wall = time.perf_counter() - wall_start
         try:
             verdict = judge_verdict(
-                scenario, judge, sim_time(), wall, robot=robot_summary(stack, hal)
+                scenario, judge, sim_time(), wall, robot=robot_summary(stack, parts.hal)
             )
             if ended != "completed":
                 verdict = replace(verdict, passed=False, reason=f"run ended early ({ended})")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -182,31 +182,9 @@ def draw_trajectory(
     return fig
 
 
-def plot_trajectory(
-    path: Path,
-    trajectory: list[tuple[float, float, float]],
-    obstacles: tuple[Obstacle, ...] | None,
-    goal: tuple[float, float] | None,
-    tolerance: float | None,
-    closest: tuple[float, float] | None,
-    title: str,
-    *,
-    path_label: str = "path (ground truth)",
-    footprint: Sequence[tuple[float, float]] = (),
-    poses: Sequence[tuple[float, float, float]] = (),
-) -> Path:
-    """Write a PNG of the run (:func:`draw_trajectory`) to ``path`` and return it."""
-    fig = draw_trajectory(
-        trajectory,
-        obstacles,
-        goal,
-        tolerance,
-        closest,
-        title,
-        path_label=path_label,
-        footprint=footprint,
-        poses=poses,
-    )
+def plot_trajectory(path: Path, *args: Any, **kwargs: Any) -> Path:
+    """Write a PNG of the run (:func:`draw_trajectory` of the other arguments) to ``path``."""
+    fig = draw_trajectory(*args, **kwargs)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, metadata={"Software": None})
     return path

@@ -1,5 +1,5 @@
-"""Run a scenario paced to the wall clock (optionally scaled), optionally in MuJoCo's
-viewer: the same world, actors, judge, recording and verdict as
+"""A scenario run paced to the wall clock (optionally scaled), optionally in MuJoCo's
+viewer: the same world, actors, judge, recording and verdict as a virtual-time
 :func:`~otonav.scenario.run.run_scenario`, on a stock asyncio loop with a
 :class:`~otonav.runtime.RealTimeClock` instead of the virtual-time loop."""
 
@@ -9,24 +9,19 @@ import asyncio
 import time
 from collections.abc import Callable
 from dataclasses import replace
-from pathlib import Path
 
 import anyio
 
 from otonav.hal.mujoco import MujocoInterface, ViewerHandle
-from otonav.hal.viewer import check_display
-from otonav.runtime import Actor, RealTime, RealTimeClock, System
+from otonav.runtime import RealTimeClock
 from otonav.runtime.timesource import tick_rate
-from otonav.scenario.artifacts import PlotWhen
-from otonav.scenario.assembly import opened_scenario
 from otonav.scenario.config import ScenarioConfig
 from otonav.scenario.judge import Judge
 from otonav.scenario.judged import JudgedRun, drive, judged_run, run_task
 from otonav.scenario.verdict import Verdict
-from otonav.stack import StackConfig
 from otonav.stack.session import StackSession
 
-__all__ = ["VIEWER_HZ", "run_scenario_realtime"]
+__all__ = ["VIEWER_HZ", "paced_run"]
 
 VIEWER_HZ = 60.0
 """Wall-clock rate at which the viewer is shown the world."""
@@ -82,91 +77,49 @@ async def _main(
             raise group.exceptions[0]  # noqa: B904 - its own cause is kept
 
 
-def run_scenario_realtime(
-    scenario: ScenarioConfig = ScenarioConfig(),
-    stack: StackConfig = StackConfig(),
-    *,
-    out_dir: Path | None = None,
-    record: bool = True,
-    plot: PlotWhen = True,
-    time: RealTime = RealTime(),
-    gui: bool = False,
-    on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
-    extra_actors: tuple[Actor, ...] = (),
-    hold: Callable[[Verdict], None] | None = None,
-    loop_factory: Callable[[], asyncio.AbstractEventLoop] | None = None,
-    source: str = "scenario",
-    progress: Callable[[Judge, float], None] | None = None,
-    on_system: Callable[[System], None] | None = None,
+def paced_run(
+    parts: JudgedRun,
+    gui: bool,
+    hold: Callable[[Verdict], None] | None,
+    on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None,
+    loop_factory: Callable[[], asyncio.AbstractEventLoop] | None,
 ) -> Verdict:
-    """:func:`~otonav.scenario.run.run_scenario` with ``time=RealTime(scale)`` (and ``gui``,
-    ``hold``), which is how to ask for it: sim time follows the wall clock times
-    ``scale``; the same world, judge, artifacts and endings (:func:`judged_run`).
-
-    ``gui=True`` shows the run in MuJoCo's viewer: the display is checked before
-    anything is built (:class:`~otonav.hal.viewer.NoDisplayError`, one line, when there
-    is none), the window opens before the clock starts, is synced at ~60 Hz wall and
-    closed at the end. Closing the window stops the run: the verdict fails and says so.
-    ``on_start(loop, task)`` is called on the run's loop once the window (if any) is up.
-    ``extra_actors`` join the system (a live view, monitors); ``on_system(system)`` is
-    called with the wired system before it runs.
-    ``hold`` (with ``gui``): once the run is over and its recording finished, call
-    ``hold(verdict)`` (its artifact paths are not set yet) and keep the window open on
-    the final state until the user closes it; Ctrl-C ends the hold too.
-    ``loop_factory``: the loop to run on (default: a stock one, the wall clock); a test
-    passes a loop whose clock it controls, so a paced run is exact.
-    """
+    """:func:`~otonav.scenario.run.run_scenario` with ``time=RealTime(scale)`` or ``gui``
+    (see there), once its scenario is opened."""
+    scenario, hal, judge, session = parts.scenario, parts.hal, parts.judge, parts.session
+    viewer: ViewerHandle | None = None
+    held: list[Verdict] = []
     if gui:
-        check_display()
-    with opened_scenario(
-        scenario,
-        stack,
-        out_dir,
-        record,
-        source,
-        progress,
-        extra_actors,
-        time=time,
-        on_system=on_system,
-    ) as (scenario, stack, hal, judge, session):
-        viewer: ViewerHandle | None = None
-        held: list[Verdict] = []
-        if gui:
-            try:
-                # Over CAN the world is the interface's sensor source: view that.
-                world = hal if isinstance(hal, MujocoInterface) else getattr(hal, "sensors", None)
-                if not isinstance(world, MujocoInterface):
-                    raise TypeError(f"gui=True needs the MuJoCo world, got {type(hal).__name__}")
-                viewer = world.open_viewer()
-            except BaseException:
-                session.close()
-                raise
-            session.add_cleanup(viewer.close)  # after the recording, before the world
-            if hold is not None:  # cleanups run last added first: before the window closes
-                shown = viewer
-                session.add_cleanup(lambda: _hold(shown, held, hold))
-        closed_at: list[float] = []
+        try:
+            # Over CAN the world is the interface's sensor source: view that.
+            world = hal if isinstance(hal, MujocoInterface) else getattr(hal, "sensors", None)
+            if not isinstance(world, MujocoInterface):
+                raise TypeError(f"gui=True needs the MuJoCo world, got {type(hal).__name__}")
+            viewer = world.open_viewer()
+        except BaseException:
+            session.close()
+            raise
+        session.add_cleanup(viewer.close)  # after the recording, before the world
+        if hold is not None:  # cleanups run last added first: before the window closes
+            shown = viewer
+            session.add_cleanup(lambda: _hold(shown, held, hold))
+    closed_at: list[float] = []
 
-        def run() -> None:
-            with asyncio.Runner(loop_factory=loop_factory) as runner:
-                runner.run(_main(scenario, session, judge, viewer, closed_at, on_start))
+    def run() -> None:
+        with asyncio.Runner(loop_factory=loop_factory) as runner:
+            runner.run(_main(scenario, session, judge, viewer, closed_at, on_start))
 
-        def amend(verdict: Verdict) -> Verdict:
-            if closed_at and not judge.reached:
-                verdict = replace(
-                    verdict,
-                    passed=False,
-                    reason=(
-                        f"stopped: the viewer window was closed at sim time {closed_at[0]:.3f} s "
-                        f"({judge.distance:.3f} m from the goal)"
-                    ),
-                )
-            held.append(verdict)  # the run completed: what a held window shows
-            return verdict
+    def amend(verdict: Verdict) -> Verdict:
+        if closed_at and not judge.reached:
+            verdict = replace(
+                verdict,
+                passed=False,
+                reason=(
+                    f"stopped: the viewer window was closed at sim time {closed_at[0]:.3f} s "
+                    f"({judge.distance:.3f} m from the goal)"
+                ),
+            )
+        held.append(verdict)  # the run completed: what a held window shows
+        return verdict
 
-        return judged_run(
-            JudgedRun(scenario, stack, hal, judge, session, out_dir, plot),
-            run,
-            lambda: hal.ticks / tick_rate(hal.tick),
-            amend=amend,
-        )
+    return judged_run(parts, run, lambda: hal.ticks / tick_rate(hal.tick), amend=amend)

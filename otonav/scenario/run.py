@@ -52,6 +52,7 @@ def run_scenario(
     gui: bool = False,
     hold: Callable[[Verdict], None] | None = None,
     on_system: Callable[[System], None] | None = None,
+    loop_factory: Callable[[], asyncio.AbstractEventLoop] | None = None,
 ) -> Verdict:
     """Run ``scenario`` headless in virtual time and judge it. With ``out_dir``, leave
     ``recording.mcap`` (unless ``record=False``) and ``trajectory.png`` there. The
@@ -60,10 +61,10 @@ def run_scenario(
     is called with the run's wired :class:`~otonav.runtime.System` before it starts: a
     host reaching the actors (``otonav run --foxglove`` serves their parameters).
     ``progress(judge, sim_time)`` is called after every judge sample (the CLI's progress
-    line). ``on_start(loop, task)`` is called on the run's loop as it starts: a host
-    running this in a worker thread cancels the run with
-    ``loop.call_soon_threadsafe(task.cancel)``. A goal outside the arena or on an
-    obstacle raises ``ConfigFileError`` naming ``source``.
+    line). ``on_start(loop, task)`` is called on the run's loop as it starts (once the
+    viewer window, if any, is up): a host running this in a worker thread cancels the
+    run with ``loop.call_soon_threadsafe(task.cancel)``. A goal outside the arena or on
+    an obstacle raises ``ConfigFileError`` naming ``source``.
     Another run writing to ``out_dir`` raises :class:`~otonav.record.outlock.OutputBusyError`
     before anything is touched. An actor's crash raises
     :class:`~otonav.scenario.crash.RunCrashedError` once the artifacts are written: an
@@ -72,30 +73,22 @@ def run_scenario(
     recording is closed (readable) and the world too.
 
     ``time=RealTime(scale)`` paces sim time to the wall clock times ``scale`` instead (the
-    same actors, judge and artifacts; ``wall_ceiling`` does not apply); ``gui=True`` (real
-    time, scale 1 unless given) shows the run in MuJoCo's viewer, and ``hold(verdict)``
-    keeps its window open at the end: see
-    :func:`~otonav.scenario.realtime.run_scenario_realtime`."""
-    if isinstance(time, RealTime) or gui:
-        from otonav.scenario.realtime import run_scenario_realtime
-
-        return run_scenario_realtime(
-            scenario,
-            stack,
-            out_dir=out_dir,
-            record=record,
-            plot=plot,
-            time=time if isinstance(time, RealTime) else RealTime(),
-            gui=gui,
-            on_start=on_start,
-            extra_actors=tuple(extra_actors),
-            hold=hold,
-            source=source,
-            progress=progress,
-            on_system=on_system,
-        )
-    if hold is not None:
+    same actors, judge and artifacts; ``wall_ceiling`` does not apply), on a stock
+    asyncio loop (``loop_factory``: another one, e.g. a test's whose clock it controls).
+    ``gui=True`` (real time, scale 1 unless given) shows the run in MuJoCo's viewer: the
+    display is checked before anything is built (:class:`~otonav.hal.viewer.NoDisplayError`,
+    one line, when there is none), the window opens before the clock starts, is synced at
+    ~60 Hz wall and closed at the end; closing it stops the run (the verdict fails and says
+    so). ``hold(verdict)`` (with ``gui``): once the run is over and its recording finished,
+    it is called (the artifact paths are not set yet) and the window stays open on the
+    final state until the user closes it; Ctrl-C ends the hold too."""
+    if hold is not None and not gui:
         raise ValueError("run_scenario: hold= needs gui=True (it keeps the viewer open)")
+    paced = time if isinstance(time, RealTime) else RealTime() if gui else None
+    if gui:
+        from otonav.hal.viewer import check_display
+
+        check_display()
     with opened_scenario(
         scenario,
         stack,
@@ -104,8 +97,14 @@ def run_scenario(
         source,
         progress,
         tuple(extra_actors),
+        time=paced or time,
         on_system=on_system,
     ) as (scenario, stack, hal, judge, session):
+        parts = JudgedRun(scenario, stack, hal, judge, session, out_dir, plot)
+        if paced is not None:
+            from otonav.scenario.realtime import paced_run
+
+            return paced_run(parts, gui, hold, on_start, loop_factory)
         preload_lazy_imports()
         sim_time = [0.0]
 
@@ -118,8 +117,4 @@ def run_scenario(
                 finally:
                     sim_time[0] = runner.get_loop().time()
 
-        return judged_run(
-            JudgedRun(scenario, stack, hal, judge, session, out_dir, plot),
-            run,
-            lambda: sim_time[0],
-        )
+        return judged_run(parts, run, lambda: sim_time[0])

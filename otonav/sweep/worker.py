@@ -159,29 +159,22 @@ def execute(task: RunTask, scratch: Path) -> RunOutcome:
     except Exception as exc:  # a broken run is a result, not the end of the sweep
         last = traceback.extract_tb(exc.__traceback__)[-1:]
         where = f" ({Path(last[0].filename).name}:{last[0].lineno})" if last else ""
+        status: Status = "error"
         reason = f"{type(exc).__name__}: {exc}{where}".replace("\n", " ")
-        return RunOutcome(
-            run_id=task.run_id,
-            status="error",
-            reason=reason,
-            figures={},
-            recording_sha256=_sha256(recording),
-            wall_time_s=time.perf_counter() - start,
-            worker=worker_name(),
-            artifacts=_artifacts(recording, None) if task.keep != "none" else {},
-            scenario_json=scenario_json,
-        )
-    status: Status = "passed" if verdict.passed else "failed"
-    figures = finite_figures(verdict.as_dict())
-    for key in ("recording", "plot", "wall_time_s", "rtf", "scenario", "reason"):
-        figures.pop(key, None)
-    figures["sim_wall_s"] = verdict.wall_time_s
-    figures.update(labels)
-    artifacts = _artifacts(recording, scratch / PLOT) if _keeps(task, status) else {}
+        figures: dict[str, Any] = {}
+        artifacts = _artifacts(recording, None) if task.keep != "none" else {}
+    else:
+        status, reason = "passed" if verdict.passed else "failed", verdict.reason
+        figures = finite_figures(verdict.as_dict())
+        for key in ("recording", "plot", "wall_time_s", "rtf", "scenario", "reason"):
+            figures.pop(key, None)
+        figures["sim_wall_s"] = verdict.wall_time_s
+        figures.update(labels)
+        artifacts = _artifacts(recording, scratch / PLOT) if _keeps(task, status) else {}
     return RunOutcome(
         run_id=task.run_id,
         status=status,
-        reason=verdict.reason,
+        reason=reason,
         figures=figures,
         recording_sha256=_sha256(recording),
         wall_time_s=time.perf_counter() - start,

@@ -262,9 +262,9 @@ class LateWallLoop(VirtualTimeLoop):
 
 
 def test_a_real_time_recording_replays_with_recorded_wakes(tmp_path: Path) -> None:
-    from otonav.scenario.realtime import run_scenario_realtime
+    from otonav.scenario import run_scenario
 
-    run_scenario_realtime(
+    run_scenario(
         ScenarioConfig(sim_budget=2.0),
         out_dir=tmp_path,
         time=RealTime(10.0),

@@ -26,14 +26,15 @@ from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
 from otonav.actors import topics
-from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewOptions
+from otonav.foxglove import FoxgloveServer, LiveView
 from otonav.msgs import Point, Pose, PoseStamped
 from otonav.record.cdr import encode
 from otonav.record.reader import read_messages
-from otonav.ros2 import Ros2Bridge, Ros2Options
+from otonav.ros2 import Ros2Bridge
 from otonav.runtime import Actor, Input, QoS, Reliability, System, run_blocking, until
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.stack import StackConfig
+from otonav.stack.config import FoxgloveConfig, Ros2Config
 from otonav.stack.door import refusal
 from otonav.stack.live_parameters import _validator
 
@@ -272,7 +273,7 @@ class Fuzz(Actor):
 def test_a_thousand_foxglove_frames_and_dds_goals_reach_no_actor_unchecked(
     tmp_path: Path,
 ) -> None:
-    server = FoxgloveServer(LiveViewOptions(port=0))
+    server = FoxgloveServer(FoxgloveConfig(port=0))
     view = LiveView(server)
     spy = GoalSpy()
 
@@ -281,7 +282,7 @@ def test_a_thousand_foxglove_frames_and_dds_goals_reach_no_actor_unchecked(
 
     with exclusive_domain() as domain:
         env = {k: v for k, v in os.environ.items() if not k.startswith(("ROS_", "CYCLONEDDS"))}
-        bridge = Ros2Bridge(Ros2Options(domain_id=domain), env=env)
+        bridge = Ros2Bridge(Ros2Config(domain_id=domain), env=env)
         fuzz = Fuzz(bridge, view, domain)
         try:
             verdict = run_scenario(

@@ -19,12 +19,13 @@ from websockets.typing import Subprotocol
 
 from otonav.actors import topics
 from otonav.embed import HOST_QOS, open_live_stack
-from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewOptions
+from otonav.foxglove import FoxgloveServer, LiveView
 from otonav.msgs import Odometry, PoseStamped
 from otonav.record.reader import read_messages
 from otonav.record.schemas import schema_for
 from otonav.runtime import RealTime, until
 from otonav.stack import StackConfig
+from otonav.stack.config import FoxgloveConfig
 
 pytestmark = pytest.mark.smoke
 
@@ -54,7 +55,7 @@ async def _parameters(ws: ClientConnection, op: str, request_id: str, **body: An
 async def test_a_client_sets_a_parameter_and_sends_a_goal_that_is_reached(
     tmp_path: Path,
 ) -> None:
-    server = FoxgloveServer(LiveViewOptions(port=0))
+    server = FoxgloveServer(FoxgloveConfig(port=0))
     view = LiveView(server)
     record = tmp_path / "live.mcap"
     stack = StackConfig.model_validate({"nav": {"planner": "stop"}})

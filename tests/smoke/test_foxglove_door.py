@@ -34,13 +34,14 @@ from websockets.typing import Subprotocol
 
 from otonav.actors import AvoidingNavigator, topics
 from otonav.embed import LiveStack, open_live_stack
+from otonav.foxglove import FoxgloveServer, LiveView
 from otonav.foxglove.protocol import CONTROL_BACKLOG
-from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewOptions
 from otonav.msgs import PoseStamped
 from otonav.record.reader import read_messages
 from otonav.record.schemas import schema_for
 from otonav.runtime import RealTime, until
 from otonav.stack import StackConfig
+from otonav.stack.config import FoxgloveConfig
 
 pytestmark = pytest.mark.smoke
 
@@ -59,7 +60,7 @@ class Run:
 
 @asynccontextmanager
 async def _running(tmp_path: Path) -> AsyncIterator[Run]:
-    server = FoxgloveServer(LiveViewOptions(port=0))
+    server = FoxgloveServer(FoxgloveConfig(port=0))
     view = LiveView(server)
     record = tmp_path / "live.mcap"
     with anyio.fail_after(CEILING):

@@ -23,12 +23,13 @@ from websockets.typing import Subprotocol
 
 from otonav.cli import main as cli_main
 from otonav.embed import open_live_stack
-from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewError, LiveViewOptions
+from otonav.foxglove import FoxgloveServer, LiveView, LiveViewError
 from otonav.msgs import LaserScan
 from otonav.record.reader import read_messages, summarize
 from otonav.runtime import SENSOR_DATA_QOS, Actor, Output, RealTime, run_blocking
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.stack import StackConfig
+from otonav.stack.config import FoxgloveConfig
 from otonav.testing import running_stack
 
 pytestmark = pytest.mark.smoke
@@ -40,8 +41,11 @@ STACK_TOPICS = {
 
 
 @contextlib.contextmanager
-def serving(**options: object) -> Iterator[FoxgloveServer]:
-    server = FoxgloveServer(LiveViewOptions(port=0, **options))  # type: ignore[arg-type]
+def serving(
+    backlog: int = 256, subscriptions: int = 1, wait: float | None = None
+) -> Iterator[FoxgloveServer]:
+    config = FoxgloveConfig(port=0, wait_for_subscriber=wait)
+    server = FoxgloveServer(config, backlog=backlog, subscriptions=subscriptions)
     try:
         yield server
     finally:
@@ -49,7 +53,7 @@ def serving(**options: object) -> Iterator[FoxgloveServer]:
 
 
 def test_every_topic_is_advertised_and_odom_arrives_as_recorded(tmp_path: Path) -> None:
-    with serving(backlog=100_000, wait_for_subscriber=30.0, wait_for_subscriptions=3) as server:
+    with serving(backlog=100_000, subscriptions=3, wait=30.0) as server:
         client = FoxgloveClient(
             server.url, expect=STACK_TOPICS, subscribe={"/odom", "/tf_static", "/scan"}
         )
@@ -131,7 +135,7 @@ def _rss_bytes() -> int:
 
 
 def test_slow_and_churning_clients_neither_stall_the_robot_nor_grow_memory() -> None:
-    with serving(backlog=64, wait_for_subscriber=30.0, wait_for_subscriptions=13) as server:
+    with serving(backlog=64, subscriptions=13, wait=30.0) as server:
         expect = STACK_TOPICS | {"/blast"}
         stuck = FoxgloveClient(server.url, expect=expect, read=False)  # subscribes to all
         reader = FoxgloveClient(server.url, expect=expect, subscribe={"/clock"})
@@ -181,7 +185,7 @@ def test_slow_and_churning_clients_neither_stall_the_robot_nor_grow_memory() -> 
 
 def test_bad_live_view_options_are_one_line_errors(capsys: pytest.CaptureFixture[str]) -> None:
     with serving() as server, pytest.raises(LiveViewError, match="Address already in use"):
-        FoxgloveServer(LiveViewOptions(port=server.port))
+        FoxgloveServer(FoxgloveConfig(port=server.port))
     with serving() as server:
         code = cli_main(["run", "--foxglove", "--foxglove-port", str(server.port), "--no-record"])
     assert code == 2

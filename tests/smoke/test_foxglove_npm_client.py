@@ -16,10 +16,11 @@ import pytest
 
 from otonav.actors import topics
 from otonav.embed import open_live_stack
-from otonav.foxglove.view import FoxgloveServer, LiveView, LiveViewOptions
+from otonav.foxglove import FoxgloveServer, LiveView
 from otonav.record.reader import read_messages
 from otonav.runtime import RealTime, until
 from otonav.stack import StackConfig
+from otonav.stack.config import FoxgloveConfig
 
 pytestmark = pytest.mark.smoke
 
@@ -50,7 +51,7 @@ def node_client() -> list[str]:
 async def test_the_npm_client_sets_a_parameter_and_sends_a_goal_that_is_reached(
     node_client: list[str], tmp_path: Path
 ) -> None:
-    server = FoxgloveServer(LiveViewOptions(port=0))
+    server = FoxgloveServer(FoxgloveConfig(port=0))
     view = LiveView(server)
     record = tmp_path / "live.mcap"
     stack = StackConfig.model_validate({"nav": {"planner": "stop"}})

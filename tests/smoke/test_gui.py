@@ -1,4 +1,4 @@
-"""Layer 2: the viewer (``run_scenario_realtime(gui=True)``) on a real X display.
+"""Layer 2: the viewer (``run_scenario(gui=True)``) on a real X display.
 
 Every GUI run is a child process: MuJoCo's viewer with no display hard-exits the
 process, and a real window needs a real X server (``xvfb-run``). Missing tools fail
@@ -40,9 +40,9 @@ import sys
 from otonav.hal.viewer import NoDisplayError
 from otonav.scenario.builtin import BUILTIN
 from otonav.runtime import RealTime
-from otonav.scenario.realtime import run_scenario_realtime
+from otonav.scenario import run_scenario
 try:
-    run_scenario_realtime(BUILTIN["empty"], time=RealTime(5.0), gui=True, record=False, plot=False)
+    run_scenario(BUILTIN["empty"], time=RealTime(5.0), gui=True, record=False, plot=False)
 except NoDisplayError as exc:
     print(f"{type(exc).__name__}: {exc}", flush=True)
     sys.exit(0)
@@ -59,7 +59,7 @@ import json, os, sys
 from otonav.hal.mujoco import MujocoInterface
 from otonav.scenario.builtin import BUILTIN
 from otonav.runtime import RealTime
-from otonav.scenario.realtime import run_scenario_realtime
+from otonav.scenario import run_scenario
 
 mode, scale = sys.argv[1], float(sys.argv[2])
 print("DISPLAY", os.environ["DISPLAY"], os.environ.get("XAUTHORITY", ""), flush=True)
@@ -84,7 +84,7 @@ def held(verdict):  # "run": the window stays up (and Xvfb with it) until "close
     if sys.stdin.readline().strip() == "close":
         handles[0]._handle.close()
 
-verdict = run_scenario_realtime(
+verdict = run_scenario(
     BUILTIN["empty"], time=RealTime(scale), gui=True, record=False, plot=False, on_start=on_start,
     hold=held if mode == "run" else None,
 )

@@ -11,7 +11,6 @@ from otonav.record.outlock import OutputBusyError, lock_output
 from otonav.runtime import RealTime
 from otonav.scenario import run_scenario
 from otonav.scenario.builtin import BUILTIN
-from otonav.scenario.realtime import run_scenario_realtime
 
 pytestmark = pytest.mark.smoke
 
@@ -41,7 +40,7 @@ def test_realtime_run_reaches_the_goal_paced_to_the_scaled_wall_clock(tmp_path: 
 @pytest.mark.parametrize("scale", [0.0, 1e308, 1e-9])
 def test_realtime_run_rejects_a_scale_it_cannot_honour(scale: float) -> None:
     with pytest.raises(ValueError, match=r"scale.*must be a number in \[0.01, 100\]"):
-        run_scenario_realtime(BUILTIN["empty"], time=RealTime(scale), record=False, plot=False)
+        run_scenario(BUILTIN["empty"], time=RealTime(scale), record=False, plot=False)
 
 
 def test_a_realtime_run_refuses_an_out_dir_another_run_writes_to(tmp_path: Path) -> None:

@@ -18,9 +18,10 @@ import pytest
 from dds_domain import exclusive_domain
 
 from otonav.embed import open_live_stack
-from otonav.ros2 import Ros2Bridge, Ros2Options
+from otonav.ros2 import Ros2Bridge
 from otonav.runtime import RealTime, until
 from otonav.stack import StackConfig
+from otonav.stack.config import Ros2Config
 
 pytestmark = pytest.mark.smoke
 
@@ -49,7 +50,7 @@ async def _reads_odom_and_sends_a_goal(way: str, domain: int) -> None:
     try:
         stack = StackConfig.model_validate({"nav": {"planner": "stop"}})
         if way == "extra_actor":
-            bridge = Ros2Bridge(Ros2Options(domain_id=domain), env=env)
+            bridge = Ros2Bridge(Ros2Config(domain_id=domain), env=env)
             extra: tuple[Ros2Bridge, ...] = (bridge,)
         else:  # the embedding API's own option, from the stack config's ros2 section
             stack = stack.model_copy(

@@ -19,10 +19,11 @@ from otonav.actors import topics
 from otonav.msgs import Twist, Vector3
 from otonav.record.cdr import encode
 from otonav.record.reader import read_messages
-from otonav.ros2 import Ros2Bridge, Ros2Options
+from otonav.ros2 import Ros2Bridge
 from otonav.runtime import Actor, run_blocking
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.stack import StackConfig
+from otonav.stack.config import Ros2Config
 
 pytestmark = pytest.mark.smoke
 
@@ -74,7 +75,7 @@ def test_goals_off_the_world_from_other_processes_are_refused_and_the_run_goes_o
 ) -> None:
     env = {k: v for k, v in os.environ.items() if not k.startswith(("ROS_", "CYCLONEDDS"))}
     with exclusive_domain() as domain:
-        bridge = Ros2Bridge(Ros2Options(domain_id=domain), env=env)
+        bridge = Ros2Bridge(Ros2Config(domain_id=domain), env=env)
         peers = Peers(bridge, domain, env)
         try:
             verdict = run_scenario(
@@ -145,7 +146,7 @@ def test_velocity_commands_beyond_any_base_are_refused_at_the_door(tmp_path: Pat
     bad = [Twist(linear=Vector3(x=1e308)), Twist(angular=Vector3(z=-1e3))]
     with exclusive_domain() as domain:
         env = {k: v for k, v in os.environ.items() if not k.startswith(("ROS_", "CYCLONEDDS"))}
-        bridge = Ros2Bridge(Ros2Options(domain_id=domain, inputs=(topics.CMD_VEL_NAV,)), env=env)
+        bridge = Ros2Bridge(Ros2Config(domain_id=domain, inputs=(topics.CMD_VEL_NAV,)), env=env)
         commands = Commands(bridge, domain, [encode(twist) for twist in bad])
         try:
             verdict = run_scenario(

@@ -206,7 +206,6 @@ PINNED: dict[str, tuple[str, ...]] = {
         "FoxgloveServer",
         "LiveView",
         "LiveViewError",
-        "LiveViewOptions",
     ),
     "otonav.record.cdr": (
         "ENCAPSULATION",
@@ -217,9 +216,7 @@ PINNED: dict[str, tuple[str, ...]] = {
     "otonav.ros2": (
         "Ros2Bridge",
         "Ros2Error",
-        "Ros2Options",
         "Ros2Statistics",
-        "bridge_for",
     ),
     "otonav.runtime": (
         "Actor",

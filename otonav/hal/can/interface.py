@@ -126,7 +126,6 @@ class CanBusInterface(RobotHardwareInterface):
         self._sensors = sensors
         self._peer = peer
         self._axes = (left, right)
-        self._node_ids = (left.node_id, right.node_id)
         self._scale = (left.turns_per_rad(), right.turns_per_rad())
         self._vel_ids = (
             p.arbitration_id(left.node_id, p.CMD_SET_INPUT_VEL),
@@ -136,12 +135,8 @@ class CanBusInterface(RobotHardwareInterface):
         # node id and turns per rad. Everything else (heartbeats, other nodes, error
         # frames) takes the slow path.
         self._encoder_axis = {
-            p.arbitration_id(axis.node_id, p.CMD_GET_ENCODER_ESTIMATES): (
-                i,
-                axis.node_id,
-                self._scale[i],
-            )
-            for i, axis in enumerate((left, right))
+            p.arbitration_id(axis.node_id, p.CMD_GET_ENCODER_ESTIMATES): (i, axis.node_id, scale)
+            for i, (axis, scale) in enumerate(zip((left, right), self._scale, strict=True))
         }
         self.monitor = DriveMonitor(
             (NodeLabel(left.node_id, left.label), NodeLabel(right.node_id, right.label)),
@@ -152,7 +147,6 @@ class CanBusInterface(RobotHardwareInterface):
         self._wheels: WheelState | None = WheelState(0.0, 0.0, 0.0, 0.0)
         self._log: deque[tuple[float, RawFrame]] = deque(maxlen=frame_log)
         self._log_limit = frame_log
-        self._logged = 0
         self.frames_dropped_from_log = 0
         self.log_frames = True
         """Keep the frames sent and received for :meth:`take_frames`."""
@@ -442,7 +436,3 @@ class CanBusInterface(RobotHardwareInterface):
                 if self._peer is not None:
                     self._peer.close()
                 self._sensors.close()
-
-    def _check_open(self) -> None:
-        if self._closed:
-            raise RuntimeError("CanBusInterface is closed")

@@ -122,7 +122,6 @@ class DriveMonitor:
         self.permanent = False
         """The fault will not be recovered from (gave up, or a wrong node id)."""
         self._bus_off = False
-        self._bus_restarted = False
         self._loss_due = -math.inf
         # RUNNING: no check can find a fault before this instant (see check()).
         self._quiet_until = -math.inf
@@ -162,14 +161,12 @@ class DriveMonitor:
 
     def bus_off(self, now: float, detail: str) -> None:
         self._bus_off = True
-        self._bus_restarted = False
         if self.phase is not Phase.FAULT or self._fault != "bus_off":
             self._enter_fault(now, "bus_off", f"CAN bus-off: {detail}", tuple(self._nodes))
 
     def bus_restarted(self, now: float) -> None:
         if self._bus_off:
             self._bus_off = False
-            self._bus_restarted = True
             self.events.append((now, "CAN controller restarted after bus-off"))
 
     def requested(self, now: float) -> None:
@@ -200,7 +197,7 @@ class DriveMonitor:
         return (
             node.heartbeat_at > self._requested_at
             and node.error == 0
-            and node.state == AxisState.CLOSED_LOOP_CONTROL
+            and node.state == _CLOSED_LOOP
         )
 
     def _check_starting(self, now: float) -> tuple[Action, ...]:
@@ -277,52 +274,43 @@ class DriveMonitor:
                 node.heartbeat_at + limits.heartbeat_timeout,
                 node.encoder_at + limits.encoder_timeout,
             )
-            age = now - node.heartbeat_at
-            if age > limits.heartbeat_timeout + 1e-9:
-                self._enter_fault(
-                    now,
-                    "heartbeat_lost",
-                    f"{node.label}: no heartbeat for {age:.3f} s of sim time "
-                    f"(timeout {limits.heartbeat_timeout:g} s)",
-                    (node.label.node_id,),
-                )
-                return (Action.ESTOP_ALL,)
-            if node.error or node.state != AxisState.CLOSED_LOOP_CONTROL:
-                self._enter_fault(
-                    now,
-                    "axis_error",
-                    f"{node.label}: axis error 0x{node.error:08x} "
-                    f"({error_names(node.error)}), state {_state_name(node.state)}",
-                    (node.label.node_id,),
-                )
-                return (Action.ESTOP_ALL,)
-            age = now - node.encoder_at
-            if age > limits.encoder_timeout + 1e-9:
-                self._enter_fault(
-                    now,
-                    "encoder_stale",
-                    f"{node.label}: newest encoder estimate {age:.3f} s old in sim time "
-                    f"(timeout {limits.encoder_timeout:g} s; frames delayed or lost)",
-                    (node.label.node_id,),
-                )
-                return (Action.ZERO_ALL,)
-            # The loss is judged ten times per window, not at every instant.
-            if now < self._loss_due:
-                continue
-            loss = self._loss(node, now, self._running_since)
-            if loss is not None and loss > limits.max_frame_loss:
-                self._enter_fault(
-                    now,
-                    "frame_loss",
-                    f"{node.label}: {loss:.0%} of encoder frames lost over the last "
-                    f"{limits.loss_window:g} s (max {limits.max_frame_loss:.0%})",
-                    (node.label.node_id,),
-                )
-                return (Action.ZERO_ALL,)
+            found = self._node_fault(node, now)
+            if found is not None:
+                fault, why, action = found
+                self._enter_fault(now, fault, f"{node.label}: {why}", (node.label.node_id,))
+                return (action,)
         if now >= self._loss_due:
             self._loss_due = now + limits.loss_window / 10.0
         self._quiet_until = min(quiet, self._loss_due)
         return ()
+
+    def _node_fault(self, node: _Node, now: float) -> tuple[str, str, Action] | None:
+        """The fault ``node`` shows while running, why, and what to send."""
+        lim, hb_age, enc_age = self.limits, now - node.heartbeat_at, now - node.encoder_at
+        if hb_age > lim.heartbeat_timeout + 1e-9:
+            why = f"no heartbeat for {hb_age:.3f} s of sim time"
+            return (
+                "heartbeat_lost",
+                f"{why} (timeout {lim.heartbeat_timeout:g} s)",
+                Action.ESTOP_ALL,
+            )
+        if node.error or node.state != _CLOSED_LOOP:
+            why = f"axis error 0x{node.error:08x} ({error_names(node.error)})"
+            return "axis_error", f"{why}, state {_state_name(node.state)}", Action.ESTOP_ALL
+        if enc_age > lim.encoder_timeout + 1e-9:
+            why = f"newest encoder estimate {enc_age:.3f} s old in sim time (timeout "
+            return (
+                "encoder_stale",
+                f"{why}{lim.encoder_timeout:g} s; frames delayed or lost)",
+                Action.ZERO_ALL,
+            )
+        if now < self._loss_due:  # the loss is judged ten times per window
+            return None
+        loss = self._loss(node, now, self._running_since)
+        if loss is None or loss <= lim.max_frame_loss:
+            return None
+        why = f"{loss:.0%} of encoder frames lost over the last {lim.loss_window:g} s"
+        return "frame_loss", f"{why} (max {lim.max_frame_loss:.0%})", Action.ZERO_ALL
 
     def _loss(self, node: _Node, now: float, since: float) -> float | None:
         """Fraction of encoder frames missing over the loss window; None until a whole
@@ -373,7 +361,6 @@ class DriveMonitor:
             attempts[node_id] = attempts.get(node_id, 0) + 1
         self.phase = Phase.RECOVERING
         self._requested_at = now
-        self._bus_restarted = False
         attempt = max((attempts[n] for n in self._fault_nodes), default=0)
         self._set(
             now,
