@@ -138,4 +138,5 @@ def test_a_tiny_max_accel_bounds_the_stopping_grid_and_stays_safe(
     # From rest, the same base barely moves in the latency: it may go.
     steps.clear()
     r = safe_command(0.5, 0.0, 0.0, 0.0, _wall(1.0), tiny)
-    assert r.reason == "safe" and max(steps) <= 501
+    assert r.reason == "safe"
+    assert max(steps) <= 501
