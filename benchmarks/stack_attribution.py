@@ -152,7 +152,11 @@ def _instrument() -> None:
                     wrapped[key] = _shared("nav/safety/control math", functions[key])
                 setattr(module, attr, wrapped[key])
     _timed_method(bridge.Bridge, "run", "actor: bridge (publishing)")
-    _timed_method(bridge.Bridge, "_apply_commands", "actor: bridge (wheel commands)")
+    # A /wheel_cmd is applied in the base's publish (ADR 0084): the bridge's callback,
+    # the HAL write inside it included, out of the base's step.
+    bridge.Bridge._apply_command = _shared(  # type: ignore[method-assign]
+        "actor: bridge (wheel commands)", bridge.Bridge._apply_command
+    )
     _timed_method(AvoidingNavigator, "run", "actor: navigator")
     _timed_method(SafetyLayer, "run", "actor: safety layer")
     _timed_method(BaseController, "run", "actor: base controller")

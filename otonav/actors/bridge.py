@@ -63,6 +63,10 @@ _LOG_LEVELS = {
 }
 
 
+def _ignore(_message: object) -> None:
+    pass
+
+
 def _diag6(*variances: float) -> tuple[float, ...]:
     """A row-major 6x6 covariance with ``variances`` on the diagonal."""
     return tuple(variances[i // 6] if i % 7 == 0 else 0.0 for i in range(36))
@@ -262,6 +266,7 @@ class Bridge(Actor):
                 ),
             )
 
+        self.wheel_cmd.deliver_to(self._apply_command)
         await self._check_health(self.clock.now())
         await self.tf_static.publish(
             TFMessage.fast(
@@ -273,19 +278,19 @@ class Bridge(Actor):
         )
 
     async def run(self) -> None:
-        async with anyio.create_task_group() as tg:
-            tg.start_soon(self._apply_commands)
-            await self._publish_loop()
+        await self._publish_loop()
 
     async def on_stop(self) -> None:
         """Zero the wheels as the bridge stops (after every actor that commands them):
         on any crash or stop, the hardware must not keep the last setpoint (issue 27
         item 8). The base's own zero on /wheel_cmd is what the recording shows."""
         self.hal.write(WheelSetpoint(0.0, 0.0))
+        self.wheel_cmd.deliver_to(_ignore)  # stopped: the hardware is no longer ours
 
-    async def _apply_commands(self) -> None:
-        async for cmd in self.wheel_cmd:
-            self.hal.write(WheelSetpoint(*_read_wheel_command(cmd)))
+    def _apply_command(self, cmd: WheelCommand) -> None:
+        """A /wheel_cmd goes to the hardware in its publisher's call (ADR 0084): at the
+        instant it is published, before the world steps on, with no wake-up of its own."""
+        self.hal.write(WheelSetpoint(*_read_wheel_command(cmd)))
 
     async def _publish_loop(self) -> None:
         """One timer for all streams: wake at the earliest due instant, publish every

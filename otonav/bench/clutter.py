@@ -179,13 +179,16 @@ class ClutterRow:
     """The profile's largest stages, share of the profiled run."""
 
 
-def clutter_curve(counts: tuple[int, ...], reps: int, *, profile: bool) -> list[ClutterRow]:
+def clutter_curve(
+    counts: tuple[int, ...], reps: int, *, profile: bool, fresh: bool = True
+) -> list[ClutterRow]:
     """Each count ``reps`` times, interleaved (0, 100, ..., 0, 100, ...), each run in a
-    fresh child process; with ``profile``, one more profiled run per count."""
+    fresh child process (``fresh`` False: one child for all); with ``profile``, one more
+    profiled run per count."""
     from otonav.bench.harness import run_in_children
 
     cases = [Case("clutter", boxes=n) for _ in range(reps) for n in counts]
-    samples = run_in_children(cases, run_clutter)
+    samples = run_in_children(cases, run_clutter, fresh=fresh)
     profiles: dict[int, dict[str, float]] = {}
     if profile:
         import multiprocessing

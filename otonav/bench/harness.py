@@ -181,12 +181,14 @@ def run_case(case: Case) -> Sample:
 
 
 def run_in_children(
-    cases: Sequence[Case], run: Callable[[Case], Sample] = run_case
+    cases: Sequence[Case], run: Callable[[Case], Sample] = run_case, *, fresh: bool = True
 ) -> list[Sample]:
     """``run(case)`` for each case in a fresh spawned process, one after another (never
-    two at once on this 2-core machine); ``run`` is a module-level function."""
+    two at once on this 2-core machine); ``run`` is a module-level function. With
+    ``fresh`` False one spawned child runs them all (``--quick``: it checks that the
+    bench runs, an import per case is most of its time)."""
     import multiprocessing
 
     ctx = multiprocessing.get_context("spawn")
-    with ctx.Pool(1, maxtasksperchild=1) as pool:
+    with ctx.Pool(1, maxtasksperchild=1 if fresh else None) as pool:
         return pool.map(run, cases, chunksize=1)

@@ -83,16 +83,17 @@ def run_bench(
     scaling: bool,
     profile: bool,
     clutter: tuple[tuple[int, ...], int] | None = None,
+    fresh: bool = True,
 ) -> dict[str, object]:
     """The stack against bare physics (rows, ratios, fixed costs, the acceptance run),
     then with ``scaling`` the beams and subscribers tables, with ``clutter`` (counts,
     reps) the clutter curve (otonav.bench.clutter; profiled per count with ``profile``),
-    all in this one session."""
+    all in this one session; ``fresh`` False: all in one child (harness.run_in_children)."""
     kinds = ("bare0", "bare", "stack", "recorded")
     extra = ("fixed", "scenario")
     # Interleave a, b, c, ... a, b, c, ... so slow phases of this shared machine hit all.
     cases = [Case(kind, duration) for _ in range(reps) for kind in (*kinds, *extra)]
-    samples = run_in_children(cases)
+    samples = run_in_children(cases, fresh=fresh)
     by_kind = {
         k: [s for c, s in zip(cases, samples, strict=True) if c.kind == k] for k in (*kinds, *extra)
     }
@@ -157,7 +158,7 @@ def run_bench(
         from otonav.bench.clutter import clutter_curve
 
         counts, clutter_reps = clutter
-        curve = clutter_curve(counts, clutter_reps, profile=profile)
+        curve = clutter_curve(counts, clutter_reps, profile=profile, fresh=fresh)
         result["clutter"] = {"reps": clutter_reps, "rows": [asdict(r) for r in curve]}
     return result
 

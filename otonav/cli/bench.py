@@ -21,7 +21,11 @@ def add_parser(commands: Any) -> None:
         "several minutes: also benchmarks/clutter_bench.py)",
     )
     p.add_argument("--clutter-reps", type=int, default=5, help="runs per box count (default 5)")
-    p.add_argument("--quick", action="store_true", help="2 s, 1 run, no scaling: checks it runs")
+    p.add_argument(
+        "--quick",
+        action="store_true",
+        help="2 s, 1 run, no scaling, one child process for all: checks it runs",
+    )
     p.add_argument(
         "--long",
         type=float,
@@ -63,7 +67,14 @@ def main(args: argparse.Namespace) -> int:
     if args.quick:
         duration, reps, scaling = 2.0, 1, False
         clutter = None if clutter is None else ((0, 100), 1)
-    result = run_bench(duration, reps, scaling=scaling, profile=not args.quick, clutter=clutter)
+    result = run_bench(
+        duration,
+        reps,
+        scaling=scaling,
+        profile=not args.quick,
+        clutter=clutter,
+        fresh=not args.quick,
+    )
     print(format_report(result))
     write_json(result, args.json)
     print(f"figures: {args.json}")

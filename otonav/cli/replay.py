@@ -181,7 +181,16 @@ def print_result(result: ReplayResult, console: Console) -> None:
         console.print(f"CRASHED: {result.crash.splitlines()[0]}")
         print(result.crash, file=sys.stderr)
     first = result.first_divergence
-    if first is not None:
+    if result.format_change is not None:
+        console.print(f"note: {result.format_change}")
+    if first is not None and result.format_change is not None:
+        console.print(f"first difference: {first}")
+        console.print(
+            f"FORMAT DIFFERS: {len(result.divergences)} message(s) beyond the tolerance, "
+            "which the format change above can explain: record the run again with this "
+            "otonav before you compare"
+        )
+    elif first is not None:
         console.print(f"first divergence: {first}")
         console.print(f"DIVERGED: {len(result.divergences)} message(s) beyond the tolerance")
         if all(d.kind != "content" for d in result.divergences):

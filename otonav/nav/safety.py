@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 
 from otonav.params import SafetyParams
 
-__all__ = ("SafetyParams", "SafetyResult", "safe_command", "stopping_reach")
+__all__ = ("MAX_STEPS", "SafetyParams", "SafetyResult", "safe_command", "stopping_reach")
 
 
 @dataclass(frozen=True, slots=True)
@@ -53,6 +53,12 @@ class SafetyResult:
     scale: float
     nearest: float
     reason: str
+
+
+MAX_STEPS = 500
+"""The most steps of ``dt`` a stopping path is integrated over (10 s at the default
+``dt``); a longer one (a base with a tiny ``max_accel``) is bounded past it instead:
+the grid, and the cost of a call, grew as v^2 / max_accel without it."""
 
 
 def stopping_reach(speed: float, params: SafetyParams) -> float:
@@ -111,10 +117,13 @@ def safe_command(
     scales = np.linspace(1.0, 0.0, p.scales)
     v_t = scales * v_cmd
     w_t = np.full(p.scales, omega_cmd)
-    top_v = np.maximum(np.abs(v_t), abs(v0)) + p.max_accel * p.latency
-    top_w = np.maximum(np.abs(w_t), abs(omega0)) + p.max_alpha * p.latency
-    duration = p.latency + max(float(top_v.max()) / p.max_accel, float(top_w.max()) / p.max_alpha)
-    t = p.dt * np.arange(1, math.ceil(duration / p.dt) + 2, dtype=np.float64)  # (K,)
+    # The fastest each profile gets (the ramp moves at most limit * latency from the
+    # current speed, never past the target), then the time to brake from it.
+    top_v = np.maximum(abs(v0), np.minimum(np.abs(v_t), abs(v0) + p.max_accel * p.latency))
+    top_w = max(abs(omega0), min(abs(omega_cmd), abs(omega0) + p.max_alpha * p.latency))
+    duration = p.latency + max(float(top_v.max()) / p.max_accel, top_w / p.max_alpha)
+    steps = math.ceil(duration / p.dt) + 1
+    t = p.dt * np.arange(1, min(steps, MAX_STEPS) + 1, dtype=np.float64)  # (K,)
     v = _profile(v0, v_t, t, p.latency, p.max_accel)  # (n, K)
     w = _profile(omega0, w_t, t, p.latency, p.max_alpha)
     th = np.cumsum(w, axis=1) * p.dt
@@ -122,6 +131,14 @@ def safe_command(
     y = np.cumsum(v * np.sin(th - 0.5 * w * p.dt), axis=1) * p.dt
     gap = np.hypot(pts[None, None, :, 0] - x[:, :, None], pts[None, None, :, 1] - y[:, :, None])
     worst = (gap - allowed).min(axis=(1, 2))
+    if steps > MAX_STEPS:
+        # The rest of a path too long to integrate (a tiny max_accel): it stays within
+        # the distance it can still travel of where the grid ends, the speed then (or
+        # the top speed, still ramping) for the time left. Conservative, never optimistic.
+        end = float(t[-1])
+        speed = np.abs(v[:, -1]) if end >= p.latency else top_v
+        tail = speed * (duration - end + p.dt)
+        worst = np.minimum(worst, (gap[:, -1, :] - allowed).min(axis=1) - tail)
     ok = worst >= 0.0
     for i in range(p.scales):
         if ok[i]:

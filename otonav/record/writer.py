@@ -43,6 +43,37 @@ from otonav.runtime.qos import QoS
 
 CHUNK_SIZE = 64 * 1024
 
+FORMAT_METADATA = "otonav.recording"
+"""The metadata record every recording starts with: ``format_version``."""
+FORMAT_VERSION = 2
+"""What a run's bytes mean besides the messages' types: the engine's order within an
+instant. A replay of a recording of another version says what differs (ADR 0084)."""
+FORMAT_CHANGES: dict[int, str] = {
+    2: (
+        "a /wheel_cmd is applied to the hardware in its publisher's call, no longer a "
+        "pass later by the bridge's own task: a reading later in the same instant (the "
+        "IMU's linear acceleration) sees the new command"
+    ),
+}
+"""What each version changed from the one before (version 1: no record)."""
+
+
+def format_difference(recorded: int) -> str | None:
+    """What differs between a recording of format ``recorded`` and this otonav's; None
+    when they are the same."""
+    if recorded == FORMAT_VERSION:
+        return None
+    newer, older = max(recorded, FORMAT_VERSION), min(recorded, FORMAT_VERSION)
+    changes = "; ".join(
+        f"format {v}: {FORMAT_CHANGES.get(v, 'unknown to this otonav')}"
+        for v in range(older + 1, newer + 1)
+    )
+    return (
+        f"the recording is format_version {recorded}, this otonav writes {FORMAT_VERSION} "
+        f"({changes})"
+    )
+
+
 _MAGIC = b"\x89MCAP0\r\n"
 # DataEnd (CRC 0: not computed) and a Footer with no summary section, then the magic:
 # what closes a data section nobody can index any more (MCAP spec, records 0x0F, 0x02).
@@ -88,6 +119,7 @@ class RecordingWriter:
             self._file, chunk_size=chunk_size, compression=CompressionType.ZSTD
         )
         self._writer.start(profile="ros2", library=_library())
+        self._writer.add_metadata(FORMAT_METADATA, {"format_version": str(FORMAT_VERSION)})
         self._file.flush()
         self._good = self._file.tell()  # the end of what is on disk, at a record boundary
         self.failed: DiskFullError | None = None

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Literal
 
 from otonav.msgs import Message
+from otonav.record.writer import FORMAT_METADATA, format_difference
 from otonav.replay.compare import Divergence, Replayed, TopicComparison, compare_topic
 from otonav.replay.feed import Feeder, FeedSource, Gate, ReplayClock, plan_instants
 from otonav.replay.nodes import build_nodes
@@ -66,6 +67,9 @@ class ReplayResult:
     cpu_time_s: float = 0.0
     """The process's CPU time over the same span as ``wall_time_s`` (on a busy machine
     the wall time follows the load, this less)."""
+    format_change: str | None = None
+    """What differs between the recording's ``format_version`` and this otonav's (the
+    engine's order within an instant, ADR 0084); None when they are the same."""
 
     @property
     def passed(self) -> bool:
@@ -336,4 +340,12 @@ def _replay(
         config,
         replayed,
         time.process_time() - cpu_start,
+        recording_format_change(meta.metadata),
     )
+
+
+def recording_format_change(metadata: dict[str, dict[str, str]]) -> str | None:
+    """What differs between a recording's format (its metadata records; none: version
+    1) and the one this otonav writes; None when they are the same."""
+    text = metadata.get(FORMAT_METADATA, {}).get("format_version", "1")
+    return format_difference(int(text) if text.isdigit() else 0)

@@ -56,6 +56,7 @@ class Subscription(Generic[M]):
     """A mailbox: the receiving end of a topic for one subscriber."""
 
     __slots__ = (
+        "_callback",
         "_depth",
         "_loop_waiter",
         "_queue",
@@ -230,10 +231,38 @@ class Subscription(Generic[M]):
     async def __anext__(self) -> M:
         return await self.recv()
 
+    def deliver_to(self, callback: Callable[[M], object]) -> None:
+        """From now on hand each message to ``callback(message)`` inside the publisher's
+        call, as a ROS 2 subscription callback but with no task of its own: the waiting
+        messages first, then each as it is published (counted received and taken; never
+        full). What ``callback`` raises, the publisher raises. For an actor's input that
+        needs no wake-up of its own: the bridge applies /wheel_cmd so (ADR 0084)."""
+        self._callback = callback
+        self.__class__ = _CallbackSubscription
+        while (message := self.try_recv()) is not None:
+            callback(message)
+
     def statistics(self) -> MailboxStatistics:
         return MailboxStatistics(
             self.received, self.taken, self.dropped, len(self._queue), self._depth
         )
+
+
+class _CallbackSubscription(Subscription[M]):
+    """A mailbox whose messages go to its callback as they are offered
+    (:meth:`Subscription.deliver_to`)."""
+
+    __slots__ = ()
+    _callback: Callable[[M], object]
+
+    def _offer(self, message: M) -> bool:
+        self.received += 1
+        self.taken += 1
+        self._callback(message)
+        return True
+
+    def _has_room(self, n: int) -> bool:
+        return True
 
 
 class Publisher(Generic[M]):

@@ -4,6 +4,8 @@ blocks a turn on the spot."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -110,3 +112,31 @@ def test_the_stopping_reach_is_latency_braking_and_the_integration_slack() -> No
     edge = p.radius + stopping_reach(0.4, p)
     assert safe_command(0.4, 0.0, 0.4, 0.0, _wall(edge + 1e-3), p).reason == "clear"
     assert safe_command(0.4, 0.0, 0.4, 0.0, _wall(edge - 1e-3), p).reason != "clear"
+
+
+def test_a_tiny_max_accel_bounds_the_stopping_grid_and_stays_safe(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """base.max_accel = 0.001: stopping from 0.5 m/s takes 500 s (125 m). The grid is
+    capped (it grew as v^2 / max_accel: ~25,000 steps, ~0.15 s a call) and the path past
+    it is bounded, so a wall 40 m ahead is still judged unsafe at full speed."""
+    import otonav.nav.safety as safety
+
+    steps: list[int] = []
+    profile = safety._profile
+
+    def counted(*args: Any) -> Any:
+        out = profile(*args)
+        steps.append(out.shape[1])
+        return out
+
+    monkeypatch.setattr(safety, "_profile", counted)
+    tiny = SafetyParams(radius=0.32, max_accel=0.001, max_alpha=3.0, latency=0.12)
+    r = safe_command(0.5, 0.0, 0.5, 0.0, _wall(40.0), tiny)
+    assert max(steps) <= 501  # 10 s of path at dt 0.02
+    assert r.reason == "stopped"
+    # From rest, the same base barely moves in the latency: it may go.
+    steps.clear()
+    r = safe_command(0.5, 0.0, 0.0, 0.0, _wall(1.0), tiny)
+    assert r.reason == "safe"
+    assert max(steps) <= 501

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from otonav.actors import Bridge, topics
-from otonav.hal import FakeHardware
+from otonav.hal import FakeHardware, WheelSetpoint
 from otonav.msgs import Clock, Imu, LaserScan, Odometry, TFMessage, Time, WheelCommand
 from otonav.runtime import QoS, Reliability, Subscription, System, virtual_loop_factory
 
@@ -339,7 +339,9 @@ def test_wheel_commands_on_wheel_cmd_reach_the_hardware() -> None:
             # Applied at the instant it was published (t = 0), held for 0.1 s.
             assert state.left_position == pytest.approx(0.2, abs=1e-12)
             assert state.right_position == pytest.approx(-0.1, abs=1e-12)
-            await wheels.publish(WheelCommand(left=3.0, right=3.0))
+            wheels.publish_nowait(WheelCommand(left=3.0, right=3.0))
+            # In the publisher's call, with no task of the bridge's in between (ADR 0084).
+            assert hal._cmd == WheelSetpoint(3.0, 3.0)
             await anyio.sleep(0.1)
             state = hal.read_wheels()
             assert (state.left_velocity, state.right_velocity) == (3.0, 3.0)

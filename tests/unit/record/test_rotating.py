@@ -39,7 +39,10 @@ def test_rotation_keeps_the_newest_files_under_the_cap(tmp_path: Path) -> None:
     for path in (writer.rotated(2), writer.rotated(1), live):
         summary = summarize(path)
         assert not summary.truncated
-        assert summary.metadata == {"otonav.world": {"obstacles": "[]", "walls": "[]"}}
+        assert summary.metadata == {
+            "otonav.recording": {"format_version": "2"},
+            "otonav.world": {"obstacles": "[]", "walls": "[]"},
+        }
         assert path.stat().st_size < 8 * CHUNK + 2 * CHUNK + 4096  # one chunk + summary over
     # Oldest to newest, the kept files are contiguous: no message lost at a rotation.
     times = _times(writer.rotated(2)) + _times(writer.rotated(1)) + _times(live)

@@ -377,3 +377,30 @@ def test_publish_nowait_delivers_to_all_or_to_none() -> None:
     assert [m.n for m in strict.drain()] == [3]
     with pytest.raises(TopicTypeError):
         pub.publish_nowait("not a ping")  # type: ignore[arg-type]
+
+
+def test_a_mailbox_delivering_to_a_callback_hands_over_in_the_publishers_call() -> None:
+    """deliver_to (ADR 0084): the waiting messages first, in order, then each one inside
+    publish/publish_nowait/try_publish_all, counted received and taken, never full;
+    what the callback raises, the publisher raises."""
+    bus = Bus()
+    pub = bus.publisher("/p", Ping, VOLATILE_RELIABLE, endpoint=Endpoint("a", "out"))
+    sub = bus.subscribe("/p", Ping, QoS(depth=2), endpoint=Endpoint("b", "in"))
+    got: list[int] = []
+    pub.publish_nowait(Ping(1))
+    pub.publish_nowait(Ping(2))
+    sub.deliver_to(lambda m: got.append(m.n))
+    assert got == [1, 2]
+    for n in (3, 4, 5):
+        pub.publish_nowait(Ping(n))  # depth 2, reliable: it would be full without it
+    assert pub.try_publish_all([Ping(6), Ping(7), Ping(8)])
+    assert got == [1, 2, 3, 4, 5, 6, 7, 8]
+    stats = sub.statistics()
+    assert (stats.received, stats.taken, stats.queued, stats.dropped) == (8, 8, 0, 0)
+
+    def refuse(m: Ping) -> None:
+        raise ValueError(f"bad {m.n}")
+
+    sub.deliver_to(refuse)
+    with pytest.raises(ValueError, match="bad 9"):
+        pub.publish_nowait(Ping(9))
