@@ -52,7 +52,7 @@ bench: $(STAMP)
 ## AST mutation testing of the nav math (safety, DWA, A*, plan grid, recovery, scan
 ## matching and its map) against the unit layer: prints the kill rate per module, raw and
 ## over the mutants not in scripts/mutation_equivalent.txt, and every survivor (a
-## report, not part of `make test`; MUTATION_ARGS="otonav.nav.dwa --ids ..." for one)
+## report, not part of `make test`; MUTATION_ARGS="otonav.nav._dwa --ids ..." for one)
 mutation: $(STAMP)
 	$(PY) scripts/mutation.py --show-survivors $(MUTATION_ARGS)
 

@@ -42,11 +42,11 @@ from pathlib import Path
 import numpy as np
 
 from otonav.scenario import run_scenario
-from otonav.scenario.config import GoalSpec, ScenarioConfig, StartSpec
+from otonav.scenario._config import GoalSpec, ScenarioConfig, StartSpec
 from otonav.stack import StackConfig
-from otonav.stack.files import ConfigFileError
-from otonav.stack.loading import load_stack_file
-from otonav.stack.overrides import apply_overrides
+from otonav.stack._files import ConfigFileError
+from otonav.stack._loading import load_stack_file
+from otonav.stack._overrides import apply_overrides
 
 HERE = Path(__file__).resolve().parent / "barn"
 WORLDS = HERE / "worlds.txt"

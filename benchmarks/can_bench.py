@@ -42,14 +42,14 @@ import json, sys, tempfile, time
 from pathlib import Path
 from otonav.scenario import run_scenario
 from otonav.stack import StackConfig
-from otonav.stack.overrides import apply_overrides
+from otonav.stack._overrides import apply_overrides
 kind, record = sys.argv[1], sys.argv[2] == "1"
 stack = apply_overrides(StackConfig(), [f"hal.kind={kind}"])
 # MuJoCo's modules are loaded by the imports above; the CAN modules (and python-can)
 # load lazily when the world is built. Time them apart so both CPU figures compare.
 imports = time.process_time()
 if kind == "can":
-    import otonav.hal.can, otonav.hal.can.tap, otonav.hal.sim
+    import otonav.hal.can, otonav.hal.can._tap, otonav.hal.sim
 imports = time.process_time() - imports
 with tempfile.TemporaryDirectory() as out:
     cpu = time.process_time()
@@ -64,11 +64,11 @@ _FLOOR = """
 import json, sys, tempfile, time
 from pathlib import Path
 import can
-from otonav.hal.can.tap import FRAMES_TOPIC
-from otonav.record.reader import summarize
+from otonav.hal.can._tap import FRAMES_TOPIC
+from otonav.record._reader import summarize
 from otonav.scenario import run_scenario
 from otonav.stack import StackConfig
-from otonav.stack.overrides import apply_overrides
+from otonav.stack._overrides import apply_overrides
 # How many frames one CAN run puts on the bus: its recording's /can/frames (untimed).
 stack = apply_overrides(StackConfig(), ["hal.kind=can"])
 with tempfile.TemporaryDirectory() as out:
@@ -79,7 +79,7 @@ instants = round(v.sim_time_s / 0.01)
 per = [frames * (i + 1) // instants - frames * i // instants for i in range(instants)]
 # As otonav's endpoints use it: sim timestamps kept, one message refilled (the endpoint's
 # class, whose per-receiver copy skips Message's constructor), bytes data.
-from otonav.hal.can.bus import _Outgoing
+from otonav.hal.can._bus import _Outgoing
 a = can.Bus(interface="virtual", channel="floor", preserve_timestamps=True)
 b = can.Bus(interface="virtual", channel="floor", preserve_timestamps=True)
 msg = _Outgoing(is_extended_id=False, check=False)
@@ -102,11 +102,11 @@ print(json.dumps({"frames": frames, "instants": instants, "cpu": best[0], "wall"
 _SPLIT = """
 import collections, json, sys, tempfile, time
 from pathlib import Path
-from otonav.hal.can import bus
-from otonav.hal.can.bus import RawFrame
+from otonav.hal.can import _bus as bus
+from otonav.hal.can._bus import RawFrame
 from otonav.scenario import run_scenario
 from otonav.stack import StackConfig
-from otonav.stack.overrides import apply_overrides
+from otonav.stack._overrides import apply_overrides
 
 class DequeEndpoint:
     # Measuring instrument only: frames cross a deque instead of python-can's bus.
@@ -152,8 +152,8 @@ import gc, json, sys, tempfile, time
 from pathlib import Path
 from otonav.scenario import run_scenario
 from otonav.stack import StackConfig
-from otonav.stack.overrides import apply_overrides
-import otonav.hal.can, otonav.hal.can.tap, otonav.hal.sim
+from otonav.stack._overrides import apply_overrides
+import otonav.hal.can, otonav.hal.can._tap, otonav.hal.sim
 record = sys.argv[2] == "1"
 stacks = {k: apply_overrides(StackConfig(), [f"hal.kind={k}"]) for k in ("mujoco", "can")}
 cpu = {k: [] for k in stacks}

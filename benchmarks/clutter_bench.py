@@ -2,7 +2,7 @@
 fills with boxes, as ``otonav bench`` prints it among its other tables.
 
 The same 17.2 s course with N boxes of 0.1 m off the robot's lane
-(:mod:`otonav.bench.clutter`), each run ``otonav run --no-record`` in a fresh process,
+(:mod:`otonav.bench._clutter`), each run ``otonav run --no-record`` in a fresh process,
 the counts interleaved, medians of ``--reps`` runs; the ratio to the run with no boxes of
 the same session, in wall and in CPU time (steadier on a shared machine); then one
 cProfile run per count (what dominates). Prints the start and end time and the load
@@ -17,7 +17,7 @@ import argparse
 import os
 import time
 
-from otonav.bench.clutter import COUNTS, clutter_curve, format_clutter
+from otonav.bench._clutter import COUNTS, clutter_curve, format_clutter
 
 
 def main() -> None:

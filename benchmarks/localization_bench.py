@@ -31,10 +31,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from otonav.actors import topics
-from otonav.actors.localizer import Localizer
+from otonav.actors._localizer import Localizer
 from otonav.hal import RobotHardwareInterface
 from otonav.msgs import Header, NavState, Point, Pose, PoseStamped, Time
-from otonav.nav.geometry import wrap_angle
+from otonav.nav._geometry import wrap_angle
 from otonav.runtime import (
     LATCHED_QOS,
     Actor,
@@ -46,10 +46,10 @@ from otonav.runtime import (
     virtual_loop_factory,
 )
 from otonav.scenario import run_scenario
-from otonav.scenario.assembly import scenario_world
-from otonav.scenario.builtin import CLUTTERED
+from otonav.scenario._assembly import scenario_world
+from otonav.scenario._builtin import CLUTTERED
 from otonav.stack import StackConfig, build_actors
-from otonav.stack.session import StackSession
+from otonav.stack._session import StackSession
 
 ROUTE = ((4.2, 0.3), (3.5, 3.5), (-3.5, 3.5), (-3.5, -3.5), (3.5, -3.5), (-4.0, 0.0))
 """Waypoints of one lap (m, world = map frame), from the start (-4, 0) of ``cluttered``."""

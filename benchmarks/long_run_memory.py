@@ -19,9 +19,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from otonav.bench.memory import current_rss_mb
+from otonav.bench._memory import current_rss_mb
 from otonav.scenario import ScenarioConfig, run_scenario
-from otonav.scenario.judge import Judge
+from otonav.scenario._judge import Judge
 
 
 def main() -> None:

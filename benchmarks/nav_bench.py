@@ -5,9 +5,9 @@ metric per family.
         [--families sparse dense rooms ...] [--seed0 0] [--set nav.planner=stop]
         [--failures DIR] [--json FILE]
 
-Families: the box densities ``sparse`` and ``dense`` (otonav.scenario.generator
+Families: the box densities ``sparse`` and ``dense`` (otonav.scenario._generator
 presets; each also runs ``--walled`` walled-in worlds of its density) and the indoor
-families of otonav.scenario.generator_indoor (rooms with doors, long walls with the
+families of otonav.scenario._generator_indoor (rooms with doors, long walls with the
 start facing them, U traps, dead ends, slaloms down to the passable limit, alcove and
 corner goals, walled-in rooms), ``--worlds`` each (seeds seed0 .. seed0 + worlds - 1),
 headless in virtual time with the default stack (``--set`` overrides it), on a process
@@ -57,20 +57,20 @@ from typing import Any
 import numpy as np
 import yaml
 
-from otonav.nav.navigate import Navigation
+from otonav.nav._navigate import Navigation
 from otonav.scenario import run_scenario
-from otonav.scenario.config import ScenarioConfig
-from otonav.scenario.generator import (
+from otonav.scenario._config import ScenarioConfig
+from otonav.scenario._generator import (
     PRESETS,
     GeneratedWorld,
     WorldParams,
     generate_world,
     walled_in,
 )
-from otonav.scenario.generator_indoor import INDOOR_FAMILIES, generate_indoor
-from otonav.scenario.generator_report import FamilyRow, RunResult, summarise
+from otonav.scenario._generator_indoor import INDOOR_FAMILIES, generate_indoor
+from otonav.scenario._generator_report import FamilyRow, RunResult, summarise
 from otonav.stack import StackConfig
-from otonav.stack.overrides import apply_overrides
+from otonav.stack._overrides import apply_overrides
 
 BOXES = ("sparse", "dense")
 FAMILIES = (*BOXES, *INDOOR_FAMILIES)

@@ -23,10 +23,11 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from otonav.bench.harness import Case, run_in_children
-from otonav.nav import navigate, navigation
+from otonav.bench._harness import Case, run_in_children
+from otonav.nav import _navigate as navigate
+from otonav.nav import _navigation as navigation
 from otonav.scenario import GoalSpec, ScenarioConfig, StartSpec, run_scenario
-from otonav.scenario.config import BoxSpec
+from otonav.scenario._config import BoxSpec
 
 
 def _timed(store: list[float], fn: Callable[..., Any]) -> Callable[..., Any]:
@@ -71,7 +72,7 @@ def step_times() -> None:
         pending[0] += dt
         return new
 
-    import otonav.actors.safety_layer as layer
+    import otonav.actors._safety_layer as layer
 
     original_check = getattr(layer, "safe_command")  # noqa: B009 (patched for timing)
     setattr(navigate.Navigation, "step", step)  # noqa: B010

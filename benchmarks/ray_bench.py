@@ -1,7 +1,7 @@
 """Is MuJoCo's ray cast limited to the geoms a beam can hit? (issue 30, ADR 0048)
 
 Measures one 360-beam scan (``mj_multiRay`` as ``MujocoInterface.read_scan`` calls it) in
-the clutter bench's worlds (otonav.bench.clutter: N boxes of 0.1 m off the robot's lane),
+the clutter bench's worlds (otonav.bench._clutter: N boxes of 0.1 m off the robot's lane),
 from 13 poses along the course, and what the options MuJoCo offers would change:
 
 - today: one call; and its two parts, the per-scan set-up (one beam) and the per-beam loop;
@@ -10,11 +10,11 @@ from 13 poses along the course, and what the options MuJoCo offers would change:
   (exact: a return nearer than the first cutoff is one the full cast gives);
 - boxes in static bodies, one per 1 m cell (MuJoCo tests a body's bounding sphere before
   its geoms): the scan, and what that layout does to a physics step;
-- otonav's numpy caster for static boxes and planes (ADR 0057, ``otonav.hal.raycast``,
+- otonav's numpy caster for static boxes and planes (ADR 0057, ``otonav.hal._raycast``,
   what read_scan uses from ``LIDAR_CASTER_MIN_BOXES`` boxes), with MuJoCo for the beams
   it is not sure of;
 - a physics step as it was and with the static geoms anchored (ADR 0062,
-  ``otonav.hal.mujoco.static_sleep``: MuJoCo's sleeping skips them in mj_kinematics).
+  ``otonav.hal.mujoco._static_sleep``: MuJoCo's sleeping skips them in mj_kinematics).
 
 Each figure is a median of CPU time (this machine is shared), us per scan or per step; every
 variant's ranges and geom ids are compared with today's ("same" or "DIFFERENT").
@@ -36,10 +36,12 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav.bench.clutter import clutter_scenario
-from otonav.hal.mujoco import lidar, scene_path, static_sleep
-from otonav.hal.raycast import StaticRayCaster
-from otonav.hal.types import LidarSpec
+from otonav.bench._clutter import clutter_scenario
+from otonav.hal._raycast import StaticRayCaster
+from otonav.hal._types import LidarSpec
+from otonav.hal.mujoco import _lidar as lidar
+from otonav.hal.mujoco import _static_sleep as static_sleep
+from otonav.hal.mujoco import scene_path
 
 BEAMS = 360
 RANGE = 8.0

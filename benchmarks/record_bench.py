@@ -27,8 +27,8 @@ from otonav.msgs import (
     Quaternion,
     Time,
 )
-from otonav.record.schemas import schema_for
-from otonav.record.writer import RecordingWriter
+from otonav.record._schemas import schema_for
+from otonav.record._writer import RecordingWriter
 
 
 def _scan(i: int) -> LaserScan:

@@ -31,8 +31,8 @@ _CHILD = """
 import json, sys, time
 from otonav.scenario import run_scenario
 from otonav.stack import StackConfig, build_world
-from otonav.stack.loading import load_stack_file
-from otonav.stack.overrides import apply_overrides
+from otonav.stack._loading import load_stack_file
+from otonav.stack._overrides import apply_overrides
 kind, value = sys.argv[1], sys.argv[2]
 stack = load_stack_file(value) if kind == "config" else apply_overrides(
     StackConfig(), [f"robot.model={value}"])

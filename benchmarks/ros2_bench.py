@@ -24,11 +24,11 @@ import tempfile
 import time
 from pathlib import Path
 
-from otonav.cli.loading import load_scenario
+from otonav.cli._loading import load_scenario
 from otonav.ros2 import Ros2Bridge
 from otonav.scenario import run_scenario
 from otonav.stack import StackConfig
-from otonav.stack.config import Ros2Config
+from otonav.stack._config import Ros2Config
 
 PEER = Path(__file__).resolve().parents[1] / "tests" / "smoke" / "ros2_peer.py"
 

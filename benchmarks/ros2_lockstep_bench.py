@@ -47,7 +47,7 @@ def _env(domain: int) -> dict[str, str]:
 
 _BRIDGE_ONLY = (
     "import dataclasses, json, pathlib, sys; from otonav.ros2 import Ros2Bridge; "
-    "from otonav.stack.config import Ros2Config; "
+    "from otonav.stack._config import Ros2Config; "
     "from otonav.scenario import ScenarioConfig, run_scenario; "
     "from otonav.stack import StackConfig; out = pathlib.Path(sys.argv[1]); "
     "v = run_scenario(ScenarioConfig(), StackConfig(), out_dir=out, plot=False, "

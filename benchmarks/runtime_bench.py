@@ -31,7 +31,7 @@ from typing import Any
 import anyio
 
 from otonav.runtime import Bus, JumpSource, QoS, Reliability, VirtualTimeLoop, virtual_loop_factory
-from otonav.runtime.mailbox import Endpoint
+from otonav.runtime._mailbox import Endpoint
 
 DEPTH = 64
 TICK = 0.001

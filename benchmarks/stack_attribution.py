@@ -1,7 +1,7 @@
 """Where the stack's time goes beyond the bare loop, per stage, in CPU microseconds per
 simulated second (ADR 0058): what stands between (b), (c) and the targets over (a).
 
-The same runs as ``otonav bench`` (otonav.bench.harness: the acceptance world, 30 s of
+The same runs as ``otonav bench`` (otonav.bench._harness: the acceptance world, 30 s of
 sim by default, goal from the scenario), each in a fresh process, interleaved, medians
 of ``--reps``. Inside each run, CPU time (``time.thread_time``) is charged to:
 
@@ -102,17 +102,17 @@ def _timed_method(cls: type, method: str, name: str) -> None:
 
 
 def _instrument() -> None:
-    import otonav.actors.bridge as bridge
-    import otonav.control.kinematics as kinematics
-    import otonav.control.odometry as odometry
-    import otonav.nav.navigate as navigate
-    import otonav.nav.safety as safety
-    import otonav.nav.scan as scan
-    from otonav.actors.avoiding_navigator import AvoidingNavigator
-    from otonav.actors.base_controller import BaseController
-    from otonav.actors.recorder import Recorder
-    from otonav.actors.safety_layer import SafetyLayer
-    from otonav.hal.mujoco.world import MujocoInterface
+    import otonav.actors._bridge as bridge
+    import otonav.control._kinematics as kinematics
+    import otonav.control._odometry as odometry
+    import otonav.nav._navigate as navigate
+    import otonav.nav._safety as safety
+    import otonav.nav._scan as scan
+    from otonav.actors._avoiding_navigator import AvoidingNavigator
+    from otonav.actors._base_controller import BaseController
+    from otonav.actors._recorder import Recorder
+    from otonav.actors._safety_layer import SafetyLayer
+    from otonav.hal.mujoco._world import MujocoInterface
 
     for method, stage in (
         ("advance", "physics (advance)"),
@@ -166,7 +166,7 @@ def _instrument() -> None:
     # drains); each is taken out of the stage it runs in.
     import zstandard
 
-    from otonav.runtime.funnel import _Tap
+    from otonav.runtime._funnel import _Tap
 
     for method in ("_offer", "_offer_all"):
         setattr(_Tap, method, _shared("recorder: funnel offers", getattr(_Tap, method)))
@@ -174,7 +174,7 @@ def _instrument() -> None:
 
 
 def _one(kind: str, duration: float) -> dict[str, float]:
-    from otonav.bench.harness import Case, run_case
+    from otonav.bench._harness import Case, run_case
 
     _instrument()
     run_case(Case(kind, 2.0))  # warm: lazy imports, first-use compilation

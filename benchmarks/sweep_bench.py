@@ -38,7 +38,7 @@ from pathlib import Path
 from typing import Any
 
 from otonav.sweep import execute, make_backend, plan_runs, prepare
-from otonav.sweep.spec import SeedRange, SweepSpec
+from otonav.sweep._spec import SeedRange, SweepSpec
 
 SHORT = "name: short\nscene: empty\ngoal: {x: 1.0, y: 0.3}\nsim_budget: 4.0\n"
 
@@ -189,7 +189,7 @@ def main() -> None:
         if not args.no_ray:
             import ray
 
-            from otonav.sweep.backends.ray import init_local
+            from otonav.sweep.backends._ray import init_local
 
             start = time.perf_counter()
             init_local(2)  # as `--backend ray` starts one: nothing written to ~/.ray

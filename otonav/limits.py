@@ -169,7 +169,7 @@ _US_PER_BEAM = 0.5
 _US_PER_BOX_STEP = 0.02
 """Wall µs per box per physics step: MuJoCo places every geom at every step and the
 sampled forward pass (measured 10-13 ns per box, issue 30). The judge's clearance no
-longer costs per box (otonav/scenario/clearance.py)."""
+longer costs per box (otonav/scenario/_clearance.py)."""
 _US_PER_BOX_BEAM = 0.01
 """Wall µs per box per lidar beam cast by mj_multiRay (worlds with fewer than
 :data:`LIDAR_CASTER_MIN_BOXES` boxes): it tests every box's bounds for every beam, and
@@ -177,12 +177,12 @@ sets every box's angular bounds up once per scan (measured 5.6 ns per box and be
 0.26 us per box and scan at 360 beams, issue 30)."""
 LIDAR_CASTER_MIN_BOXES = 400
 """From this many static boxes the lidar casts them with otonav's numpy caster
-(``otonav/hal/raycast.py``, ADR 0057: the same returns as mj_multiRay), whose cost per
+(``otonav/hal/_raycast.py``, ADR 0057: the same returns as mj_multiRay), whose cost per
 scan is mostly fixed; below it, one mj_multiRay call is cheaper."""
 STATIC_SLEEP_MIN_GEOMS = 100
 """From this many static geoms (world body and bodies welded to it) the world anchors
 them with MuJoCo's sleeping so that ``mj_kinematics`` places them once, not at every step
-(``otonav/hal/mujoco/static_sleep.py``, ADR 0062: the same physics bit for bit). Below
+(``otonav/hal/mujoco/_static_sleep.py``, ADR 0062: the same physics bit for bit). Below
 it the sleep bookkeeping (~0.6 us a step) costs more than it saves (~9 ns a geom)."""
 _US_CASTER_PER_BEAM = 3.0
 """Wall µs per beam of a scan by the numpy caster, whatever the box count (measured

@@ -351,7 +351,7 @@ def scenario_reference() -> str:
 
 
 def sweep_reference() -> str:
-    from otonav.sweep.spec import SweepSpec
+    from otonav.sweep._spec import SweepSpec
 
     return config_table(SweepSpec, None)
 

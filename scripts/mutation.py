@@ -59,39 +59,39 @@ from types import CodeType
 ROOT = Path(__file__).resolve().parent.parent
 
 TARGETS: dict[str, tuple[str, ...]] = {
-    "otonav.nav.safety": (
+    "otonav.nav._safety": (
         "tests/unit/test_safety_limit.py",
         "tests/unit/test_safety_reference.py",
         "tests/unit/test_safety_properties.py",
     ),
-    "otonav.nav.dwa": (
+    "otonav.nav._dwa": (
         "tests/unit/test_nav_planning.py",
         "tests/unit/test_dwa_reference.py",
         "tests/unit/test_dwa_documented.py",
     ),
-    "otonav.nav.global_path": (
+    "otonav.nav._global_path": (
         "tests/unit/test_nav_planning.py",
         "tests/unit/test_nav_indoor.py",
         "tests/unit/test_nav_search.py",
         "tests/unit/test_astar_contract.py",
     ),
-    "otonav.nav.plan_grid": (
+    "otonav.nav._plan_grid": (
         "tests/unit/test_nav_indoor.py",
         "tests/unit/test_nav_search.py",
         "tests/unit/test_plan_grid_contract.py",
     ),
-    "otonav.nav.recovery": (
+    "otonav.nav._recovery": (
         "tests/unit/test_nav_planning.py",
         "tests/unit/test_nav_indoor.py",
         "tests/unit/test_recovery_reference.py",
     ),
-    "otonav.nav.scan_match": (
+    "otonav.nav._scan_match": (
         "tests/unit/test_scan_match.py",
         "tests/unit/test_scan_match_reference.py",
         "tests/unit/test_scan_match_documented.py",
         "tests/unit/test_localizer.py",
     ),
-    "otonav.nav.scan_map": (
+    "otonav.nav._scan_map": (
         "tests/unit/test_scan_match.py",
         "tests/unit/test_scan_map_reference.py",
         "tests/unit/test_localizer.py",

@@ -38,7 +38,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from otonav.record.reader import read_messages, summarize  # noqa: E402
+from otonav.record._reader import read_messages, summarize  # noqa: E402
 
 SCENARIO = "acceptance"
 

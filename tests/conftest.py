@@ -11,8 +11,8 @@ import pytest
 from sabotage import sabotaged_robot as _sabotaged_robot
 from sabotage import sabotaged_robot_config as _sabotaged_robot_config
 
-from otonav.hal.description import RobotDescription
-from otonav.stack.config import RobotConfig
+from otonav.hal._description import RobotDescription
+from otonav.stack._config import RobotConfig
 
 pytest_plugins = ["pytester"]
 

@@ -1,4 +1,4 @@
-"""The DWA's documented sampling (otonav.nav.dwa's module docstring), written as a plain
+"""The DWA's documented sampling (otonav.nav._dwa's module docstring), written as a plain
 per-sample loop: the reference the DWA unit tests compare ``dwa_step`` against."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from otonav.nav.dwa import ClearanceFn, DwaParams, DwaResult
+from otonav.nav._dwa import ClearanceFn, DwaParams, DwaResult
 
 Pose = tuple[float, float, float]
 

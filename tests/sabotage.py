@@ -10,8 +10,8 @@ import re
 from pathlib import Path
 from typing import Final
 
-from otonav.hal.description import RobotDescription, builtin_robot
-from otonav.stack.config import MountConfig, RobotConfig
+from otonav.hal._description import RobotDescription, builtin_robot
+from otonav.stack._config import MountConfig, RobotConfig
 
 BUG_KV: Final = 10.0
 """Velocity-actuator gain (N m s/rad) of the sabotaged drives."""

@@ -1,6 +1,6 @@
 """The safety limit's documented stopping model, written as a plain loop (no numpy
 integration, no horizon): the reference the safety unit tests compare
-``otonav.nav.safety`` against."""
+``otonav.nav._safety`` against."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from otonav.nav.safety import SafetyParams
+from otonav.nav._safety import SafetyParams
 
 
 def speed_profile(start: float, target: float, tm: float, latency: float, limit: float) -> float:

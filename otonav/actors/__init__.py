@@ -4,13 +4,13 @@
 ``topics.SENSOR_QOS``), as a ROS 2 interface package names them.
 """
 
-from otonav.actors import topics
-from otonav.actors.avoiding_navigator import AvoidingNavigator
-from otonav.actors.base_controller import BaseController, BaseLimits
-from otonav.actors.bridge import Bridge
-from otonav.actors.command_watch import EXTERNAL_COMMAND_WAIT, CommandWatch
-from otonav.actors.navigator import Navigator
-from otonav.actors.safety_layer import SafetyLayer
+from otonav.actors import _topics as topics
+from otonav.actors._avoiding_navigator import AvoidingNavigator
+from otonav.actors._base_controller import BaseController, BaseLimits
+from otonav.actors._bridge import Bridge
+from otonav.actors._command_watch import EXTERNAL_COMMAND_WAIT, CommandWatch
+from otonav.actors._navigator import Navigator
+from otonav.actors._safety_layer import SafetyLayer
 
 __all__ = (
     "EXTERNAL_COMMAND_WAIT",

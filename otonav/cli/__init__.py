@@ -18,10 +18,10 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 from otonav.errors import UsageError
-from otonav.record import diskfull as _diskfull
+from otonav.record import _diskfull as _diskfull
 
 if TYPE_CHECKING:
-    from otonav.cli.loading import load_scenario, load_stack
+    from otonav.cli._loading import load_scenario, load_stack
 
 __all__ = ("build_parser", "load_scenario", "load_stack", "main")
 """The command line is the CLI's interface; from Python: :func:`main` (``argv`` as
@@ -82,6 +82,7 @@ class _VersionAction(argparse.Action):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``otonav`` command line: every subcommand and its options."""
     parser = _Parser(
         prog="otonav",
         description="Deterministic robot scenarios in sim time.",
@@ -91,7 +92,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action=_VersionAction, help="print the version and exit")
     commands = parser.add_subparsers(dest="command", parser_class=_Parser, metavar="COMMAND")
     for name in COMMANDS:
-        importlib.import_module(f"otonav.cli.{name}").add_parser(commands)
+        importlib.import_module(f"otonav.cli._{name}").add_parser(commands)
     return parser
 
 
@@ -109,7 +110,7 @@ def main(argv: Sequence[str] | None = None, *, owns_process: bool = False) -> in
         args_list = ["run", *args_list]  # no command = run the default scenario
     args = build_parser().parse_args(args_list)
     args.owns_process = owns_process
-    from otonav.cli import logs
+    from otonav.cli import _logs as logs
 
     logs.install(verbose=getattr(args, "verbose", False))
     try:
@@ -142,5 +143,5 @@ def _disk_full_line(exc: BaseException) -> str:
 
 def __getattr__(name: str) -> object:
     if name in ("load_scenario", "load_stack"):
-        return getattr(importlib.import_module("otonav.cli.loading"), name)
+        return getattr(importlib.import_module("otonav.cli._loading"), name)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,6 +1,6 @@
 """Pure diff-drive math: kinematics, odometry, command limits (no I/O)."""
 
-from otonav.control.kinematics import (
+from otonav.control._kinematics import (
     DiffDriveGeometry,
     Pose2D,
     integrate_odometry,
@@ -8,7 +8,7 @@ from otonav.control.kinematics import (
     twist_to_wheels,
     wheels_to_twist,
 )
-from otonav.control.odometry import OdometryEstimate, estimate_odometry
+from otonav.control._odometry import OdometryEstimate, estimate_odometry
 
 __all__ = (
     "DiffDriveGeometry",

@@ -34,7 +34,7 @@ on the host's loop is the actors' own (a lidar scan ~0.1 ms, an MCAP chunk compr
 every 64 KiB when recording).
 """
 
-from otonav.embed.runs import DEFAULT_MAX_RUNS, check_run, default_limiter, run_scenario_async
+from otonav.embed._runs import DEFAULT_MAX_RUNS, check_run, default_limiter, run_scenario_async
 from otonav.engine import HOST_QOS, LiveStack, LiveSubscription, open_live_stack
 
 __all__ = (

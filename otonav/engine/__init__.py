@@ -8,8 +8,8 @@
   wired in one place for the CLI, the embedding and pytest (:class:`Extras`).
 """
 
-from otonav.engine.extras import Extras, ExtrasError, open_extras
-from otonav.engine.live import HOST_QOS, LiveStack, LiveSubscription, open_live_stack
+from otonav.engine._extras import Extras, ExtrasError, open_extras
+from otonav.engine._live import HOST_QOS, LiveStack, LiveSubscription, open_live_stack
 
 __all__ = (
     "HOST_QOS",

@@ -8,11 +8,11 @@ server is: without it, ``FoxgloveServer`` raises :class:`LiveViewError`).
 
 from typing import TYPE_CHECKING
 
-from otonav.foxglove.errors import LiveViewError
-from otonav.foxglove.view import LiveView
+from otonav.foxglove._errors import LiveViewError
+from otonav.foxglove._view import LiveView
 
 if TYPE_CHECKING:
-    from otonav.foxglove.protocol import FoxgloveServer
+    from otonav.foxglove._protocol import FoxgloveServer
 
 __all__ = ("FoxgloveServer", "LiveView", "LiveViewError")
 
@@ -21,7 +21,7 @@ def __getattr__(name: str) -> object:
     if name != "FoxgloveServer":
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     try:
-        from otonav.foxglove.protocol import FoxgloveServer
+        from otonav.foxglove._protocol import FoxgloveServer
     except ImportError:
         raise LiveViewError(
             "--foxglove needs the foxglove extra: pip install 'otonav[foxglove]'"

@@ -4,10 +4,10 @@
 types, interface and fake does not load MuJoCo.
 """
 
-from otonav.hal.fake import FakeHardware
-from otonav.hal.health import HardwareHealth, HealthLevel
-from otonav.hal.interface import RobotHardwareInterface
-from otonav.hal.types import (
+from otonav.hal._fake import FakeHardware
+from otonav.hal._health import HardwareHealth, HealthLevel
+from otonav.hal._interface import RobotHardwareInterface
+from otonav.hal._types import (
     BoxObstacle,
     GroundTruth,
     ImuSample,

@@ -1,7 +1,7 @@
 """Message types, shaped like the ROS 2 messages they stand for (frozen pydantic)."""
 
 from otonav.msgs._base import Message
-from otonav.msgs.geometry import (
+from otonav.msgs._geometry import (
     Point,
     Pose,
     PoseStamped,
@@ -14,21 +14,21 @@ from otonav.msgs.geometry import (
     TwistWithCovariance,
     Vector3,
 )
-from otonav.msgs.hardware import (
+from otonav.msgs._hardware import (
     DiagnosticArray,
     DiagnosticStatus,
     Frame,
     HardwareStatus,
     KeyValue,
 )
-from otonav.msgs.otonav_msgs import (
+from otonav.msgs._otonav_msgs import (
     NavDiagnostics,
     NavState,
     SafetyState,
     ScenarioVerdict,
     WheelCommand,
 )
-from otonav.msgs.sensors import (
+from otonav.msgs._sensors import (
     Imu,
     JointState,
     LaserScan,
@@ -37,7 +37,7 @@ from otonav.msgs.sensors import (
     Odometry,
     TFMessage,
 )
-from otonav.msgs.std import (
+from otonav.msgs._std import (
     Clock,
     Header,
     Log,

@@ -2,15 +2,15 @@
 guard, the local planner (DWA), the safety limit, and the navigation that ties them
 with a costmap, a global path and recovery (:class:`Navigation`)."""
 
-from otonav.nav.dwa import DwaParams, DwaResult, dwa_step
-from otonav.nav.footprint import centre_clearance
-from otonav.nav.geometry import goal_problem, wrap_angle
-from otonav.nav.go_to_goal import GoalCommand, GoToGoalParams, go_to_goal
-from otonav.nav.guard import GuardParams, guard_blocked
-from otonav.nav.navigate import Navigation
-from otonav.nav.navigation import NavOutput
-from otonav.nav.safety import SafetyParams, SafetyResult, safe_command
-from otonav.params import NavigationParams
+from otonav._params import NavigationParams
+from otonav.nav._dwa import DwaParams, DwaResult, dwa_step
+from otonav.nav._footprint import centre_clearance
+from otonav.nav._geometry import goal_problem, wrap_angle
+from otonav.nav._go_to_goal import GoalCommand, GoToGoalParams, go_to_goal
+from otonav.nav._guard import GuardParams, guard_blocked
+from otonav.nav._navigate import Navigation
+from otonav.nav._navigation import NavOutput
+from otonav.nav._safety import SafetyParams, SafetyResult, safe_command
 
 __all__ = (
     "DwaParams",

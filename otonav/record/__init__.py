@@ -19,18 +19,18 @@ import importlib
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from otonav.record.bag import write_bag_directory
-    from otonav.record.reader import (
+    from otonav.record._bag import write_bag_directory
+    from otonav.record._reader import (
         DamagedRecordingError,
         RecordingError,
         RecordingSummary,
         TopicSummary,
         read_messages,
     )
-    from otonav.record.reader import summarize as summarize_recording
-    from otonav.record.rotating import RotatingRecordingWriter
-    from otonav.record.salvage import salvage
-    from otonav.record.writer import RecordingWriter
+    from otonav.record._reader import summarize as summarize_recording
+    from otonav.record._rotating import RotatingRecordingWriter
+    from otonav.record._salvage import salvage
+    from otonav.record._writer import RecordingWriter
 
 __all__ = (
     "DamagedRecordingError",
@@ -46,16 +46,16 @@ __all__ = (
 )
 
 _LAZY = {
-    "write_bag_directory": "otonav.record.bag",
-    "DamagedRecordingError": "otonav.record.reader",
-    "RecordingError": "otonav.record.reader",
-    "RecordingSummary": "otonav.record.reader",
-    "TopicSummary": "otonav.record.reader",
-    "read_messages": "otonav.record.reader",
-    "summarize_recording": "otonav.record.reader",
-    "RotatingRecordingWriter": "otonav.record.rotating",
-    "salvage": "otonav.record.salvage",
-    "RecordingWriter": "otonav.record.writer",
+    "write_bag_directory": "otonav.record._bag",
+    "DamagedRecordingError": "otonav.record._reader",
+    "RecordingError": "otonav.record._reader",
+    "RecordingSummary": "otonav.record._reader",
+    "TopicSummary": "otonav.record._reader",
+    "read_messages": "otonav.record._reader",
+    "summarize_recording": "otonav.record._reader",
+    "RotatingRecordingWriter": "otonav.record._rotating",
+    "salvage": "otonav.record._salvage",
+    "RecordingWriter": "otonav.record._writer",
 }
 
 

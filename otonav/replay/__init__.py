@@ -8,9 +8,9 @@
 - ``output``: a new MCAP with the replayed outputs beside the recorded inputs.
 """
 
-from otonav.replay.compare import Divergence, TopicComparison
-from otonav.replay.recording import ReplayInputError
-from otonav.replay.runner import ReplayResult, replay_recording
+from otonav.replay._compare import Divergence, TopicComparison
+from otonav.replay._recording import ReplayInputError
+from otonav.replay._runner import ReplayResult, replay_recording
 
 __all__ = (
     "Divergence",

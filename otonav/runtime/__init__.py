@@ -13,8 +13,8 @@
 - ``graph``: the wiring and statistics as data.
 """
 
-from otonav.runtime.actor import Actor, Input, Output
-from otonav.runtime.clock import (
+from otonav.runtime._actor import Actor, Input, Output
+from otonav.runtime._clock import (
     MAX_STEP_BATCH,
     Clock,
     Rate,
@@ -22,7 +22,7 @@ from otonav.runtime.clock import (
     VirtualClock,
     current_clock,
 )
-from otonav.runtime.errors import (
+from otonav.runtime._errors import (
     ActorCrashedError,
     ActorDefinitionError,
     DeadlockError,
@@ -35,11 +35,11 @@ from otonav.runtime.errors import (
     WallClockCeilingError,
     WiringError,
 )
-from otonav.runtime.events import ActorStatus, EventKind, SystemEvent
-from otonav.runtime.graph import Graph
-from otonav.runtime.loop import VirtualTimeLoop, run_blocking, virtual_loop_factory
-from otonav.runtime.mailbox import Bus, Endpoint, MailboxStatistics, Publisher, Subscription
-from otonav.runtime.qos import (
+from otonav.runtime._events import ActorStatus, EventKind, SystemEvent
+from otonav.runtime._graph import Graph
+from otonav.runtime._loop import VirtualTimeLoop, run_blocking, virtual_loop_factory
+from otonav.runtime._mailbox import Bus, Endpoint, MailboxStatistics, Publisher, Subscription
+from otonav.runtime._qos import (
     DEFAULT_QOS,
     LATCHED_QOS,
     SENSOR_DATA_QOS,
@@ -47,10 +47,10 @@ from otonav.runtime.qos import (
     QoS,
     Reliability,
 )
-from otonav.runtime.system import RestartPolicy, System
-from otonav.runtime.timemode import RealTime, TimeMode, Virtual
-from otonav.runtime.timesource import JumpSource, TimeSource
-from otonav.runtime.waits import next_message, until
+from otonav.runtime._system import RestartPolicy, System
+from otonav.runtime._timemode import RealTime, TimeMode, Virtual
+from otonav.runtime._timesource import JumpSource, TimeSource
+from otonav.runtime._waits import next_message, until
 
 __all__ = (
     "DEFAULT_QOS",

@@ -1,6 +1,6 @@
 """Every reach into asyncio's and anyio's private names, in one module.
 
-The virtual-time loop (:mod:`otonav.runtime.loop`) needs what asyncio does not publish:
+The virtual-time loop (:mod:`otonav.runtime._loop`) needs what asyncio does not publish:
 its iteration (``BaseEventLoop._run_once``), its ready queue and timer heap, the timer
 handles' fields, the thresholds for purging cancelled timers; the runners pre-load
 anyio's asyncio backend (``anyio._backends._asyncio``) outside their timed span. Nothing

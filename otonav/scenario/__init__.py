@@ -10,11 +10,11 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING
 
-from otonav.scenario.builtin import BUILTIN
-from otonav.scenario.config import BoxSpec, Coordinate, GoalSpec, ScenarioConfig, StartSpec
+from otonav.scenario._builtin import BUILTIN
+from otonav.scenario._config import BoxSpec, Coordinate, GoalSpec, ScenarioConfig, StartSpec
 
 if TYPE_CHECKING:
-    from otonav.scenario.generator import (
+    from otonav.scenario._generator import (
         DENSE,
         SPARSE,
         GeneratedWorld,
@@ -23,10 +23,10 @@ if TYPE_CHECKING:
         generate_worlds,
         walled_in,
     )
-    from otonav.scenario.judge import Judge
-    from otonav.scenario.run import run_scenario
-    from otonav.scenario.validate import check_goal
-    from otonav.scenario.verdict import Verdict
+    from otonav.scenario._judge import Judge
+    from otonav.scenario._run import run_scenario
+    from otonav.scenario._validate import check_goal
+    from otonav.scenario._verdict import Verdict
 
 __all__ = (
     "BUILTIN",
@@ -49,17 +49,17 @@ __all__ = (
 )
 
 _LAZY = {
-    "DENSE": "otonav.scenario.generator",
-    "SPARSE": "otonav.scenario.generator",
-    "GeneratedWorld": "otonav.scenario.generator",
-    "WorldParams": "otonav.scenario.generator",
-    "generate_world": "otonav.scenario.generator",
-    "generate_worlds": "otonav.scenario.generator",
-    "walled_in": "otonav.scenario.generator",
-    "Judge": "otonav.scenario.judge",
-    "Verdict": "otonav.scenario.verdict",
-    "run_scenario": "otonav.scenario.run",
-    "check_goal": "otonav.scenario.validate",
+    "DENSE": "otonav.scenario._generator",
+    "SPARSE": "otonav.scenario._generator",
+    "GeneratedWorld": "otonav.scenario._generator",
+    "WorldParams": "otonav.scenario._generator",
+    "generate_world": "otonav.scenario._generator",
+    "generate_worlds": "otonav.scenario._generator",
+    "walled_in": "otonav.scenario._generator",
+    "Judge": "otonav.scenario._judge",
+    "Verdict": "otonav.scenario._verdict",
+    "run_scenario": "otonav.scenario._run",
+    "check_goal": "otonav.scenario._validate",
 }
 
 

@@ -1,5 +1,5 @@
 """Composition: the robot stack from its config (the launch file), and the session
-that runs it (time mode, recording, one teardown: ``otonav.stack.session``).
+that runs it (time mode, recording, one teardown: ``otonav.stack._session``).
 
 The config models are imported here; ``build_actors``, ``build_world`` and the session
 (the actors, MuJoCo, numpy) on first use, so reading a config file stays cheap (``otonav --help``).
@@ -10,15 +10,15 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING
 
-from otonav.params import BaseConfig, DwaConfig, GuardConfig, NavConfig, SafetyConfig
-from otonav.stack.config import RatesConfig, StackConfig, WorldConfig
-from otonav.stack.files import ConfigFileError, describe_validation_error, to_json
-from otonav.stack.overrides import apply_overrides
+from otonav._params import BaseConfig, DwaConfig, GuardConfig, NavConfig, SafetyConfig
+from otonav.stack._config import RatesConfig, StackConfig, WorldConfig
+from otonav.stack._files import ConfigFileError, describe_validation_error, to_json
+from otonav.stack._overrides import apply_overrides
 
 if TYPE_CHECKING:
-    from otonav.stack.build import build_actors, build_world
-    from otonav.stack.loading import load_stack_file
-    from otonav.stack.session import StackSession
+    from otonav.stack._build import build_actors, build_world
+    from otonav.stack._loading import load_stack_file
+    from otonav.stack._session import StackSession
 
 __all__ = (
     "BaseConfig",
@@ -40,10 +40,10 @@ __all__ = (
 )
 
 _LAZY = {
-    "build_actors": "otonav.stack.build",
-    "build_world": "otonav.stack.build",
-    "load_stack_file": "otonav.stack.loading",
-    "StackSession": "otonav.stack.session",
+    "build_actors": "otonav.stack._build",
+    "build_world": "otonav.stack._build",
+    "load_stack_file": "otonav.stack._loading",
+    "StackSession": "otonav.stack._session",
 }
 
 

@@ -13,12 +13,12 @@ resume, results, artifacts), ``results`` (results.jsonl), ``stats``/``report``/`
 (the report), ``api`` (iterating results from async code).
 """
 
-from otonav.sweep.api import run_sweep, sweep_results
-from otonav.sweep.plan import RunTask, plan_runs
-from otonav.sweep.report import summarize, write_report
-from otonav.sweep.runner import all_records, execute, make_backend, prepare
-from otonav.sweep.spec import GenerateSpec, SweepSpec, load_sweep
-from otonav.sweep.worker import RunOutcome
+from otonav.sweep._api import run_sweep, sweep_results
+from otonav.sweep._plan import RunTask, plan_runs
+from otonav.sweep._report import summarize, write_report
+from otonav.sweep._runner import all_records, execute, make_backend, prepare
+from otonav.sweep._spec import GenerateSpec, SweepSpec, load_sweep
+from otonav.sweep._worker import RunOutcome
 
 __all__ = (
     "GenerateSpec",

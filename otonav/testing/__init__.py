@@ -6,7 +6,7 @@
 - :func:`replay`: re-simulate an actor against a recording; its divergences.
 """
 
-from otonav.testing.replay import ReplayCrashError, replay
-from otonav.testing.stack import running_stack
+from otonav.testing._replay import ReplayCrashError, replay
+from otonav.testing._stack import running_stack
 
 __all__ = ("ReplayCrashError", "replay", "running_stack")

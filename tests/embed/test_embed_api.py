@@ -20,7 +20,7 @@ from otonav.embed import (
     run_scenario_async,
 )
 from otonav.msgs import LaserScan, Odometry, PoseStamped
-from otonav.record.reader import read_messages, summarize
+from otonav.record._reader import read_messages, summarize
 from otonav.runtime import (
     LATCHED_QOS,
     Actor,
@@ -33,7 +33,7 @@ from otonav.runtime import (
     until,
 )
 from otonav.scenario import GoalSpec, ScenarioConfig
-from otonav.stack.files import ConfigFileError
+from otonav.stack._files import ConfigFileError
 
 pytestmark = pytest.mark.smoke
 

@@ -24,9 +24,9 @@ import httpx
 import pytest
 
 from otonav.embed import run_scenario_async
-from otonav.record.reader import summarize
+from otonav.record._reader import summarize
 from otonav.scenario import run_scenario
-from otonav.scenario.builtin import BUILTIN
+from otonav.scenario._builtin import BUILTIN
 
 pytestmark = pytest.mark.smoke
 

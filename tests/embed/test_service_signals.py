@@ -17,7 +17,7 @@ import httpx
 import pytest
 from children import terminal_signals
 
-from otonav.record.reader import summarize
+from otonav.record._reader import summarize
 
 pytestmark = pytest.mark.smoke
 

@@ -31,7 +31,7 @@ class Hog(Actor):
 
 
 def main() -> int:
-    import otonav.cli.run as run_command
+    import otonav.cli._run as run_command
     from otonav.cli import main as cli
     from otonav.engine import Extras
 

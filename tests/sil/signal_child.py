@@ -40,11 +40,11 @@ def main() -> int:
 
         return entry()
 
-    import otonav.scenario.artifacts as artifacts_module
-    import otonav.scenario.assembly as assembly_module
+    import otonav.scenario._artifacts as artifacts_module
+    import otonav.scenario._assembly as assembly_module
     from otonav.cli import main as cli
-    from otonav.scenario.judge import Judge
-    from otonav.scenario.plot import plot_trajectory
+    from otonav.scenario._judge import Judge
+    from otonav.scenario._plot import plot_trajectory
 
     out, first, second_at = sys.argv[1], sys.argv[2], sys.argv[3]
     sig = {"INT": signal.SIGINT, "TERM": signal.SIGTERM}[first]

@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from otonav.record.reader import read_messages
+from otonav.record._reader import read_messages
 from otonav.replay import replay_recording
-from otonav.replay.nodes import stack_actor_names
+from otonav.replay._nodes import stack_actor_names
 from otonav.scenario import GoalSpec, ScenarioConfig, StartSpec, run_scenario
-from otonav.scenario.config import BoxSpec
+from otonav.scenario._config import BoxSpec
 from otonav.stack import DwaConfig, NavConfig, StackConfig
 
 pytestmark = pytest.mark.sil

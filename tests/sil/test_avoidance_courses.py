@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 
 from otonav.scenario import ScenarioConfig, run_scenario
-from otonav.scenario.builtin import AVOIDANCE, BOX, WALLED_IN
+from otonav.scenario._builtin import AVOIDANCE, BOX, WALLED_IN
 from otonav.stack import StackConfig
-from otonav.stack.overrides import apply_overrides
+from otonav.stack._overrides import apply_overrides
 
 pytestmark = pytest.mark.sil
 

@@ -21,8 +21,8 @@ import pytest
 from otonav.actors import topics
 from otonav.hal import HealthLevel, RobotHardwareInterface, WheelSetpoint
 from otonav.hal.can import CanBusInterface, MonitorLimits, RawFrame, WheelAxis, open_endpoint
-from otonav.hal.can import protocol as p
-from otonav.hal.can.tap import FRAMES_TOPIC
+from otonav.hal.can import _protocol as p
+from otonav.hal.can._tap import FRAMES_TOPIC
 from otonav.hal.mujoco import MujocoInterface
 from otonav.hal.sim import AxisParams, DriveEmulator, DriveMount
 from otonav.msgs import (
@@ -35,7 +35,7 @@ from otonav.msgs import (
     PoseStamped,
     WheelCommand,
 )
-from otonav.record.reader import read_messages, summarize
+from otonav.record._reader import read_messages, summarize
 from otonav.runtime import (
     LATCHED_QOS,
     EventKind,
@@ -47,8 +47,8 @@ from otonav.runtime import (
 )
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.stack import StackConfig, StackSession
-from otonav.stack.build import build_actors, build_world
-from otonav.stack.overrides import apply_overrides
+from otonav.stack._build import build_actors, build_world
+from otonav.stack._overrides import apply_overrides
 from otonav.testing import running_stack
 
 pytestmark = pytest.mark.sil
@@ -639,7 +639,7 @@ def test_cli_without_python_can_names_the_extra(
 def test_a_fault_from_the_cli_starts_at_its_time(tmp_path: Path) -> None:
     from otonav.cli import main
     from otonav.msgs import HardwareStatus
-    from otonav.record.reader import read_messages
+    from otonav.record._reader import read_messages
 
     args = ["run", "--out", str(tmp_path), "--set", "hal.kind=can",
             "--set", "hal.sim.faults.axis_error.node_id=1",

@@ -18,14 +18,14 @@ import pytest
 from otonav.actors import topics
 from otonav.hal import RobotHardwareInterface
 from otonav.hal.can import CanBusInterface
-from otonav.hal.can import protocol as p
+from otonav.hal.can import _protocol as p
 from otonav.hal.sim import DriveEmulator
 from otonav.msgs import Point, Pose, PoseStamped
-from otonav.record.reader import read_messages
+from otonav.record._reader import read_messages
 from otonav.runtime import LATCHED_QOS, until
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.stack import StackConfig
-from otonav.stack.overrides import apply_overrides
+from otonav.stack._overrides import apply_overrides
 from otonav.testing import running_stack
 
 pytestmark = pytest.mark.sil

@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 
 from otonav.actors import topics
-from otonav.actors.avoiding_navigator import AvoidingNavigator
+from otonav.actors._avoiding_navigator import AvoidingNavigator
 from otonav.cli import main
-from otonav.record.reader import read_messages, summarize
+from otonav.record._reader import read_messages, summarize
 
 pytestmark = pytest.mark.sil
 

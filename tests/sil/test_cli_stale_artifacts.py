@@ -16,7 +16,7 @@ import pytest
 from children import terminal_signals
 
 from otonav.cli import main
-from otonav.record.reader import summarize
+from otonav.record._reader import summarize
 
 pytestmark = pytest.mark.sil
 

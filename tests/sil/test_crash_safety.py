@@ -12,8 +12,8 @@ from pathlib import Path
 import pytest
 from children import terminal_signals
 
-from otonav.record.reader import read_messages, summarize
-from otonav.record.salvage import salvage
+from otonav.record._reader import read_messages, summarize
+from otonav.record._salvage import salvage
 
 pytestmark = pytest.mark.sil
 

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 from children import terminal_signals
 
-from otonav.record.reader import summarize
+from otonav.record._reader import summarize
 from otonav.runtime import Actor, WallClockCeilingError
 
 pytestmark = pytest.mark.sil

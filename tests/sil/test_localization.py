@@ -15,18 +15,18 @@ import pytest
 from otonav.actors import topics
 from otonav.hal import RobotHardwareInterface
 from otonav.msgs import Odometry, TFMessage
-from otonav.msgs.geometry import quaternion_yaw
-from otonav.nav.scan_match import compose
-from otonav.record.reader import read_messages
+from otonav.msgs._geometry import quaternion_yaw
+from otonav.nav._scan_match import compose
+from otonav.record._reader import read_messages
 from otonav.runtime import Actor, Input, QoS, Reliability, virtual_loop_factory
 from otonav.scenario import Verdict, run_scenario
-from otonav.scenario.assembly import scenario_session, scenario_world
-from otonav.scenario.builtin import CLUTTERED
-from otonav.scenario.judge import Judge
-from otonav.scenario.judged import drive
-from otonav.scenario.verdict import judge_verdict
+from otonav.scenario._assembly import scenario_session, scenario_world
+from otonav.scenario._builtin import CLUTTERED
+from otonav.scenario._judge import Judge
+from otonav.scenario._judged import drive
+from otonav.scenario._verdict import judge_verdict
 from otonav.stack import StackConfig
-from otonav.stack.overrides import apply_overrides
+from otonav.stack._overrides import apply_overrides
 
 pytestmark = pytest.mark.sil
 

@@ -23,9 +23,9 @@ def test_no_run_leaves_its_world_for_a_later_runs_ticks() -> None:
     """Two short generated worlds in this process as a benchmark worker runs them: after
     each, no object of a per-run type is alive (this test collects nothing itself), so
     no later tick can absorb its collection; and the ticks were timed."""
-    from otonav.runtime.loop import VirtualTimeLoop
-    from otonav.runtime.system import System
-    from otonav.stack.session import StackSession
+    from otonav.runtime._loop import VirtualTimeLoop
+    from otonav.runtime._system import System
+    from otonav.stack._session import StackSession
 
     per_run = (StackSession, System, VirtualTimeLoop)
 

@@ -12,7 +12,7 @@ import pytest
 
 from otonav.actors import topics
 from otonav.cli import main
-from otonav.record.reader import read_messages
+from otonav.record._reader import read_messages
 
 pytestmark = pytest.mark.sil
 

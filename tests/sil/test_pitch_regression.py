@@ -13,11 +13,11 @@ from otonav.actors import topics
 from otonav.hal import RobotHardwareInterface
 from otonav.hal.mujoco import MujocoInterface
 from otonav.msgs import LaserScan, NavState, PoseStamped
-from otonav.msgs.geometry import Point, Pose
+from otonav.msgs._geometry import Point, Pose
 from otonav.runtime import LATCHED_QOS, Actor, Input
 from otonav.scenario import ScenarioConfig
 from otonav.stack import GuardConfig, NavConfig, StackConfig, WorldConfig
-from otonav.stack.config import RobotConfig
+from otonav.stack._config import RobotConfig
 from otonav.testing import running_stack
 
 pytestmark = pytest.mark.sil

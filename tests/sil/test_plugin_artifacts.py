@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from otonav.record.reader import summarize
+from otonav.record._reader import summarize
 
 pytestmark = pytest.mark.sil
 
@@ -67,7 +67,7 @@ SHORT_FAILURES = """
 import pytest
 from otonav.runtime import until
 from otonav.stack import StackConfig
-from otonav.stack.config import ActorConfig
+from otonav.stack._config import ActorConfig
 from otonav.testing import running_stack
 
 PROBES = {probes!r}

@@ -14,7 +14,7 @@ from mcap_ros2.decoder import DecoderFactory
 
 import otonav
 from otonav.control import DiffDriveGeometry, twist_to_wheels
-from otonav.record.reader import read_messages, summarize
+from otonav.record._reader import read_messages, summarize
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.stack import NavConfig, StackConfig
 
@@ -140,7 +140,7 @@ def test_wrong_sign_in_the_kinematics_fails_and_leaves_its_recording(
         return twist_to_wheels(v, -omega, geometry)  # the seeds' classic: wheels swapped
 
     # The base controller looks the function up in its own module at each call.
-    monkeypatch.setattr("otonav.actors.base_controller.twist_to_wheels", flipped)
+    monkeypatch.setattr("otonav.actors._base_controller.twist_to_wheels", flipped)
     scenario = ScenarioConfig()
     verdict = run_scenario(scenario, out_dir=tmp_path)
     assert not verdict.passed

@@ -18,20 +18,21 @@ import pytest
 from otonav.cli import main as cli_main
 from otonav.hal import RobotHardwareInterface
 from otonav.msgs import Clock, Imu, Message, Odometry, PoseStamped, TFMessage, Twist
-from otonav.msgs.flat import is_flat
+from otonav.msgs._flat import is_flat
 from otonav.nav import GoalCommand, go_to_goal
+from otonav.record._reader import MAGIC, read_messages, summarize
+from otonav.record._writer import RecordingWriter
 from otonav.record.cdr import decode
-from otonav.record.reader import MAGIC, read_messages, summarize
-from otonav.record.writer import RecordingWriter
-from otonav.replay import nodes, replay_recording
-from otonav.replay.feed import FLAT_LAYOUTS
-from otonav.replay.lazy import input_maker
-from otonav.replay.nodes import stack_actor_names
-from otonav.replay.recording import load_recording
+from otonav.replay import _nodes as nodes
+from otonav.replay import replay_recording
+from otonav.replay._feed import FLAT_LAYOUTS
+from otonav.replay._lazy import input_maker
+from otonav.replay._nodes import stack_actor_names
+from otonav.replay._recording import load_recording
 from otonav.runtime import JumpSource, RealTime, VirtualTimeLoop
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.stack import NavConfig, SafetyConfig, StackConfig, build_world
-from otonav.stack.worldmeta import WORLD_METADATA, geometry_from_metadata, world_metadata
+from otonav.stack._worldmeta import WORLD_METADATA, geometry_from_metadata, world_metadata
 from otonav.testing import replay
 
 pytestmark = pytest.mark.sil
@@ -92,7 +93,7 @@ def test_the_recorded_robot_spares_building_the_world(
     assert [stack.world.lidar_range_max for stack in built] == [7.5]
     # A recording made before the geometry was kept builds the world, as it did.
     monkeypatch.setattr(
-        "otonav.stack.session.world_metadata",
+        "otonav.stack._session.world_metadata",
         lambda hal: {k: v for k, v in world_metadata(hal).items() if k != "robot"},
     )
     run_scenario(ScenarioConfig(sim_budget=1.0), stack=STOP_ONLY, out_dir=tmp_path, plot=False)
@@ -132,7 +133,7 @@ def test_a_deliberate_change_is_reported_at_its_first_divergence(
         command = go_to_goal(*args, **kwargs)  # type: ignore[arg-type]
         return dataclasses.replace(command, omega=command.omega * 0.9)
 
-    monkeypatch.setattr("otonav.actors.navigator.go_to_goal", sluggish)
+    monkeypatch.setattr("otonav.actors._navigator.go_to_goal", sluggish)
     divergences = replay(acceptance, "nav")
     assert divergences
     first = divergences[0]

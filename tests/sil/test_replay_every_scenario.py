@@ -14,9 +14,9 @@ from pathlib import Path
 import pytest
 
 from otonav.replay import replay_recording
-from otonav.replay.nodes import stack_actor_names
+from otonav.replay._nodes import stack_actor_names
 from otonav.scenario import ScenarioConfig, run_scenario
-from otonav.scenario.builtin import BUILTIN
+from otonav.scenario._builtin import BUILTIN
 from otonav.stack import StackConfig
 
 pytestmark = pytest.mark.sil

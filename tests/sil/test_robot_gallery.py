@@ -9,13 +9,13 @@ from pathlib import Path
 import pytest
 
 from otonav.cli import main
-from otonav.record.reader import read_messages
+from otonav.record._reader import read_messages
 from otonav.scenario import ScenarioConfig, run_scenario
-from otonav.scenario.builtin import BUILTIN
-from otonav.scenario.replay import recorded_plot
+from otonav.scenario._builtin import BUILTIN
+from otonav.scenario._replay import recorded_plot
 from otonav.stack import StackConfig
-from otonav.stack.loading import load_stack_file
-from otonav.stack.overrides import apply_overrides
+from otonav.stack._loading import load_stack_file
+from otonav.stack._overrides import apply_overrides
 
 pytestmark = pytest.mark.sil
 

@@ -21,7 +21,7 @@ from typing import Any
 import pytest
 from dds_domain import exclusive_domain
 
-from otonav.record.reader import read_messages, summarize
+from otonav.record._reader import read_messages, summarize
 
 pytestmark = pytest.mark.sil
 

@@ -13,7 +13,7 @@ from rosbags.rosbag2 import Reader
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from otonav.cli import main
-from otonav.record.reader import summarize
+from otonav.record._reader import summarize
 
 pytestmark = pytest.mark.sil
 

@@ -13,7 +13,7 @@ from otonav.actors import topics
 from otonav.msgs import Twist, Vector3
 from otonav.runtime import Actor, Output
 from otonav.scenario import GoalSpec, ScenarioConfig, StartSpec, run_scenario
-from otonav.scenario.config import BoxSpec
+from otonav.scenario._config import BoxSpec
 from otonav.stack import NavConfig, SafetyConfig, StackConfig
 
 pytestmark = pytest.mark.sil

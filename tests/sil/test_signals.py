@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from children import terminal_signals
 
-from otonav.record.reader import read_messages, summarize
+from otonav.record._reader import read_messages, summarize
 
 pytestmark = pytest.mark.sil
 

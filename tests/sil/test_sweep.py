@@ -25,9 +25,9 @@ import pytest
 
 from otonav.cli import main
 from otonav.sweep import execute, load_sweep, make_backend, plan_runs, prepare, sweep_results
-from otonav.sweep.plan import RunTask
-from otonav.sweep.results import read_results
-from otonav.sweep.worker import FAULT_ENV
+from otonav.sweep._plan import RunTask
+from otonav.sweep._results import read_results
+from otonav.sweep._worker import FAULT_ENV
 
 pytestmark = pytest.mark.sil
 
@@ -176,11 +176,11 @@ def test_a_warm_worker_frees_each_run_before_the_next(tmp_path: Path) -> None:
     crept (docs/adr/0029). Here the real worker code runs real runs in this process, and
     after each one no object of a per-run type may be alive, without this test
     collecting anything."""
-    from otonav.record.writer import RecordingWriter
-    from otonav.runtime.loop import VirtualTimeLoop
-    from otonav.runtime.system import System
-    from otonav.stack.session import StackSession
-    from otonav.sweep.worker import WarmWorker
+    from otonav.record._writer import RecordingWriter
+    from otonav.runtime._loop import VirtualTimeLoop
+    from otonav.runtime._system import System
+    from otonav.stack._session import StackSession
+    from otonav.sweep._worker import WarmWorker
 
     per_run = (StackSession, System, VirtualTimeLoop, RecordingWriter)
 
@@ -347,7 +347,7 @@ def local_ray(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
     home: yields that home, where Ray must leave nothing (no ``.ray/auth_token``)."""
     import ray  # the dev extra includes otonav[ray]: a missing Ray fails, never skips
 
-    from otonav.sweep.backends.ray import init_local
+    from otonav.sweep.backends._ray import init_local
 
     home = tmp_path_factory.mktemp("home")
     saved = {k: os.environ.pop(k, None) for k in ("HOME", *_RAY_AUTH)}

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from otonav.sweep.results import read_results
+from otonav.sweep._results import read_results
 
 pytestmark = pytest.mark.sil
 

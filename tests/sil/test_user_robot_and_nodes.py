@@ -14,12 +14,12 @@ from mcap.reader import make_reader
 
 from otonav.cli import main
 from otonav.msgs import Log, NavState
-from otonav.record.reader import read_messages
+from otonav.record._reader import read_messages
 from otonav.runtime import until
 from otonav.scenario import ScenarioConfig, run_scenario
-from otonav.scenario.builtin import BUILTIN
+from otonav.scenario._builtin import BUILTIN
 from otonav.stack import StackConfig
-from otonav.stack.config import RobotConfig
+from otonav.stack._config import RobotConfig
 from otonav.testing import running_stack
 
 pytestmark = pytest.mark.sil

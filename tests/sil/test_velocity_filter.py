@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from otonav.cli import main
-from otonav.record.reader import read_messages
+from otonav.record._reader import read_messages
 
 pytestmark = pytest.mark.sil
 

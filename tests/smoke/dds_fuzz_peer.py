@@ -14,8 +14,8 @@ import os
 import sys
 
 from otonav.msgs import Message, PoseStamped, Twist
-from otonav.ros2.dds import Participant
-from otonav.ros2.naming import dds_qos, discovery
+from otonav.ros2._dds import Participant
+from otonav.ros2._naming import dds_qos, discovery
 from otonav.runtime import QoS
 
 HANG = 30.0

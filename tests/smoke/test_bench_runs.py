@@ -57,7 +57,7 @@ def test_bench_quick_mode_runs_and_writes_its_figures(
 
 
 def test_memory_probe_reads_rss_heap_and_file_at_each_checkpoint() -> None:
-    from otonav.bench.memory import long_run
+    from otonav.bench._memory import long_run
 
     points = long_run(3.0, 1.0, trace=True)
     assert [round(p.sim_s, 6) for p in points] == [1.0, 2.0, 3.0]

@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pytest
 
-from otonav.record.diskfull import DISK_FULL_EXIT
-from otonav.record.reader import read_messages
+from otonav.record._diskfull import DISK_FULL_EXIT
+from otonav.record._reader import read_messages
 
 pytestmark = pytest.mark.smoke
 

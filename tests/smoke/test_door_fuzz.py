@@ -28,15 +28,15 @@ from websockets.sync.client import connect
 from otonav.actors import topics
 from otonav.foxglove import FoxgloveServer, LiveView
 from otonav.msgs import Point, Pose, PoseStamped
+from otonav.record._reader import read_messages
 from otonav.record.cdr import encode
-from otonav.record.reader import read_messages
 from otonav.ros2 import Ros2Bridge
 from otonav.runtime import Actor, Input, QoS, Reliability, System, run_blocking, until
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.stack import StackConfig
-from otonav.stack.config import FoxgloveConfig, Ros2Config
-from otonav.stack.door import refusal
-from otonav.stack.live_parameters import _validator
+from otonav.stack._config import FoxgloveConfig, Ros2Config
+from otonav.stack._door import refusal
+from otonav.stack._live_parameters import _validator
 
 pytestmark = pytest.mark.smoke
 

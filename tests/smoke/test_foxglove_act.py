@@ -21,11 +21,11 @@ from otonav.actors import topics
 from otonav.embed import HOST_QOS, open_live_stack
 from otonav.foxglove import FoxgloveServer, LiveView
 from otonav.msgs import Odometry, PoseStamped
-from otonav.record.reader import read_messages
-from otonav.record.schemas import schema_for
+from otonav.record._reader import read_messages
+from otonav.record._schemas import schema_for
 from otonav.runtime import RealTime, until
 from otonav.stack import StackConfig
-from otonav.stack.config import FoxgloveConfig
+from otonav.stack._config import FoxgloveConfig
 
 pytestmark = pytest.mark.smoke
 

@@ -21,10 +21,10 @@ from test_foxglove_live import _free_port
 from websockets.asyncio.client import ClientConnection, connect
 
 from otonav.actors import topics
-from otonav.record.reader import read_messages
+from otonav.record._reader import read_messages
 from otonav.runtime import ActorStatus, RealTime, System, Virtual
 from otonav.scenario import run_scenario
-from otonav.scenario.builtin import BUILTIN
+from otonav.scenario._builtin import BUILTIN
 
 pytestmark = pytest.mark.smoke
 

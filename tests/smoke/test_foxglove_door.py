@@ -35,13 +35,13 @@ from websockets.typing import Subprotocol
 from otonav.actors import AvoidingNavigator, topics
 from otonav.embed import LiveStack, open_live_stack
 from otonav.foxglove import FoxgloveServer, LiveView
-from otonav.foxglove.protocol import CONTROL_BACKLOG
+from otonav.foxglove._protocol import CONTROL_BACKLOG
 from otonav.msgs import PoseStamped
-from otonav.record.reader import read_messages
-from otonav.record.schemas import schema_for
+from otonav.record._reader import read_messages
+from otonav.record._schemas import schema_for
 from otonav.runtime import RealTime, until
 from otonav.stack import StackConfig
-from otonav.stack.config import FoxgloveConfig
+from otonav.stack._config import FoxgloveConfig
 
 pytestmark = pytest.mark.smoke
 

@@ -14,8 +14,8 @@ from foxglove_client import FoxgloveClient
 from test_foxglove_live import _free_port
 from test_gui import CLI_GUI_CHILD, _Child, _robot, _screen_of, _screenshot, _start_children
 
-from otonav.replay.recording import load_recording
-from otonav.runtime.clock import MAX_STEP_BATCH
+from otonav.replay._recording import load_recording
+from otonav.runtime._clock import MAX_STEP_BATCH
 
 pytestmark = pytest.mark.smoke
 

@@ -25,11 +25,11 @@ from otonav.cli import main as cli_main
 from otonav.embed import open_live_stack
 from otonav.foxglove import FoxgloveServer, LiveView, LiveViewError
 from otonav.msgs import LaserScan
-from otonav.record.reader import read_messages, summarize
+from otonav.record._reader import read_messages, summarize
 from otonav.runtime import SENSOR_DATA_QOS, Actor, Output, RealTime, run_blocking
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.stack import StackConfig
-from otonav.stack.config import FoxgloveConfig
+from otonav.stack._config import FoxgloveConfig
 from otonav.testing import running_stack
 
 pytestmark = pytest.mark.smoke

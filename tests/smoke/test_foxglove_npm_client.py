@@ -17,10 +17,10 @@ import pytest
 from otonav.actors import topics
 from otonav.embed import open_live_stack
 from otonav.foxglove import FoxgloveServer, LiveView
-from otonav.record.reader import read_messages
+from otonav.record._reader import read_messages
 from otonav.runtime import RealTime, until
 from otonav.stack import StackConfig
-from otonav.stack.config import FoxgloveConfig
+from otonav.stack._config import FoxgloveConfig
 
 pytestmark = pytest.mark.smoke
 

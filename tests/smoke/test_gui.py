@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from otonav.hal.viewer import NO_DISPLAY_FIX
+from otonav.hal._viewer import NO_DISPLAY_FIX
 
 pytestmark = pytest.mark.smoke
 
@@ -37,8 +37,8 @@ ENSURE = "scripts/ensure_xvfb.sh (Debian packages xvfb, x11-apps)"
 
 NO_DISPLAY_CHILD = """
 import sys
-from otonav.hal.viewer import NoDisplayError
-from otonav.scenario.builtin import BUILTIN
+from otonav.hal._viewer import NoDisplayError
+from otonav.scenario._builtin import BUILTIN
 from otonav.runtime import RealTime
 from otonav.scenario import run_scenario
 try:
@@ -57,7 +57,7 @@ sys.exit(4)
 GUI_CHILD = """
 import json, os, sys
 from otonav.hal.mujoco import MujocoInterface
-from otonav.scenario.builtin import BUILTIN
+from otonav.scenario._builtin import BUILTIN
 from otonav.runtime import RealTime
 from otonav.scenario import run_scenario
 

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from otonav.record.reader import summarize
+from otonav.record._reader import summarize
 
 pytestmark = pytest.mark.smoke
 

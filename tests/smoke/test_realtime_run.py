@@ -7,10 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from otonav.record.outlock import OutputBusyError, lock_output
+from otonav.record._outlock import OutputBusyError, lock_output
 from otonav.runtime import RealTime
 from otonav.scenario import run_scenario
-from otonav.scenario.builtin import BUILTIN
+from otonav.scenario._builtin import BUILTIN
 
 pytestmark = pytest.mark.smoke
 

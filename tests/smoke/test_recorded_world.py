@@ -11,7 +11,7 @@ import pytest
 from otonav.actors import topics
 from otonav.msgs import Point, Pose, PoseStamped
 from otonav.runtime import LATCHED_QOS
-from otonav.scenario.replay import recorded_plot
+from otonav.scenario._replay import recorded_plot
 from otonav.testing import running_stack
 
 pytestmark = pytest.mark.smoke

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from otonav.record.reader import summarize
+from otonav.record._reader import summarize
 from otonav.scenario import ScenarioConfig, run_scenario
 
 pytestmark = pytest.mark.smoke
@@ -27,7 +27,7 @@ CEILING_S = 120.0
 NODE = "replay_signal_actor:SignalsItself"
 WHILE_WRITING = """
 import os, signal, sys
-from otonav.record.fastwriter import FastWriter
+from otonav.record._fastwriter import FastWriter
 add, written = FastWriter.add_message, [0]
 def counted(self, *args, **kwargs):
     written[0] += 1

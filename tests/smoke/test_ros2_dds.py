@@ -21,7 +21,7 @@ from otonav.embed import open_live_stack
 from otonav.ros2 import Ros2Bridge
 from otonav.runtime import RealTime, until
 from otonav.stack import StackConfig
-from otonav.stack.config import Ros2Config
+from otonav.stack._config import Ros2Config
 
 pytestmark = pytest.mark.smoke
 

@@ -17,13 +17,13 @@ from dds_domain import exclusive_domain
 
 from otonav.actors import topics
 from otonav.msgs import Twist, Vector3
+from otonav.record._reader import read_messages
 from otonav.record.cdr import encode
-from otonav.record.reader import read_messages
 from otonav.ros2 import Ros2Bridge
 from otonav.runtime import Actor, run_blocking
 from otonav.scenario import ScenarioConfig, run_scenario
 from otonav.stack import StackConfig
-from otonav.stack.config import Ros2Config
+from otonav.stack._config import Ros2Config
 
 pytestmark = pytest.mark.smoke
 

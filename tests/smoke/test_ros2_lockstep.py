@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 from dds_domain import exclusive_domain
 
-from otonav.record.reader import read_messages, summarize
+from otonav.record._reader import read_messages, summarize
 
 pytestmark = pytest.mark.smoke
 

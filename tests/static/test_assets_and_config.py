@@ -8,9 +8,9 @@ import pytest
 
 from otonav.hal.mujoco import compile_scene, scene_names
 from otonav.scenario import ScenarioConfig
-from otonav.scenario.builtin import BUILTIN
+from otonav.scenario._builtin import BUILTIN
 from otonav.stack import StackConfig
-from otonav.stack.files import load_model
+from otonav.stack._files import load_model
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -177,9 +177,9 @@ def _heavy_modules(module: str) -> set[str]:
 
 def test_importing_the_stack_config_loads_no_numpy() -> None:
     assert _heavy_modules("otonav.stack") == set()
-    assert _heavy_modules("otonav.params") == set()
+    assert _heavy_modules("otonav._params") == set()
 
 
 def test_the_import_probe_sees_numpy() -> None:
     """The check can fail: importing the nav math loads numpy and the costmap."""
-    assert {"numpy", "otonav.nav.costmap"} <= _heavy_modules("otonav.nav")
+    assert {"numpy", "otonav.nav._costmap"} <= _heavy_modules("otonav.nav")

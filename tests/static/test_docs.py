@@ -27,7 +27,7 @@ import docs_hooks  # noqa: E402
 from otonav.cli import build_parser  # noqa: E402
 from otonav.scenario import ScenarioConfig  # noqa: E402
 from otonav.stack import StackConfig  # noqa: E402
-from otonav.sweep.spec import SweepSpec  # noqa: E402
+from otonav.sweep._spec import SweepSpec  # noqa: E402
 
 
 def test_the_site_builds_strict(tmp_path: Path) -> None:
@@ -200,16 +200,16 @@ def test_the_api_reference_turns_sphinx_roles_into_links() -> None:
     import griffe_sphinx_roles
 
     runtime = griffe.load("otonav.runtime", search_paths=[str(ROOT)])
-    clock = runtime["clock"]
+    clock = runtime["_clock"]
     text = (
-        "The :class:`~otonav.runtime.system.System` and :class:`Clock`; see :func:`now()`."
+        "The :class:`~otonav.runtime._system.System` and :class:`Clock`; see :func:`now()`."
         "\n\nLike this::\n\n    code\n"
     )
     converted = griffe_sphinx_roles.convert(text, clock)
     assert ":class:" not in converted
     assert ":func:" not in converted
     link = '<autoref identifier="otonav.runtime.{}" optional><code>{}</code></autoref>'
-    assert link.format("system.System", "System") in converted
-    assert link.format("clock.Clock", "Clock") in converted
+    assert link.format("_system.System", "System") in converted
+    assert link.format("_clock.Clock", "Clock") in converted
     assert "Like this:\n" in converted
     assert "::" not in converted

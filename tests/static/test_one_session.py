@@ -2,7 +2,7 @@
 
 Five modules used to build world, writer, recorder and system each in its own way and
 tear them down in four different orders. They now hand their world and actors to
-``otonav.stack.session.StackSession``; this test keeps it so.
+``otonav.stack._session.StackSession``; this test keeps it so.
 """
 
 from __future__ import annotations
@@ -15,13 +15,13 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 
 RUNNERS = [
-    "otonav/scenario/run.py",
-    "otonav/scenario/assembly.py",
-    "otonav/scenario/judged.py",
-    "otonav/scenario/realtime.py",
-    "otonav/testing/stack.py",
-    "otonav/engine/live.py",
-    "otonav/bench/harness.py",
+    "otonav/scenario/_run.py",
+    "otonav/scenario/_assembly.py",
+    "otonav/scenario/_judged.py",
+    "otonav/scenario/_realtime.py",
+    "otonav/testing/_stack.py",
+    "otonav/engine/_live.py",
+    "otonav/bench/_harness.py",
 ]
 #: What only the session may make or do: it owns recording, time mode and teardown.
 SESSION_ONLY = {"System", "RecordingWriter", "Recorder", "RealTimeClock", "attach_rosout"}
@@ -46,13 +46,13 @@ def test_runner_leaves_assembly_and_teardown_to_the_session(module: str) -> None
     found = _violations(ROOT / module)
     assert not found, (
         f"{module} assembles or tears down the stack itself ({'; '.join(found)}); hand the "
-        "world and actors to otonav.stack.session.StackSession instead"
+        "world and actors to otonav.stack._session.StackSession instead"
     )
 
 
 def test_the_session_is_where_they_happen() -> None:
     """The check looks at the right things: the session itself does all of them."""
-    found = " ".join(_violations(ROOT / "otonav/stack/session.py"))
+    found = " ".join(_violations(ROOT / "otonav/stack/_session.py"))
     for name in ("System", "RecordingWriter", "Recorder", "attach_rosout"):
         assert f"{name}(" in found
     for method in SESSION_ONLY_METHODS:

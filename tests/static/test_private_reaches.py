@@ -34,7 +34,7 @@ LIBS = ("asyncio", "anyio")
 COMPAT = "otonav/runtime/_asyncio_compat.py"
 NOT_THE_LIBRARYS = {
     # (module, name): rule 5 matches by name; these objects are another library's.
-    ("otonav/record/fastwriter.py", "_buffer"): "mcap's Writer, whose chunk buffer it is",
+    ("otonav/record/_fastwriter.py", "_buffer"): "mcap's Writer, whose chunk buffer it is",
 }
 PRIVATE_MODULE_STRING = re.compile(r"(asyncio|anyio)(\.\w+)*\._[A-Za-z]\w*(\.\w+)*")
 

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import ast
 import importlib
+import inspect
+import pkgutil
 import sys
 from pathlib import Path
 
@@ -83,11 +85,11 @@ def test_examples_and_docs_import_only_the_public_api(source: str) -> None:
     [
         ("from otonav.nav import Navigation", []),
         ("from otonav.errors import UsageError", []),
-        ("from otonav.nav.navigate import Navigation", ["implementation module"]),
-        ("import otonav.runtime.mailbox", ["implementation module"]),
+        ("from otonav.nav._navigate import Navigation", ["private"]),
+        ("import otonav.runtime._mailbox", ["private"]),
         ("from otonav.stack import files", ["does not export"]),
         ("from otonav.hal.mujoco._lib import mujoco", ["private"]),
-        ("async for x in y:\n    from otonav.record.writer import X", ["implementation"]),
+        ("async for x in y:\n    from otonav.record._writer import X", ["private"]),
     ],
 )
 def test_the_check_tells_a_reach_from_a_public_import(code: str, expected: list[str]) -> None:
@@ -105,3 +107,69 @@ def test_no_module_cites_notes_outside_the_repository() -> None:
         and "notes/" in path.read_text(errors="replace")
     ]
     assert not citing, f"cite an ADR or a docs page instead of notes/: {citing}"
+
+
+def _walk() -> list[tuple[str, bool]]:
+    """Every module of otonav, and whether it is a package."""
+    import otonav
+
+    return [(info.name, info.ispkg) for info in pkgutil.walk_packages(otonav.__path__, "otonav.")]
+
+
+def stray_modules(walked: list[tuple[str, bool]]) -> list[str]:
+    """The modules of ``walked`` that are neither a package nor one of PUBLIC_MODULES."""
+    return [
+        name
+        for name, package in walked
+        if not package
+        and name not in PUBLIC_MODULES
+        and not any(part.startswith("_") for part in name.split("."))
+    ]
+
+
+def test_a_module_named_without_an_underscore_is_public() -> None:
+    """Issue 36: implementation modules carry private names (``_loop.py``), as trio's and
+    httpx's do, so what a user can import without an underscore is the public API: a
+    package (with its ``__all__``) or one of PUBLIC_MODULES."""
+    stray = stray_modules(_walk())
+    assert not stray, f"give these modules a private name (_module.py): {stray}"
+
+
+def test_the_walk_finds_a_stray_public_module(tmp_path: Path) -> None:
+    """The check can fail: a module file without an underscore next to a private one."""
+    package = tmp_path / "pkg"
+    package.mkdir()
+    for name in ("__init__.py", "_private.py", "stray.py"):
+        (package / name).write_text("")
+    walked = [(i.name, i.ispkg) for i in pkgutil.walk_packages([str(package)], "pkg.")]
+    assert stray_modules(walked) == ["pkg.stray"]
+
+
+PACKAGES = [
+    "otonav",
+    *(name for name, package in _walk() if package and "._" not in name),
+]
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_the_export_walk(package: str) -> None:
+    """Every name a public package exports resolves, is public, and (a class or a
+    function) is documented: what mkdocstrings renders as the API reference is the
+    ``__all__`` of these packages."""
+    module = importlib.import_module(package)
+    exported = getattr(module, "__all__", None)
+    assert exported is not None, f"{package} has no __all__"
+    problems = []
+    for name in exported:
+        if name.startswith("_") and not (name.startswith("__") and name.endswith("__")):
+            problems.append(f"{name} is private")
+            continue
+        try:
+            value = getattr(module, name)
+        except (AttributeError, ImportError) as exc:
+            problems.append(f"{name} does not resolve: {exc}")
+            continue
+        documented = inspect.isclass(value) or inspect.isfunction(value)
+        if documented and not (value.__doc__ or "").strip():
+            problems.append(f"{name} has no docstring")
+    assert not problems, f"{package}: {problems}"

@@ -9,7 +9,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from otonav.nav.global_path import AstarSearch, GridPath, astar
+from otonav.nav._global_path import AstarSearch, GridPath, astar
 
 pytestmark = pytest.mark.unit
 

@@ -12,7 +12,7 @@ import pytest
 
 from otonav.cli import main
 from otonav.stack import StackConfig
-from otonav.stack.overrides import apply_overrides
+from otonav.stack._overrides import apply_overrides
 
 pytestmark = pytest.mark.unit
 

@@ -1,4 +1,4 @@
-"""Layer 1: the python-can boundary (``otonav.hal.can.bus``) on python-can's in-process
+"""Layer 1: the python-can boundary (``otonav.hal.can._bus``) on python-can's in-process
 ``virtual`` interface: what a receiver gets is what python-can itself would give."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import can
 import pytest
 
 from otonav.hal.can import RawFrame, open_endpoint
-from otonav.hal.can.bus import _Outgoing
+from otonav.hal.can._bus import _Outgoing
 
 pytestmark = pytest.mark.unit
 

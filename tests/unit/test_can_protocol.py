@@ -9,9 +9,9 @@ import struct
 import pytest
 
 from otonav.hal import HealthLevel
-from otonav.hal.can import protocol as p
-from otonav.hal.can.monitor import Action, DriveMonitor, MonitorLimits, NodeLabel, Phase
-from otonav.hal.sim.odrive import AxisModel, AxisParams
+from otonav.hal.can import _protocol as p
+from otonav.hal.can._monitor import Action, DriveMonitor, MonitorLimits, NodeLabel, Phase
+from otonav.hal.sim._odrive import AxisModel, AxisParams
 
 pytestmark = pytest.mark.unit
 

@@ -12,10 +12,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from otonav.hal.can.bus import RawFrame
-from otonav.hal.can.tap import frame_layout, frames_of
+from otonav.hal.can._bus import RawFrame
+from otonav.hal.can._tap import frame_layout, frames_of
 from otonav.msgs import Frame, Header, Time
-from otonav.msgs.flat import is_flat, reader
+from otonav.msgs._flat import is_flat, reader
 from otonav.record.cdr import encode
 
 pytestmark = pytest.mark.unit

@@ -1,8 +1,8 @@
-"""What otonav.nav.dwa documents at its edges (issue 24, ADR 0060 round three):
+"""What otonav.nav._dwa documents at its edges (issue 24, ADR 0060 round three):
 
 * the defaults of ``DwaParams`` are the ones the launch file ``config/stack.yaml``
   documents (its header: "Every key is optional: the defaults live in
-  otonav/stack/config.py", whose ``nav.dwa`` section takes them from ``DwaParams``; the
+  otonav/stack/_config.py", whose ``nav.dwa`` section takes them from ``DwaParams``; the
   config reference in docs/ is generated from there too). Read from the YAML text, not
   copied: the file is what a user reads;
 * "admissible when ``v * latency + v**2 / (2 * max_accel) <= free length``": a sample
@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 import yaml
 
-from otonav.nav.dwa import DwaParams, clear_arc, dwa_step
+from otonav.nav._dwa import DwaParams, clear_arc, dwa_step
 
 pytestmark = pytest.mark.unit
 

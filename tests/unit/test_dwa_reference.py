@@ -1,4 +1,4 @@
-"""The DWA (otonav.nav.dwa) against its module docstring written as plain per-sample
+"""The DWA (otonav.nav._dwa) against its module docstring written as plain per-sample
 loops, on random settings as well as the defaults (issue 24, test rigor): acceleration
 and yaw limits other than 1, one-sample windows, a robot already inside its radius, a
 yaw rate beyond the limit, goals nearer than 1 m, targets within reach of a rollout,
@@ -18,7 +18,7 @@ import pytest
 from dwa_model import Pose
 from dwa_model import dwa_reference as _reference
 
-from otonav.nav.dwa import ClearanceFn, DwaParams, DwaResult, PointClearanceFn, clear_arc, dwa_step
+from otonav.nav._dwa import ClearanceFn, DwaParams, DwaResult, PointClearanceFn, clear_arc, dwa_step
 
 pytestmark = pytest.mark.unit
 

@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
 
-from otonav.nav.dwa import ClearanceFn, DwaParams, dwa_step
+from otonav.nav._dwa import ClearanceFn, DwaParams, dwa_step
 
 pytestmark = pytest.mark.unit
 

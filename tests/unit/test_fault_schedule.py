@@ -5,13 +5,13 @@ from __future__ import annotations
 import pytest
 
 from otonav.hal import FakeHardware
-from otonav.hal.can import protocol as p
-from otonav.hal.can.bus import CAN_ERR_BUSOFF, CAN_ERR_RESTARTED, open_endpoint
+from otonav.hal.can import _protocol as p
+from otonav.hal.can._bus import CAN_ERR_BUSOFF, CAN_ERR_RESTARTED, open_endpoint
 from otonav.hal.sim import AxisParams, DriveEmulator
-from otonav.hal.sim.schedule import FaultPlan, Window
+from otonav.hal.sim._schedule import FaultPlan, Window
 from otonav.stack import StackConfig
-from otonav.stack.faults import fault_plan
-from otonav.stack.overrides import apply_overrides
+from otonav.stack._faults import fault_plan
+from otonav.stack._overrides import apply_overrides
 
 
 def test_each_fault_starts_and_ends_at_its_time() -> None:

@@ -1,4 +1,4 @@
-"""Unit tests for otonav.nav.go_to_goal and otonav.nav.geometry."""
+"""Unit tests for otonav.nav.go_to_goal and otonav.nav._geometry."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Unit tests for otonav.nav.guard (front-sector obstacle guard)."""
+"""Unit tests for otonav.nav._guard (front-sector obstacle guard)."""
 
 from __future__ import annotations
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from otonav.hal import BoxObstacle, FakeHardware, RangeScan, WheelSetpoint
-from otonav.hal.fake import cast_rays_2d
+from otonav.hal._fake import cast_rays_2d
 
 pytestmark = pytest.mark.unit
 

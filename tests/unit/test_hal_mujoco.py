@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from otonav.hal import BoxObstacle, RangeScan, RobotHardwareInterface, WheelSetpoint
-from otonav.hal.description import RobotDescription
+from otonav.hal._description import RobotDescription
 from otonav.hal.mujoco import MujocoInterface, SceneError, compile_scene, scene_names
 
 pytestmark = pytest.mark.unit

@@ -15,10 +15,11 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from otonav.bench.clutter import clutter_scenario
-from otonav.hal.mujoco import MujocoInterface, lidar
+from otonav.bench._clutter import clutter_scenario
+from otonav.hal._raycast import ray_box, ray_plane
+from otonav.hal.mujoco import MujocoInterface
+from otonav.hal.mujoco import _lidar as lidar
 from otonav.hal.mujoco._lib import mujoco
-from otonav.hal.raycast import ray_box, ray_plane
 
 _QUAT = st.tuples(*[st.floats(-1.0, 1.0) for _ in range(4)]).filter(
     lambda q: sum(c * c for c in q) > 0.01

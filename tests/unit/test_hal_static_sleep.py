@@ -10,9 +10,11 @@ from typing import Any
 import numpy as np
 import pytest
 
-from otonav.bench.clutter import clutter_scenario
+from otonav.bench._clutter import clutter_scenario
 from otonav.hal import WheelSetpoint
-from otonav.hal.mujoco import MujocoInterface, lidar, static_sleep
+from otonav.hal.mujoco import MujocoInterface
+from otonav.hal.mujoco import _lidar as lidar
+from otonav.hal.mujoco import _static_sleep as static_sleep
 from otonav.hal.mujoco._lib import mujoco
 
 

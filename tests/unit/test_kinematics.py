@@ -1,4 +1,4 @@
-"""Unit tests for otonav.control.kinematics (diff-drive IK/FK, odometry, limits)."""
+"""Unit tests for otonav.control._kinematics (diff-drive IK/FK, odometry, limits)."""
 
 from __future__ import annotations
 

@@ -11,14 +11,14 @@ import pytest
 from numpy.typing import NDArray
 from synthetic_scans import ROOM, box, scan
 
+from otonav._params import NavigationParams
 from otonav.actors import Bridge, topics
-from otonav.actors.localized_navigator import LocalizedNavigator
-from otonav.actors.localizer import Localizer, LocalizerParams
-from otonav.actors.odometry_error import OdometryError
+from otonav.actors._localized_navigator import LocalizedNavigator
+from otonav.actors._localizer import Localizer, LocalizerParams
+from otonav.actors._odometry_error import OdometryError
 from otonav.hal import FakeHardware
 from otonav.msgs import OccupancyGrid, Odometry, Time, WheelCommand
-from otonav.nav.scan_match import compose, inverse
-from otonav.params import NavigationParams
+from otonav.nav._scan_match import compose, inverse
 from otonav.record.cdr import decode, encode
 from otonav.runtime import QoS, Reliability, System, virtual_loop_factory
 
@@ -169,6 +169,6 @@ def test_the_localized_navigator_works_in_the_map_frame() -> None:
 
 def test_the_stack_config_defaults_are_the_localizers() -> None:
     from otonav.stack import StackConfig
-    from otonav.stack.build import localizer_params
+    from otonav.stack._build import localizer_params
 
     assert localizer_params(StackConfig()) == LocalizerParams()

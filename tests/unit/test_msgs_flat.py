@@ -1,4 +1,4 @@
-"""Flat messages (otonav.msgs.flat) are, from their first use on, the message the bridge
+"""Flat messages (otonav.msgs._flat) are, from their first use on, the message the bridge
 used to build eagerly; before it, only ``type()`` tells them apart, and the readers
 that must not build them (the odometry history, the publisher) do not."""
 
@@ -12,8 +12,8 @@ from typing import Any
 
 import pytest
 
-from otonav.actors.bridge import CLOCK, IMU, ODOM, TF
-from otonav.actors.odom_history import OdomHistory
+from otonav.actors._bridge import CLOCK, IMU, ODOM, TF
+from otonav.actors._odom_history import OdomHistory
 from otonav.msgs import (
     Clock,
     Header,
@@ -31,10 +31,10 @@ from otonav.msgs import (
     TwistWithCovariance,
     Vector3,
 )
-from otonav.msgs.flat import FlatLayout, flat_state, is_flat, materialize, reader, real_type
+from otonav.msgs._flat import FlatLayout, flat_state, is_flat, materialize, reader, real_type
 from otonav.record.cdr import encode
 from otonav.runtime import QoS, Reliability, TopicTypeError
-from otonav.runtime.mailbox import Bus, Endpoint
+from otonav.runtime._mailbox import Bus, Endpoint
 
 pytestmark = pytest.mark.unit
 
@@ -46,8 +46,8 @@ def eager_odometry(
     sec: int, nsec: int, x: float, y: float, yaw: float, v: float, w: float
 ) -> Odometry:
     """The /odom message as the bridge built it before fixed layouts (ADR 0027's code)."""
-    from otonav.actors.bridge import _POSE_COV as pose_cov
-    from otonav.actors.bridge import _TWIST_COV as twist_cov
+    from otonav.actors._bridge import _POSE_COV as pose_cov
+    from otonav.actors._bridge import _TWIST_COV as twist_cov
 
     return Odometry.fast(
         header=Header.fast(stamp=Time.fast(sec=sec, nanosec=nsec), frame_id="odom"),

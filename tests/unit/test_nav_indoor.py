@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from otonav.nav import Navigation, NavigationParams
-from otonav.nav.dwa import DwaParams
-from otonav.nav.planner import Plan
+from otonav.nav._dwa import DwaParams
+from otonav.nav._planner import Plan
 
 pytestmark = pytest.mark.unit
 
@@ -104,7 +104,7 @@ def test_a_gap_under_the_limit_is_not_planned_through() -> None:
 
 
 def test_a_search_in_slices_is_the_search_in_one_go() -> None:
-    from otonav.nav.global_path import AstarSearch, astar
+    from otonav.nav._global_path import AstarSearch, astar
 
     rng = np.random.default_rng(3)
     free = rng.random((60, 60)) > 0.3

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from otonav.nav import Navigation, NavigationParams
-from otonav.nav.controller import Controller
-from otonav.nav.planner import GlobalPlanner, Plan
-from otonav.nav.recovery import ProgressChecker, Recovery, Stage
+from otonav.nav._controller import Controller
+from otonav.nav._planner import GlobalPlanner, Plan
+from otonav.nav._recovery import ProgressChecker, Recovery, Stage
 
 pytestmark = pytest.mark.unit
 

@@ -14,13 +14,13 @@ from dwa_model import dwa_reference
 from otonav.hal import RobotGeometry
 from otonav.hal.mujoco import MujocoInterface
 from otonav.nav import Navigation, NavigationParams
-from otonav.nav.costmap import ClearanceMap
-from otonav.nav.dwa import DwaParams, clear_arc, dwa_step
-from otonav.nav.footprint import centre_clearance
-from otonav.nav.global_path import astar
-from otonav.nav.planner import Plan
-from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
-from otonav.nav.scan import ScanRays, nearest_return, scan_in_frame, scan_points, to_frame
+from otonav.nav._costmap import ClearanceMap
+from otonav.nav._dwa import DwaParams, clear_arc, dwa_step
+from otonav.nav._footprint import centre_clearance
+from otonav.nav._global_path import astar
+from otonav.nav._planner import Plan
+from otonav.nav._recovery import ProgressChecker, boundary_side, follow_boundary
+from otonav.nav._scan import ScanRays, nearest_return, scan_in_frame, scan_points, to_frame
 
 pytestmark = pytest.mark.unit
 

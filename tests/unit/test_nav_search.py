@@ -13,8 +13,8 @@ import math
 import numpy as np
 import pytest
 
-from otonav.nav.global_path import AstarSearch, astar
-from otonav.nav.plan_grid import best_points, free_threshold, pooled
+from otonav.nav._global_path import AstarSearch, astar
+from otonav.nav._plan_grid import best_points, free_threshold, pooled
 
 pytestmark = pytest.mark.unit
 

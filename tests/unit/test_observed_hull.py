@@ -12,10 +12,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from otonav.nav import Navigation, NavigationParams
-from otonav.nav.dwa import DwaParams
-from otonav.nav.observed_hull import ObservedHull, convex_hull, free_ends
-from otonav.nav.planner import Plan
-from otonav.nav.scan import ScanRays
+from otonav.nav._dwa import DwaParams
+from otonav.nav._observed_hull import ObservedHull, convex_hull, free_ends
+from otonav.nav._planner import Plan
+from otonav.nav._scan import ScanRays
 
 pytestmark = pytest.mark.unit
 

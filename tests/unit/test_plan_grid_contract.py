@@ -1,4 +1,4 @@
-"""What otonav.nav.plan_grid's docstrings promise beyond the pooled values (issue 24,
+"""What otonav.nav._plan_grid's docstrings promise beyond the pooled values (issue 24,
 ADR 0060 round three): at stride 1 the coarse grid *is* the fine one (no copy per
 replan: a caller writing into it would write into the map) and the best points are the
 coarse cells given; at any other stride the result is a new array."""
@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from otonav.nav.plan_grid import best_points, pooled
+from otonav.nav._plan_grid import best_points, pooled
 
 pytestmark = pytest.mark.unit
 

@@ -1,4 +1,4 @@
-"""The recovery pieces (otonav.nav.recovery) against their docstrings (issue 24, test
+"""The recovery pieces (otonav.nav._recovery) against their docstrings (issue 24, test
 rigor): the progress checker against a plain model on random sequences of updates,
 new paths and resets (on a grid of exact values, so "by at least ``distance``" and
 "within ``window`` s" meet their bounds exactly); the boundary side and the wall
@@ -11,7 +11,7 @@ import math
 import numpy as np
 import pytest
 
-from otonav.nav.recovery import ProgressChecker, boundary_side, follow_boundary
+from otonav.nav._recovery import ProgressChecker, boundary_side, follow_boundary
 
 pytestmark = pytest.mark.unit
 

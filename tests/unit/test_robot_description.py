@@ -16,12 +16,13 @@ import numpy as np
 import pytest
 
 from otonav.actors import Bridge, topics
-from otonav.hal import BoxObstacle, WheelSetpoint, description
-from otonav.hal.description import Mount, RobotDescription, builtin_robot
+from otonav.hal import BoxObstacle, WheelSetpoint
+from otonav.hal import _description as description
+from otonav.hal._description import Mount, RobotDescription, builtin_robot
 from otonav.hal.mujoco import MujocoInterface, SceneError, scene_path
 from otonav.msgs import JointState, WheelCommand
 from otonav.runtime import System, virtual_loop_factory
-from otonav.scenario.verdict import lidar_over_obstacles
+from otonav.scenario._verdict import lidar_over_obstacles
 
 PATHFINDER = Path(__file__).resolve().parents[2] / "examples" / "my_robot"
 

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from otonav.nav.safety import SafetyParams, safe_command, stopping_reach
+from otonav.nav._safety import SafetyParams, safe_command, stopping_reach
 
 pytestmark = pytest.mark.unit
 
@@ -120,7 +120,7 @@ def test_a_tiny_max_accel_bounds_the_stopping_grid_and_stays_safe(
     """base.max_accel = 0.001: stopping from 0.5 m/s takes 500 s (125 m). The grid is
     capped (it grew as v^2 / max_accel: ~25,000 steps, ~0.15 s a call) and the path past
     it is bounded, so a wall 40 m ahead is still judged unsafe at full speed."""
-    import otonav.nav.safety as safety
+    import otonav.nav._safety as safety
 
     steps: list[int] = []
     profile = safety._profile

@@ -25,7 +25,7 @@ from hypothesis import strategies as st
 from safety_model import stopping_path as _path
 from safety_model import worst_gap as _worst
 
-from otonav.nav.safety import SafetyParams, safe_command, stopping_reach
+from otonav.nav._safety import SafetyParams, safe_command, stopping_reach
 
 pytestmark = pytest.mark.unit
 

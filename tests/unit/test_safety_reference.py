@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from safety_model import stopping_path, worst_gap
 
-from otonav.nav.safety import SafetyParams, safe_command
+from otonav.nav._safety import SafetyParams, safe_command
 
 pytestmark = pytest.mark.unit
 

@@ -1,4 +1,4 @@
-"""The localizer's map (otonav.nav.scan_map) against its module docstring written as plain
+"""The localizer's map (otonav.nav._scan_map) against its module docstring written as plain
 loops, on random scans of random boxes seen from random poses, with stray returns and
 returns off the map (issue 24, test rigor):
 
@@ -22,8 +22,8 @@ import numpy as np
 import pytest
 from synthetic_scans import box, scan
 
-from otonav.nav.scan_map import CLAMP, HIT, MISS, ScanMap, normals
-from otonav.nav.scan_match import transform
+from otonav.nav._scan_map import CLAMP, HIT, MISS, ScanMap, normals
+from otonav.nav._scan_match import transform
 
 pytestmark = pytest.mark.unit
 

@@ -1,4 +1,4 @@
-"""The localization math (otonav.nav.scan_map, otonav.nav.scan_match): a known transform
+"""The localization math (otonav.nav._scan_map, otonav.nav._scan_match): a known transform
 is recovered from synthetic scans of a known world, a corridor's unconstrained length
 stays at the prediction, an empty or foreign map is not trusted, and the map's fields
 hold what they say."""
@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from synthetic_scans import CORRIDOR, ROOM, Segment, box, circle, scan
 
-from otonav.nav.scan_map import CLAMP, HIT, MISS, ScanMap, normals
-from otonav.nav.scan_match import (
+from otonav.nav._scan_map import CLAMP, HIT, MISS, ScanMap, normals
+from otonav.nav._scan_match import (
     MatchParams,
     compose,
     correlative_search,
@@ -365,7 +365,7 @@ def test_the_search_finds_the_right_post_where_refinement_alone_takes_the_wrong_
 
 
 def test_the_search_tries_the_prediction_first_then_outward() -> None:
-    from otonav.nav.scan_match import _offsets
+    from otonav.nav._scan_match import _offsets
 
     assert _offsets(0.1, 0.05).tolist() == pytest.approx([0.0, 0.05, -0.05, 0.1, -0.1])
     assert _offsets(0.0, 0.05).tolist() == [0.0]

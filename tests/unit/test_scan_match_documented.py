@@ -1,4 +1,4 @@
-"""What otonav.nav.scan_match's docstrings document at their edges (issue 24, ADR 0060
+"""What otonav.nav._scan_match's docstrings document at their edges (issue 24, ADR 0060
 round three):
 
 * a step is accepted when it does not raise the cost: at the minimum the zero step is
@@ -14,9 +14,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from otonav.nav.scan_map import ScanMap
-from otonav.nav.scan_match import MatchParams, correlative_search, match_scan, refine
-from otonav.params import LocalizationConfig
+from otonav._params import LocalizationConfig
+from otonav.nav._scan_map import ScanMap
+from otonav.nav._scan_match import MatchParams, correlative_search, match_scan, refine
 
 pytestmark = pytest.mark.unit
 

@@ -1,4 +1,4 @@
-"""The scan matcher (otonav.nav.scan_match) against its module docstring written as plain
+"""The scan matcher (otonav.nav._scan_match) against its module docstring written as plain
 loops (issue 24, test rigor), on random rooms, scans and predictions:
 
 * the correlative search is the brute-force minimum over its window (``0, +-step, ...``
@@ -20,8 +20,8 @@ import numpy as np
 import pytest
 from synthetic_scans import Segment, box, scan
 
-from otonav.nav.scan_map import ScanMap
-from otonav.nav.scan_match import (
+from otonav.nav._scan_map import ScanMap
+from otonav.nav._scan_match import (
     MatchParams,
     Pose,
     correlative_search,

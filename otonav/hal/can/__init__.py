@@ -7,9 +7,9 @@
 - ``tap``: the actor that publishes the raw frames (``can_msgs/msg/Frame``).
 """
 
-from otonav.hal.can.bus import BusError, CanEndpoint, RawFrame, open_endpoint
-from otonav.hal.can.interface import BusPeer, CanBusInterface, WheelAxis
-from otonav.hal.can.monitor import DriveMonitor, MonitorLimits, Phase
+from otonav.hal.can._bus import BusError, CanEndpoint, RawFrame, open_endpoint
+from otonav.hal.can._interface import BusPeer, CanBusInterface, WheelAxis
+from otonav.hal.can._monitor import DriveMonitor, MonitorLimits, Phase
 
 __all__ = (
     "BusError",

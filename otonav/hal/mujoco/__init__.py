@@ -12,13 +12,13 @@ module imports :mod:`mujoco` (an import-linter contract; ADR 0056). Its modules:
 - ``shapes``: its static geoms as the judge measures them;
 - ``static_sleep``: static geoms placed once, not at every step (ADR 0062).
 
-The viewer's window (:class:`~otonav.hal.viewer.ViewerHandle`, the display check) lives
-in :mod:`otonav.hal.viewer`, which does not import MuJoCo.
+The viewer's window (:class:`~otonav.hal._viewer.ViewerHandle`, the display check) lives
+in :mod:`otonav.hal._viewer`, which does not import MuJoCo.
 """
 
-from otonav.hal.mujoco.scene import SceneError, compile_scene, scene_names, scene_path
-from otonav.hal.mujoco.world import MujocoInterface
-from otonav.hal.viewer import NoDisplayError, ViewerHandle
+from otonav.hal._viewer import NoDisplayError, ViewerHandle
+from otonav.hal.mujoco._scene import SceneError, compile_scene, scene_names, scene_path
+from otonav.hal.mujoco._world import MujocoInterface
 
 __all__ = (
     "MujocoInterface",

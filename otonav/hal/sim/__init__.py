@@ -4,8 +4,8 @@ Never imported by robot code (an import-linter contract): only the stack builder
 composes a simulated robot, and tests use it.
 """
 
-from otonav.hal.sim.emulator import DriveEmulator, DriveMount
-from otonav.hal.sim.odrive import AxisModel, AxisParams
-from otonav.hal.sim.schedule import BusFaults
+from otonav.hal.sim._emulator import DriveEmulator, DriveMount
+from otonav.hal.sim._odrive import AxisModel, AxisParams
+from otonav.hal.sim._schedule import BusFaults
 
 __all__ = ("AxisModel", "AxisParams", "BusFaults", "DriveEmulator", "DriveMount")

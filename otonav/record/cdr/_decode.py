@@ -3,7 +3,7 @@
 Replay feeds recorded messages to actors, so it needs the same pydantic objects the
 stack published, bit for bit (a float64 comes back as the same double, a float32 scan
 range as the same float32 value). The decoder is compiled per message class from the
-same layouts (:func:`~otonav.record.schemas.layout_for`) and the same leaf flattening as
+same layouts (:func:`~otonav.record._schemas.layout_for`) and the same leaf flattening as
 the encoder: each run of fixed-size fields is one precompiled ``unpack_from`` (one per
 start offset mod 8, since the padding inside a run depends on where it starts);
 strings and sequences are read one by one; then the values are built back into the
@@ -25,7 +25,8 @@ from typing import Any, Final, TypeVar
 
 from otonav.msgs import Header, Message
 from otonav.msgs._base import _new, _setstate
-from otonav.msgs.flat import FlatLayout
+from otonav.msgs._flat import FlatLayout
+from otonav.record._schemas import SEQUENCE, layout_for
 from otonav.record.cdr._encode import encode
 from otonav.record.cdr._layout import (
     ENCAPSULATION,
@@ -36,7 +37,6 @@ from otonav.record.cdr._layout import (
     run_format,
     wire_parts,
 )
-from otonav.record.schemas import SEQUENCE, layout_for
 
 __all__ = ("decode", "flat_values")
 
@@ -307,7 +307,7 @@ def decode(message: type[M], data: bytes, header: Header | None = None) -> M:
 
 @functools.cache  # layouts are module constants: compiled once per process
 def flat_values(layout: FlatLayout[Any]) -> Callable[[bytes], tuple[Any, ...] | None]:
-    """The inverse of a fixed layout's packer (:mod:`otonav.msgs.flat`): from CDR bytes,
+    """The inverse of a fixed layout's packer (:mod:`otonav.msgs._flat`): from CDR bytes,
     the values at ``layout.paths`` when everything else is the template's, byte for byte
     (so ``layout(*values)`` is the message the bytes hold, and encodes to them); None
     otherwise (another length, a frame id, a covariance, a -0.0 where the template has

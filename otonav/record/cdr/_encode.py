@@ -1,6 +1,6 @@
 """Fast CDR encoding of otonav messages: the bytes ROS 2 puts on the wire and in bags.
 
-Each message class is compiled once, from its layout (:func:`~otonav.record.schemas.
+Each message class is compiled once, from its layout (:func:`~otonav.record._schemas.
 layout_for`), into one generated Python function (:class:`_Source`; read it in the
 function's ``__doc__``). Nested messages are flattened into attribute paths
 (``header.stamp.sec``), each nested message is read once into a local, and every run of
@@ -20,7 +20,8 @@ from operator import attrgetter
 from typing import Any, Final
 
 from otonav.msgs import Message
-from otonav.msgs.flat import FlatLayout, flat_state, materialize, real_type
+from otonav.msgs._flat import FlatLayout, flat_state, materialize, real_type
+from otonav.record._schemas import SEQUENCE
 from otonav.record.cdr._layout import (
     ENCAPSULATION,
     Fixed,
@@ -30,7 +31,6 @@ from otonav.record.cdr._layout import (
     run_format,
     wire_parts,
 )
-from otonav.record.schemas import SEQUENCE
 
 __all__ = ("encode",)
 

@@ -22,8 +22,8 @@ from dataclasses import dataclass
 from typing import Final
 
 from otonav.msgs import Message
-from otonav.msgs.flat import real_type
-from otonav.record.schemas import SEQUENCE, layout_for
+from otonav.msgs._flat import real_type
+from otonav.record._schemas import SEQUENCE, layout_for
 
 ENCAPSULATION: Final = b"\x00\x01\x00\x00"
 """CDR_LE encapsulation kind (big-endian uint16 1) and options 0."""

@@ -9,13 +9,15 @@ import threading
 from collections.abc import Callable, Sequence
 from typing import Protocol
 
-from otonav.sweep.plan import RunTask
-from otonav.sweep.worker import RunOutcome
+from otonav.sweep._plan import RunTask
+from otonav.sweep._worker import RunOutcome
 
 Emit = Callable[[RunTask, RunOutcome], None]
 
 
 class Backend(Protocol):
+    """Where a sweep's runs execute: a process pool, Ray, or one process."""
+
     name: str
 
     def run(self, tasks: Sequence[RunTask], emit: Emit, stop: threading.Event) -> None: ...

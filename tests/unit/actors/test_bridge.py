@@ -362,7 +362,7 @@ def test_a_full_reliable_subscriber_holds_the_streams_back_in_order() -> None:
     every later one of the instant wait: nothing lost, the publish order kept (/imu
     after /tf, although /imu's mailboxes had room)."""
     from otonav.msgs import TFMessage
-    from otonav.runtime.funnel import Funnel
+    from otonav.runtime._funnel import Funnel
 
     hal = FakeHardware()
     wanted = {topics.CLOCK, topics.ODOM, topics.TF, topics.IMU}

@@ -28,7 +28,7 @@ from otonav.runtime import (
     until,
     virtual_loop_factory,
 )
-from otonav.runtime.mailbox import Endpoint
+from otonav.runtime._mailbox import Endpoint
 
 pytestmark = pytest.mark.unit
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from otonav.actors.bridge import ODOM
-from otonav.actors.odom_history import OdomHistory
-from otonav.msgs.flat import is_flat
+from otonav.actors._bridge import ODOM
+from otonav.actors._odom_history import OdomHistory
+from otonav.msgs._flat import is_flat
 
 pytestmark = pytest.mark.unit
 

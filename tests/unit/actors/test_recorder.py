@@ -9,10 +9,10 @@ from pathlib import Path
 import anyio
 import pytest
 
-from otonav.actors.recorder import Recorder
+from otonav.actors._recorder import Recorder
 from otonav.msgs import Clock, Time
-from otonav.record.reader import read_messages
-from otonav.record.writer import RecordingWriter
+from otonav.record._reader import read_messages
+from otonav.record._writer import RecordingWriter
 from otonav.runtime import Actor, Output, System, virtual_loop_factory
 
 pytestmark = pytest.mark.unit

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from otonav.actors.scan_cache import nearest_bound_of, nearest_of, points_of
+from otonav.actors._scan_cache import nearest_bound_of, nearest_of, points_of
 from otonav.msgs import LaserScan
 
 pytestmark = pytest.mark.unit
@@ -58,7 +58,7 @@ def test_one_scan_is_converted_once_and_its_array_is_read_only() -> None:
     assert points_of(scan, 0.1) is first
     other = _scan([1.0, 2.0, 3.0, 4.0])
     assert points_of(other, 0.1) is not first
-    from otonav.actors.scan_cache import _wire
+    from otonav.actors._scan_cache import _wire
 
     ranges = _wire(other)[0]
     assert _wire(other)[0] is ranges

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from otonav.record.reader import MAGIC
+from otonav.record._reader import MAGIC
 
 pytestmark = pytest.mark.unit
 
@@ -97,7 +97,7 @@ def test_long_names_through_set_are_refused_in_a_short_line(
 
 def test_anchors_for_ordinary_reuse_still_work(tmp_path: Path) -> None:
     from otonav.scenario import ScenarioConfig
-    from otonav.stack.files import load_model
+    from otonav.stack._files import load_model
 
     f = tmp_path / "s.yaml"
     f.write_text(

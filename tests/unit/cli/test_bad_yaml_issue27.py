@@ -38,7 +38,7 @@ def test_an_empty_scenario_file_is_refused(
 
 
 def test_merge_keys_may_still_be_overridden() -> None:
-    from otonav.stack import safe_yaml
+    from otonav.stack import _safe_yaml as safe_yaml
 
     data = safe_yaml.load("base: &b {x: 1, y: 2}\ngoal:\n  <<: *b\n  x: 3\n")
     assert data["goal"] == {"x": 3, "y": 2}

@@ -121,7 +121,7 @@ def test_info_on_a_cut_off_recording_warns_and_still_shows_it(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
     from otonav.msgs import Clock, Time
-    from otonav.record.writer import RecordingWriter
+    from otonav.record._writer import RecordingWriter
 
     path = tmp_path / "cut.mcap"
     writer = RecordingWriter(path, chunk_size=1024)

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from otonav.cli import main
-from otonav.scenario.builtin import BUILTIN
+from otonav.scenario._builtin import BUILTIN
 
 pytestmark = pytest.mark.unit
 

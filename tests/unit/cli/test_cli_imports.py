@@ -62,7 +62,7 @@ def test_help_and_scenarios_load_nothing_heavy(argv: list[str]) -> None:
 
 def test_info_loads_nothing_heavy(tmp_path: Path) -> None:
     from otonav.msgs import Clock, Time
-    from otonav.record.writer import RecordingWriter
+    from otonav.record._writer import RecordingWriter
 
     recording = tmp_path / "r.mcap"
     writer = RecordingWriter(recording)

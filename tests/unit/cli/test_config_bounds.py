@@ -16,7 +16,7 @@ from otonav import limits
 from otonav.cli import main
 from otonav.scenario import ScenarioConfig
 from otonav.stack import StackConfig
-from otonav.stack.files import describe_validation_error
+from otonav.stack._files import describe_validation_error
 
 pytestmark = pytest.mark.unit
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from otonav.cli import main
-from otonav.cli.console import make_console
+from otonav.cli._console import make_console
 
 
 def test_a_long_line_stays_one_line_off_a_terminal(capsys: pytest.CaptureFixture[str]) -> None:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from otonav.cli.inspect import plot_target
+from otonav.cli._inspect import plot_target
 
 pytestmark = pytest.mark.unit
 

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from otonav.record.outlock import OutputBusyError, lock_output
+from otonav.record._outlock import OutputBusyError, lock_output
 
 pytestmark = pytest.mark.unit
 

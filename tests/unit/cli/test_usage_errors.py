@@ -9,13 +9,13 @@ import pytest
 
 from otonav.cli import main
 from otonav.errors import OtonavError, UsageError
+from otonav.hal._viewer import NoDisplayError
 from otonav.hal.mujoco import SceneError
-from otonav.hal.viewer import NoDisplayError
-from otonav.record.outlock import OutputBusyError
-from otonav.record.reader import RecordingError
-from otonav.ros2.naming import Ros2Error
-from otonav.runtime.errors import OtonavRuntimeError, SimTimeoutError
-from otonav.stack.files import ConfigFileError
+from otonav.record._outlock import OutputBusyError
+from otonav.record._reader import RecordingError
+from otonav.ros2._naming import Ros2Error
+from otonav.runtime._errors import OtonavRuntimeError, SimTimeoutError
+from otonav.stack._files import ConfigFileError
 
 
 @pytest.mark.parametrize(

@@ -55,9 +55,9 @@ from otonav.msgs import (
     WheelCommand,
 )
 from otonav.msgs import KeyValue as DiagKeyValue
+from otonav.record._schemas import schema_for
 from otonav.record.cdr import decode as decode_cdr
 from otonav.record.cdr import encode
-from otonav.record.schemas import schema_for
 
 pytestmark = pytest.mark.unit
 
@@ -253,7 +253,7 @@ def samples() -> dict[type[Message], list[Message]]:
                 level=Log.FATAL,
                 name="actor.bridge",
                 msg="crashed: ZeroDivisionError — ünïcode",
-                file="otonav/actors/bridge.py",
+                file="otonav/actors/_bridge.py",
                 function="run",
                 line=4_000_000_000,
             ),

@@ -12,8 +12,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from otonav.actors.bridge import CLOCK, IMU, ODOM, TF
-from otonav.hal.can.tap import frame_layout
+from otonav.actors._bridge import CLOCK, IMU, ODOM, TF
+from otonav.hal.can._tap import frame_layout
 from otonav.msgs import (
     DiagnosticArray,
     DiagnosticStatus,
@@ -24,7 +24,7 @@ from otonav.msgs import (
     Message,
     Time,
 )
-from otonav.msgs.flat import FlatLayout, is_flat, materialize
+from otonav.msgs._flat import FlatLayout, is_flat, materialize
 from otonav.record.cdr import encode
 
 pytestmark = pytest.mark.unit

@@ -12,8 +12,8 @@ import pytest
 
 from otonav.cli import main
 from otonav.msgs import Clock, Odometry, Point, Pose, PoseWithCovariance, Time
-from otonav.record.reader import MAGIC, RecordingError, read_messages, summarize
-from otonav.record.writer import RecordingWriter
+from otonav.record._reader import MAGIC, RecordingError, read_messages, summarize
+from otonav.record._writer import RecordingWriter
 
 pytestmark = pytest.mark.unit
 

@@ -17,10 +17,10 @@ from typing import Any
 import pytest
 
 from otonav.msgs import Clock, Time
-from otonav.record.diskfull import DiskFullError, is_disk_full
-from otonav.record.reader import read_messages, summarize
-from otonav.record.salvage import salvage
-from otonav.record.writer import RecordingWriter
+from otonav.record._diskfull import DiskFullError, is_disk_full
+from otonav.record._reader import read_messages, summarize
+from otonav.record._salvage import salvage
+from otonav.record._writer import RecordingWriter
 
 pytestmark = pytest.mark.unit
 
@@ -64,7 +64,7 @@ def _full_disk(monkeypatch: pytest.MonkeyPatch, budget: int) -> list[_FullAfter]
     ``budget`` bytes; other opens are left alone. Returns the files made."""
     import builtins
 
-    import otonav.record.writer as writer_module
+    import otonav.record._writer as writer_module
 
     made: list[_FullAfter] = []
 

@@ -12,8 +12,8 @@ import pytest
 from mcap.reader import make_reader
 from mcap.writer import CompressionType, IndexType, Writer
 
-from otonav.record import fastreader
-from otonav.record.fastreader import ChunkDamageError, read_raw_messages
+from otonav.record import _fastreader as fastreader
+from otonav.record._fastreader import ChunkDamageError, read_raw_messages
 
 pytestmark = pytest.mark.unit
 

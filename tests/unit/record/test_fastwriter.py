@@ -7,7 +7,7 @@ import io
 import pytest
 from mcap.writer import CompressionType, Writer
 
-from otonav.record.fastwriter import SUPPORTED, FastWriter
+from otonav.record._fastwriter import SUPPORTED, FastWriter
 
 pytestmark = pytest.mark.unit
 

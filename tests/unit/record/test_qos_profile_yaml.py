@@ -7,8 +7,8 @@ import itertools
 
 import yaml
 
-from otonav.record.qos_profile import offered_qos_profiles, offered_qos_yaml
-from otonav.runtime.qos import MAX_DEPTH, Durability, QoS, Reliability
+from otonav.record._qos_profile import offered_qos_profiles, offered_qos_yaml
+from otonav.runtime._qos import MAX_DEPTH, Durability, QoS, Reliability
 
 
 def _by_dump(offered: list[QoS]) -> str:

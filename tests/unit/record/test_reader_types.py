@@ -12,10 +12,10 @@ from mcap.writer import Writer
 
 from otonav.cli import main
 from otonav.msgs import Clock, Frame, Header, Message, Time
+from otonav.record._reader import RecordingError, read_messages
+from otonav.record._schemas import schema_for
+from otonav.record._writer import RecordingWriter
 from otonav.record.cdr import ENCAPSULATION, encode
-from otonav.record.reader import RecordingError, read_messages
-from otonav.record.schemas import schema_for
-from otonav.record.writer import RecordingWriter
 
 pytestmark = pytest.mark.unit
 

@@ -25,13 +25,13 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 import otonav.msgs
 from otonav.msgs import Clock, Message, NavState, TFMessage, Time
-from otonav.record.bag import write_bag_directory
-from otonav.record.interface_package import PACKAGE, TYPES, msg_files
-from otonav.record.qos_profile import offered_qos_yaml
-from otonav.record.schemas import schema_for
-from otonav.record.type_hash import rihs01
-from otonav.record.writer import RecordingWriter
-from otonav.runtime.qos import DEFAULT_QOS, LATCHED_QOS, SENSOR_DATA_QOS, QoS
+from otonav.record._bag import write_bag_directory
+from otonav.record._interface_package import PACKAGE, TYPES, msg_files
+from otonav.record._qos_profile import offered_qos_yaml
+from otonav.record._schemas import schema_for
+from otonav.record._type_hash import rihs01
+from otonav.record._writer import RecordingWriter
+from otonav.runtime._qos import DEFAULT_QOS, LATCHED_QOS, SENSOR_DATA_QOS, QoS
 
 pytestmark = pytest.mark.unit
 
@@ -149,7 +149,7 @@ def test_the_interface_package_msg_files_are_the_recorded_schemas() -> None:
     on_disk = {p.name: p.read_text(encoding="utf-8") for p in (folder / "msg").glob("*.msg")}
     assert on_disk == files, (
         "otonav_msgs/msg differs from the schemas otonav records; regenerate it with "
-        "python -m otonav.record.interface_package otonav_msgs/msg"
+        "python -m otonav.record._interface_package otonav_msgs/msg"
     )
     cmake = (folder / "CMakeLists.txt").read_text()
     assert "rosidl_generate_interfaces" in cmake
@@ -167,7 +167,7 @@ def test_the_interface_package_msg_files_are_the_recorded_schemas() -> None:
 
 
 def test_sweep_bag_makes_a_bag_beside_every_kept_recording(tmp_path: Path) -> None:
-    from otonav.cli.sweep import _write_bags
+    from otonav.cli._sweep import _write_bags
 
     _record(tmp_path / "runs" / "a" / "recording.mcap")
     records: list[dict[str, Any]] = [

@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 
 from otonav.msgs import Clock, Time
-from otonav.record.reader import read_messages, summarize
-from otonav.record.rotating import RotatingRecordingWriter
+from otonav.record._reader import read_messages, summarize
+from otonav.record._rotating import RotatingRecordingWriter
 
 pytestmark = pytest.mark.unit
 

@@ -12,14 +12,14 @@ import pytest
 
 from otonav.cli import main
 from otonav.msgs import Clock, Time
-from otonav.record.reader import summarize
-from otonav.record.salvage import salvage
-from otonav.record.writer import RecordingWriter
+from otonav.record._reader import summarize
+from otonav.record._salvage import salvage
+from otonav.record._writer import RecordingWriter
 from otonav.scenario import ScenarioConfig, run_scenario
-from otonav.scenario.artifacts import run_metadata
-from otonav.scenario.assembly import effective_stack
+from otonav.scenario._artifacts import run_metadata
+from otonav.scenario._assembly import effective_stack
 from otonav.stack import NavConfig, StackConfig
-from otonav.stack.worldmeta import WORLD_METADATA
+from otonav.stack._worldmeta import WORLD_METADATA
 
 pytestmark = pytest.mark.unit
 

@@ -7,11 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from otonav.actors.bridge import CLOCK, ODOM
-from otonav.hal.can.bus import RawFrame
-from otonav.hal.can.tap import frames_of
+from otonav.actors._bridge import CLOCK, ODOM
+from otonav.hal.can._bus import RawFrame
+from otonav.hal.can._tap import frames_of
 from otonav.msgs import Clock, Header, Log, Message, Time
-from otonav.record.writer import RecordingWriter
+from otonav.record._writer import RecordingWriter
 
 pytestmark = pytest.mark.unit
 

@@ -7,12 +7,12 @@ from pathlib import Path
 
 from rich.console import Console
 
-from otonav.cli.replay import print_result
+from otonav.cli._replay import print_result
 from otonav.msgs import NavState
 from otonav.record.cdr import encode
 from otonav.replay import ReplayResult
-from otonav.replay.compare import Divergence, Replayed, compare_topic
-from otonav.replay.recording import RecordedMessage
+from otonav.replay._compare import Divergence, Replayed, compare_topic
+from otonav.replay._recording import RecordedMessage
 
 
 def test_a_text_difference_prints_both_values() -> None:

@@ -9,14 +9,14 @@ from pathlib import Path
 
 import pytest
 
-from otonav.actors.recorder import Recorder
+from otonav.actors._recorder import Recorder
 from otonav.msgs import Twist, Vector3
+from otonav.record._reader import read_messages
+from otonav.record._writer import RecordingWriter
 from otonav.record.cdr import encode
-from otonav.record.reader import read_messages
-from otonav.record.writer import RecordingWriter
 from otonav.replay import ReplayInputError, replay_recording
-from otonav.replay.feed import Settle, plan_instants
-from otonav.replay.recording import RecordedMessage
+from otonav.replay._feed import Settle, plan_instants
+from otonav.replay._recording import RecordedMessage
 from otonav.runtime import Actor, Input, JumpSource, Output, System, virtual_loop_factory
 
 pytestmark = pytest.mark.unit

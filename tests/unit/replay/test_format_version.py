@@ -13,7 +13,7 @@ from mcap.reader import make_reader
 
 from otonav.cli import main
 from otonav.msgs import Clock, Time
-from otonav.record.writer import FORMAT_METADATA, FORMAT_VERSION, RecordingWriter
+from otonav.record._writer import FORMAT_METADATA, FORMAT_VERSION, RecordingWriter
 
 pytestmark = pytest.mark.unit
 

@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 
-from otonav.actors.bridge import ODOM as ODOM_LAYOUT
+from otonav.actors._bridge import ODOM as ODOM_LAYOUT
 from otonav.msgs import (
     Header,
     Imu,
@@ -24,12 +24,12 @@ from otonav.msgs import (
     Twist,
     Vector3,
 )
-from otonav.msgs.flat import flat_state, is_flat
+from otonav.msgs._flat import flat_state, is_flat
 from otonav.record.cdr import decode, encode
-from otonav.replay.feed import FLAT_LAYOUTS
-from otonav.replay.lazy import input_maker, is_lazy, lazy, materialize
+from otonav.replay._feed import FLAT_LAYOUTS
+from otonav.replay._lazy import input_maker, is_lazy, lazy, materialize
 from otonav.runtime import QoS, Reliability, TopicTypeError
-from otonav.runtime.mailbox import Bus, Endpoint
+from otonav.runtime._mailbox import Bus, Endpoint
 
 pytestmark = pytest.mark.unit
 

@@ -10,8 +10,8 @@ import pytest
 
 from otonav.cli import main
 from otonav.msgs import Clock, Time
-from otonav.record.reader import MAGIC
-from otonav.record.writer import RecordingWriter
+from otonav.record._reader import MAGIC
+from otonav.record._writer import RecordingWriter
 
 pytestmark = pytest.mark.unit
 

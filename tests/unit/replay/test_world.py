@@ -9,13 +9,13 @@ import sys
 import pytest
 
 from otonav.hal import FakeHardware, RobotGeometry, WheelSetpoint
-from otonav.hal.description import builtin_robot
+from otonav.hal._description import builtin_robot
 from otonav.hal.mujoco import MujocoInterface
 from otonav.replay import ReplayInputError
-from otonav.replay.nodes import build_nodes, stack_actor_names
-from otonav.replay.world import RecordedRobot
+from otonav.replay._nodes import build_nodes, stack_actor_names
+from otonav.replay._world import RecordedRobot
 from otonav.stack import StackConfig
-from otonav.stack.worldmeta import geometry_from_metadata, reach_from_metadata, world_metadata
+from otonav.stack._worldmeta import geometry_from_metadata, reach_from_metadata, world_metadata
 
 pytestmark = pytest.mark.unit
 

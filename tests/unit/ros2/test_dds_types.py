@@ -10,8 +10,8 @@ pytest.importorskip("cyclonedds")
 
 from otonav.msgs import Clock, Imu, LaserScan, Log, Message, Odometry, PoseStamped, TFMessage
 from otonav.record.cdr import encode
-from otonav.ros2.dds import idl_type
-from otonav.ros2.naming import dds_type_name
+from otonav.ros2._dds import idl_type
+from otonav.ros2._naming import dds_type_name
 
 pytestmark = pytest.mark.unit
 

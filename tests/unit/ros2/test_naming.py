@@ -10,8 +10,8 @@ import pytest
 
 from otonav.actors import topics
 from otonav.msgs import Clock, Odometry, PoseStamped
-from otonav.record.type_hash import rihs01
-from otonav.ros2.naming import (
+from otonav.record._type_hash import rihs01
+from otonav.ros2._naming import (
     LOCALHOST_CONFIG,
     LOCKSTEP_CONFIG,
     NETWORK_CONFIG,
@@ -80,7 +80,7 @@ def test_the_users_cyclonedds_uri_applies_after_ours() -> None:
 
 def test_cyclonedds_is_imported_only_when_a_bridge_is_made() -> None:
     code = (
-        "import sys, otonav.ros2, otonav.cli.run, otonav.ros2.naming; "
+        "import sys, otonav.ros2, otonav.cli._run, otonav.ros2._naming; "
         "print('cyclonedds' in sys.modules)"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

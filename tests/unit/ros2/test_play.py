@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from conftest import CliFails
 
-from otonav.record.qos_profile import offered_qos_yaml, recorded_qos
+from otonav.record._qos_profile import offered_qos_yaml, recorded_qos
 from otonav.runtime import LATCHED_QOS, SENSOR_DATA_QOS, QoS
 
 pytestmark = pytest.mark.unit

@@ -10,8 +10,8 @@ import anyio.lowlevel
 import pytest
 
 from otonav.runtime import SENSOR_DATA_QOS, Bus, virtual_loop_factory
-from otonav.runtime.funnel import Funnel
-from otonav.runtime.mailbox import Endpoint
+from otonav.runtime._funnel import Funnel
+from otonav.runtime._mailbox import Endpoint
 
 pytestmark = pytest.mark.unit
 

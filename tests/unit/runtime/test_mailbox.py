@@ -327,7 +327,7 @@ def test_a_late_transient_local_joiner_mid_delivery_gets_the_message_once(late: 
     message in its history; a transient-local subscriber (or a recorder's tap) joining
     now gets it from the history and must not get it again when the publisher resumes.
     (It did: the joiner was appended to the very list the publisher was iterating.)"""
-    from otonav.runtime.funnel import Funnel
+    from otonav.runtime._funnel import Funnel
 
     bus = Bus()
     kept = QoS(depth=5, durability=Durability.TRANSIENT_LOCAL)

@@ -14,9 +14,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from otonav.runtime import QoS, Reliability, TopicTypeError, virtual_loop_factory
-from otonav.runtime.funnel import Funnel
-from otonav.runtime.mailbox import Bus, Endpoint, Publisher, Subscription
-from otonav.runtime.qos import Durability
+from otonav.runtime._funnel import Funnel
+from otonav.runtime._mailbox import Bus, Endpoint, Publisher, Subscription
+from otonav.runtime._qos import Durability
 
 pytestmark = pytest.mark.unit
 

@@ -8,7 +8,7 @@ from typing import Any
 import pytest
 
 from otonav.runtime import QoS, Reliability, System
-from otonav.runtime.qos import Durability
+from otonav.runtime._qos import Durability
 
 pytestmark = pytest.mark.unit
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 import pytest
 
 from otonav.scenario import run_scenario
-from otonav.scenario.config import GoalSpec, ScenarioConfig
+from otonav.scenario._config import GoalSpec, ScenarioConfig
 from otonav.stack import StackConfig
 
 pytestmark = pytest.mark.unit

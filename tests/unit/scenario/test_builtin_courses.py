@@ -11,8 +11,8 @@ import pytest
 from otonav.hal import BoxObstacle
 from otonav.hal.mujoco import MujocoInterface
 from otonav.scenario import ScenarioConfig
-from otonav.scenario.builtin import AVOIDANCE, BUILTIN, GAP, describe
-from otonav.scenario.generator import (
+from otonav.scenario._builtin import AVOIDANCE, BUILTIN, GAP, describe
+from otonav.scenario._generator import (
     EMPTY_WALLS,
     FOOTPRINT_RADIUS,
     SPARSE,

@@ -12,8 +12,8 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from otonav.hal import BoxObstacle, PolygonObstacle, RoundObstacle
-from otonav.hal.types import convex_hull
-from otonav.scenario.clearance import ClearanceTracker
+from otonav.hal._types import convex_hull
+from otonav.scenario._clearance import ClearanceTracker
 
 pytestmark = pytest.mark.unit
 

@@ -15,8 +15,8 @@ from otonav.hal import BoxObstacle, FakeHardware
 from otonav.msgs import NavState
 from otonav.runtime import System, virtual_loop_factory
 from otonav.scenario import Judge, ScenarioConfig
-from otonav.scenario.verdict import judge_verdict
-from otonav.stack.files import ConfigFileError, load_model
+from otonav.scenario._verdict import judge_verdict
+from otonav.stack._files import ConfigFileError, load_model
 
 pytestmark = pytest.mark.unit
 

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 from otonav.hal import BoxObstacle
 from otonav.scenario import ScenarioConfig
-from otonav.scenario.generator import (
+from otonav.scenario._generator import (
     DENSE,
     EMPTY_WALLS,
     SPARSE,
@@ -27,7 +27,7 @@ from otonav.scenario.generator import (
     plan_path,
     walled_in,
 )
-from otonav.scenario.generator_grid import occupancy, shortest_path
+from otonav.scenario._generator_grid import occupancy, shortest_path
 
 pytestmark = pytest.mark.unit
 
@@ -279,7 +279,7 @@ def test_bad_params_name_the_field(field: str, value: Any) -> None:
 def test_the_generator_does_not_load_the_simulator() -> None:
     # A fresh interpreter: this one has imported everything already.
     code = (
-        "import sys, otonav.scenario.generator as g; g.generate_world(0); "
+        "import sys, otonav.scenario._generator as g; g.generate_world(0); "
         "print(sorted({m.split('.')[0] for m in sys.modules} & {'mujoco', 'anyio'}))"
     )
     child = subprocess.run(

@@ -7,7 +7,7 @@ import math
 
 import pytest
 
-from otonav.scenario.generator_indoor import INDOOR_FAMILIES, PLAN_CLEARANCE, generate_indoor
+from otonav.scenario._generator_indoor import INDOOR_FAMILIES, PLAN_CLEARANCE, generate_indoor
 
 pytestmark = pytest.mark.unit
 
@@ -45,7 +45,7 @@ def test_a_door_just_over_the_limit_is_labelled_open() -> None:
     """The labels pass a disc of the centre clearance, not footprint + clearance
     (0.54 m, which closed every gap under ~1.09 m)."""
     from otonav.hal import BoxObstacle
-    from otonav.scenario.generator import plan_path
+    from otonav.scenario._generator import plan_path
 
     wall = (BoxObstacle(0.0, 2.9, 0.05, 2.5), BoxObstacle(0.0, -2.9, 0.05, 2.5))  # gap 0.8
     assert plan_path(wall, (-2.0, 0.0), (2.0, 0.0), PLAN_CLEARANCE) is not None

@@ -7,8 +7,8 @@ from dataclasses import replace
 
 import pytest
 
-from otonav.scenario.generator import SPARSE, WALLED_IN, generate_world
-from otonav.scenario.generator_report import RunResult, summarise
+from otonav.scenario._generator import SPARSE, WALLED_IN, generate_world
+from otonav.scenario._generator_report import RunResult, summarise
 
 pytestmark = pytest.mark.unit
 

@@ -11,7 +11,7 @@ import pytest
 
 from otonav.hal import FakeHardware, GroundTruth
 from otonav.scenario import Judge
-from otonav.scenario.judge import TRAIL_POINTS
+from otonav.scenario._judge import TRAIL_POINTS
 
 pytestmark = pytest.mark.unit
 

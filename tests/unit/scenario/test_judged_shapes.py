@@ -13,7 +13,7 @@ import pytest
 from otonav.hal import BoxObstacle, RoundObstacle
 from otonav.hal.mujoco import MujocoInterface
 from otonav.scenario import run_scenario
-from otonav.scenario.config import GoalSpec, ScenarioConfig
+from otonav.scenario._config import GoalSpec, ScenarioConfig
 from otonav.stack import StackConfig
 
 pytestmark = pytest.mark.unit
@@ -111,7 +111,7 @@ def test_a_cylinder_s_clearance_is_measured(tmp_path: Path) -> None:
 def test_the_plot_draws_disks_and_mesh_footprints_with_the_boxes() -> None:
     """Issue 42: a scene of cylinders drew no obstacle. One artist still draws them all."""
     from otonav.hal import PolygonObstacle
-    from otonav.scenario.plot import draw_trajectory
+    from otonav.scenario._plot import draw_trajectory
 
     shapes = (
         BoxObstacle(1.0, 0.5, 0.2, 0.3, 0.0),

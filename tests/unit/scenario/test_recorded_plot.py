@@ -16,10 +16,10 @@ from matplotlib.path import Path as Path_
 from otonav.cli import main
 from otonav.hal import BoxObstacle
 from otonav.msgs import Header, Odometry, Point, Pose, PoseStamped, PoseWithCovariance, Time
-from otonav.record.writer import RecordingWriter
-from otonav.scenario.plot import box_outlines, draw_trajectory, key_poses
-from otonav.scenario.replay import plot_recording, recorded_plot
-from otonav.stack.worldmeta import WORLD_METADATA
+from otonav.record._writer import RecordingWriter
+from otonav.scenario._plot import box_outlines, draw_trajectory, key_poses
+from otonav.scenario._replay import plot_recording, recorded_plot
+from otonav.stack._worldmeta import WORLD_METADATA
 
 pytestmark = pytest.mark.unit
 

@@ -6,8 +6,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from otonav.scenario import ScenarioConfig, run_scenario
-from otonav.scenario.replay import recorded_plot
-from otonav.scenario.verdict import verdict_title
+from otonav.scenario._replay import recorded_plot
+from otonav.scenario._verdict import verdict_title
 
 
 def test_a_recorded_verdict_titles_the_plot(tmp_path: Path) -> None:

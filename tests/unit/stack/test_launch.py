@@ -7,12 +7,12 @@ from pathlib import Path
 
 import pytest
 
-from otonav.cli.loading import load_stack
+from otonav.cli._loading import load_stack
 from otonav.hal import FakeHardware
 from otonav.stack import StackConfig, build_actors
-from otonav.stack.config import ActorConfig
-from otonav.stack.files import ConfigFileError
-from otonav.stack.launch import add_actors, make_actor
+from otonav.stack._config import ActorConfig
+from otonav.stack._files import ConfigFileError
+from otonav.stack._launch import add_actors, make_actor
 
 ROOT = Path(__file__).resolve().parents[3]
 PLANNER = ROOT / "examples" / "my_nodes" / "simple_planner.py"
@@ -126,8 +126,8 @@ def test_the_class_key_is_written_as_class() -> None:
 
 
 def test_recovery_speeds_respect_the_navigators_limits() -> None:
-    from otonav.stack.build import navigation_params
-    from otonav.stack.overrides import apply_overrides
+    from otonav.stack._build import navigation_params
+    from otonav.stack._overrides import apply_overrides
 
     stack = apply_overrides(StackConfig(), ["nav.max_v=0.0001", "nav.max_omega=0.5"])
     params = navigation_params(stack, FakeHardware().geometry)

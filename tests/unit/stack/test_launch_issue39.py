@@ -11,12 +11,12 @@ from typing import Any
 import pytest
 
 from otonav.actors import topics
-from otonav.cli.loading import load_stack
+from otonav.cli._loading import load_stack
 from otonav.hal import FakeHardware
 from otonav.stack import StackConfig, build_actors
-from otonav.stack.config import ActorConfig
-from otonav.stack.files import ConfigFileError
-from otonav.stack.launch import make_actor
+from otonav.stack._config import ActorConfig
+from otonav.stack._files import ConfigFileError
+from otonav.stack._launch import make_actor
 
 pytestmark = pytest.mark.unit
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from otonav.actors import SafetyLayer
-from otonav.hal.fake import FakeHardware
+from otonav.hal._fake import FakeHardware
 from otonav.runtime import Actor
 from otonav.stack import StackConfig, build_actors
 

@@ -6,13 +6,13 @@ from __future__ import annotations
 
 import pytest
 
-from otonav.hal.fake import FakeHardware
-from otonav.hal.types import Reach
-from otonav.scenario.assembly import for_robot
-from otonav.scenario.builtin import BUILTIN
+from otonav.hal._fake import FakeHardware
+from otonav.hal._types import Reach
+from otonav.scenario._assembly import for_robot
+from otonav.scenario._builtin import BUILTIN
 from otonav.stack import StackConfig
-from otonav.stack.build import navigation_params
-from otonav.stack.robot import deadband
+from otonav.stack._build import navigation_params
+from otonav.stack._robot import deadband
 
 pytestmark = pytest.mark.unit
 
@@ -54,7 +54,7 @@ def test_a_robot_that_never_moved_is_taken_at_the_asked_figures() -> None:
 
 
 def test_the_verdict_table_says_what_the_robot_reached() -> None:
-    from otonav.cli.run import reach_row
+    from otonav.cli._run import reach_row
 
     assert reach_row({"v": 0.187, "asked_v": 0.22}) == [
         ("reaches", "0.187 of 0.22 m/s asked (85%)")

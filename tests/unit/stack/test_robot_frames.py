@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from otonav.actors.topics import FRAMES, Frames
-from otonav.stack.config import RobotConfig
-from otonav.stack.loading import load_stack_file
-from otonav.stack.overrides import apply_overrides
-from otonav.stack.robot import robot_frames
+from otonav.actors._topics import FRAMES, Frames
+from otonav.stack._config import RobotConfig
+from otonav.stack._loading import load_stack_file
+from otonav.stack._overrides import apply_overrides
+from otonav.stack._robot import robot_frames
 
 pytestmark = pytest.mark.unit
 

@@ -12,9 +12,9 @@ import anyio
 import pytest
 
 from otonav.embed import open_live_stack
-from otonav.hal.fake import FakeHardware
+from otonav.hal._fake import FakeHardware
 from otonav.msgs import Point, Pose, PoseStamped
-from otonav.record.reader import read_messages
+from otonav.record._reader import read_messages
 from otonav.runtime import (
     Actor,
     JumpSource,
@@ -24,7 +24,7 @@ from otonav.runtime import (
     virtual_loop_factory,
 )
 from otonav.stack import StackConfig
-from otonav.stack.session import StackSession
+from otonav.stack._session import StackSession
 from otonav.testing import running_stack
 
 pytestmark = pytest.mark.unit

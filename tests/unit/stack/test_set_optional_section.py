@@ -6,8 +6,8 @@ from __future__ import annotations
 import pytest
 
 from otonav.stack import StackConfig
-from otonav.stack.files import ConfigFileError
-from otonav.stack.overrides import apply_overrides
+from otonav.stack._files import ConfigFileError
+from otonav.stack._overrides import apply_overrides
 
 pytestmark = pytest.mark.unit
 

@@ -9,9 +9,9 @@ import warnings
 import pytest
 
 from otonav.stack import StackConfig
-from otonav.stack.build import navigation_params
-from otonav.stack.overrides import apply_overrides
-from otonav.stack.robot import nav_speeds, robot_base
+from otonav.stack._build import navigation_params
+from otonav.stack._overrides import apply_overrides
+from otonav.stack._robot import nav_speeds, robot_base
 
 pytestmark = pytest.mark.unit
 

@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 
 from otonav import limits
-from otonav.stack.files import ConfigFileError
-from otonav.sweep.plan import plan_runs
-from otonav.sweep.spec import GenerateSource, GenerateSpec, SeedRange, SweepSpec
+from otonav.stack._files import ConfigFileError
+from otonav.sweep._plan import plan_runs
+from otonav.sweep._spec import GenerateSource, GenerateSpec, SeedRange, SweepSpec
 
 pytestmark = pytest.mark.unit
 

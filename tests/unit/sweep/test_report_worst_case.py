@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from otonav.sweep.report import summarize, worst_case, write_report
+from otonav.sweep._report import summarize, worst_case, write_report
 
 
 def record(run_id: str, status: str, clearance: float | None, **more: Any) -> dict[str, Any]:

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from otonav.sweep.plan import plan_runs, run_id
-from otonav.sweep.spec import load_sweep
+from otonav.sweep._plan import plan_runs, run_id
+from otonav.sweep._spec import load_sweep
 
 pytestmark = pytest.mark.unit
 
@@ -137,8 +137,8 @@ def test_an_out_dir_holding_another_sweep_is_refused(
 def test_generated_worlds_are_named_by_params_and_seed_and_drawn_by_workers(
     tmp_path: Path,
 ) -> None:
-    from otonav.scenario.generator import DENSE, generate_world
-    from otonav.sweep.worlds import draw_world
+    from otonav.scenario._generator import DENSE, generate_world
+    from otonav.sweep._worlds import draw_world
 
     sweep = _write(
         tmp_path / "s.yaml",
@@ -184,7 +184,7 @@ def test_bad_generator_parameters(
 def test_the_quick_form_generates_worlds(tmp_path: Path) -> None:
     import argparse
 
-    from otonav.cli.sweep import quick_spec
+    from otonav.cli._sweep import quick_spec
 
     args = argparse.Namespace(
         scenario=[], generate=4, density="dense", gen=["max_speed=0.5"], seeds=None,

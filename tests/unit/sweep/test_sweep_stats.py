@@ -12,8 +12,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from otonav.sweep.results import ResultsFile, latest_by_run, read_results
-from otonav.sweep.stats import (
+from otonav.sweep._results import ResultsFile, latest_by_run, read_results
+from otonav.sweep._stats import (
     failures_by_reason,
     override_rates,
     pass_rate,

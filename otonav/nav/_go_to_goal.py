@@ -1,0 +1,84 @@
+"""Go-to-goal proportional controller ("turn, then drive").
+
+Frames and units: the pose and goal are in the same planar frame (``odom``), m and rad;
+the output is a body twist for ``base_link`` (x forward, yaw CCW), m/s and rad/s.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from otonav._params import GoToGoalParams
+from otonav.control._kinematics import Pose2D
+from otonav.nav._geometry import wrap_angle
+
+__all__ = ("GoToGoalParams", "GoalCommand", "go_to_goal")
+
+
+@dataclass(frozen=True, slots=True)
+class GoalCommand:
+    """Output of :func:`go_to_goal`.
+
+    Attributes:
+        v: forward speed command, m/s (never negative).
+        omega: yaw-rate command, rad/s (CCW positive).
+        reached: the goal is within tolerance; v and omega are then 0.
+        distance: Euclidean distance from pose to goal, m.
+        heading_error: bearing to goal minus yaw, wrapped to [-pi, pi], rad
+            (positive: goal is to the left).
+    """
+
+    v: float
+    omega: float
+    reached: bool
+    distance: float
+    heading_error: float
+
+
+def _require_finite(name: str, value: float) -> None:
+    if not math.isfinite(value):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+
+
+def go_to_goal(pose: Pose2D, goal_x: float, goal_y: float, params: GoToGoalParams) -> GoalCommand:
+    """Compute a twist that drives ``pose`` towards ``(goal_x, goal_y)``.
+
+    P-control on distance and heading error. With ``|heading_error|`` above
+    ``params.turn_in_place_threshold`` the robot turns in place (v = 0); otherwise
+    ``v = min(kp_lin*distance, max_v) * max(cos(heading_error), 0)``. Always
+    ``omega = clamp(kp_ang*heading_error, ±max_omega)``. Never reverses (v >= 0).
+
+    Args:
+        pose: robot pose in the odom frame.
+        goal_x: goal x in the odom frame, m.
+        goal_y: goal y in the odom frame, m.
+        params: gains and limits.
+
+    Returns:
+        The command and the errors it was computed from.
+
+    Raises:
+        ValueError: if an input is NaN or infinite; the message names it.
+    """
+    _require_finite("pose.x", pose.x)
+    _require_finite("pose.y", pose.y)
+    _require_finite("pose.yaw", pose.yaw)
+    _require_finite("goal_x", goal_x)
+    _require_finite("goal_y", goal_y)
+    dx = goal_x - pose.x
+    dy = goal_y - pose.y
+    distance = math.hypot(dx, dy)
+    heading_error = wrap_angle(math.atan2(dy, dx) - pose.yaw)
+    if distance <= params.tolerance:
+        return GoalCommand(
+            v=0.0, omega=0.0, reached=True, distance=distance, heading_error=heading_error
+        )
+    omega = min(max(params.kp_ang * heading_error, -params.max_omega), params.max_omega)
+    if abs(heading_error) > params.turn_in_place_threshold:
+        v = 0.0
+    else:
+        v = min(params.kp_lin * distance, params.max_v) * max(math.cos(heading_error), 0.0)
+    return GoalCommand(
+        v=v, omega=omega, reached=False, distance=distance, heading_error=heading_error
+    )
