@@ -7,7 +7,6 @@ import math
 
 import numpy as np
 
-from otonav._params import NavigationParams
 from otonav.actors import _topics as topics
 from otonav.actors._navigator import NAME, RATE_HZ, SCAN_TIMEOUT, GoalNavigator
 from otonav.actors._odom_history import OdomHistory
@@ -16,6 +15,7 @@ from otonav.msgs import LaserScan, NavDiagnostics, Time
 from otonav.nav._navigate import Navigation
 from otonav.nav._navigation import NavOutput
 from otonav.nav._scan import to_frame
+from otonav.params import NavigationParams
 from otonav.runtime import Output
 
 _AT_REST = frozenset({"idle", "waiting", "reached", "unreachable", "fault"})

@@ -8,12 +8,12 @@ from dataclasses import dataclass
 
 import anyio
 
-from otonav._params import BaseConfig
 from otonav.actors import _topics as topics
 from otonav.control import DiffDriveGeometry, limit_twist, twist_to_wheels
 from otonav.msgs import HardwareStatus, Header, Log, Time, Twist, WheelCommand
 from otonav.msgs._flat import FlatLayout
 from otonav.msgs._std import split_seconds
+from otonav.params import BaseConfig
 from otonav.runtime import Actor, Input, Output
 
 _DEFAULT = BaseConfig()

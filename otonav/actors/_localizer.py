@@ -13,7 +13,6 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav._params import LocalizerParams
 from otonav.actors import _topics as topics
 from otonav.actors._odom_history import OdomHistory
 from otonav.actors._scan_cache import points_of
@@ -35,6 +34,7 @@ from otonav.msgs import (
 from otonav.nav._geometry import wrap_angle
 from otonav.nav._scan_map import ScanMap
 from otonav.nav._scan_match import compose, inverse, match_scan, transform
+from otonav.params import LocalizerParams
 from otonav.runtime import Actor, Input, Output
 
 __all__ = ("Localizer", "LocalizerParams")

@@ -9,7 +9,6 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav._params import NavConfig
 from otonav.actors import _topics as topics
 from otonav.control import Pose2D
 from otonav.msgs import (
@@ -24,6 +23,7 @@ from otonav.msgs import (
     Vector3,
 )
 from otonav.nav import GoToGoalParams, GuardParams, go_to_goal, goal_problem, guard_blocked
+from otonav.params import NavConfig
 from otonav.runtime import Actor, Input, Output
 
 _log = logging.getLogger(__name__)

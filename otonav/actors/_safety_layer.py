@@ -7,13 +7,13 @@ from __future__ import annotations
 
 import math
 
-from otonav._params import SafetyConfig, SafetyParams
 from otonav.actors import _topics as topics
 from otonav.actors._odom_history import OdomHistory
 from otonav.actors._scan_cache import nearest_bound_of, nearest_of, points_of
 from otonav.msgs import Header, LaserScan, Odometry, SafetyState, Time, Twist, Vector3
 from otonav.nav._safety import safe_command, stopping_reach
 from otonav.nav._scan import to_frame
+from otonav.params import SafetyConfig, SafetyParams
 from otonav.runtime import Actor, Input, Output
 
 _DEFAULT = SafetyConfig()

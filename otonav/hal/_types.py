@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav._params import LIDAR_BEAMS, LIDAR_RANGE
+from otonav.params import LIDAR_BEAMS, LIDAR_RANGE
 
 __all__ = [
     "BoxObstacle",

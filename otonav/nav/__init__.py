@@ -2,7 +2,6 @@
 guard, the local planner (DWA), the safety limit, and the navigation that ties them
 with a costmap, a global path and recovery (:class:`Navigation`)."""
 
-from otonav._params import NavigationParams
 from otonav.nav._dwa import DwaParams, DwaResult, dwa_step
 from otonav.nav._footprint import centre_clearance
 from otonav.nav._geometry import goal_problem, wrap_angle
@@ -11,6 +10,7 @@ from otonav.nav._guard import GuardParams, guard_blocked
 from otonav.nav._navigate import Navigation
 from otonav.nav._navigation import NavOutput
 from otonav.nav._safety import SafetyParams, SafetyResult, safe_command
+from otonav.params import NavigationParams
 
 __all__ = (
     "DwaParams",

@@ -17,11 +17,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from otonav._params import NavigationParams
 from otonav.nav._dwa import ClearanceFn, DwaResult, clear_arc, dwa_step
 from otonav.nav._geometry import wrap_angle
 from otonav.nav._local_clearance import local_clearance, nearby
 from otonav.nav._planner import GlobalPlanner
+from otonav.params import NavigationParams
 
 __all__ = ("Command", "Controller")
 

@@ -33,8 +33,8 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav._params import NavigationParams
 from otonav.nav._scan import ScanRays
+from otonav.params import NavigationParams
 
 _NAV = NavigationParams()
 

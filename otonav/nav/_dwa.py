@@ -66,7 +66,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav._params import DwaParams
+from otonav.params import DwaParams
 
 __all__ = ("ClearanceFn", "DwaParams", "DwaResult", "PointClearanceFn", "clear_arc", "dwa_step")
 

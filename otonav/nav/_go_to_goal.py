@@ -9,9 +9,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from otonav._params import GoToGoalParams
 from otonav.control._kinematics import Pose2D
 from otonav.nav._geometry import wrap_angle
+from otonav.params import GoToGoalParams
 
 __all__ = ("GoToGoalParams", "GoalCommand", "go_to_goal")
 

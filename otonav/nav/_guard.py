@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav._params import GuardParams
+from otonav.params import GuardParams
 
 __all__ = ("GuardParams", "guard_blocked")
 

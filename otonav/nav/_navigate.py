@@ -24,7 +24,6 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav._params import NavigationParams
 from otonav.nav._controller import Controller
 from otonav.nav._dwa import DwaResult
 from otonav.nav._geometry import wrap_angle
@@ -32,6 +31,7 @@ from otonav.nav._navigation import NavOutput
 from otonav.nav._planner import GlobalPlanner, Plan
 from otonav.nav._recovery import Points, Pose, ProgressChecker, Recovery, Stage
 from otonav.nav._scan import ScanRays
+from otonav.params import NavigationParams
 
 __all__ = ("Navigation",)
 

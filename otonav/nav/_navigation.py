@@ -1,5 +1,5 @@
 """What each step of the avoiding navigator returns (:class:`NavOutput`). Its settings,
-:class:`~otonav._params.NavigationParams`, live in the numpy-free :mod:`otonav._params`;
+:class:`~otonav.params.NavigationParams`, live in the numpy-free :mod:`otonav.params`;
 the navigation itself is a global planner (:mod:`otonav.nav._planner`), a controller
 (:mod:`otonav.nav._controller`) and a recovery ladder (:mod:`otonav.nav._recovery`), tied
 by :class:`otonav.nav.Navigation` (:mod:`otonav.nav._navigate`).

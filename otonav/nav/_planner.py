@@ -16,12 +16,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav._params import NavigationParams
 from otonav.nav._costmap import ClearanceMap
 from otonav.nav._global_path import AstarSearch, GridPath
 from otonav.nav._observed_hull import ObservedHull, free_ends
 from otonav.nav._plan_grid import best_points, free_threshold, pooled
 from otonav.nav._scan import ScanRays
+from otonav.params import NavigationParams
 
 __all__ = ("LOOKAHEAD_TIME", "MIN_LOOKAHEAD", "GlobalPlanner", "Plan")
 

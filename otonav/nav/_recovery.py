@@ -20,9 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav._params import NavigationParams as Params
 from otonav.nav._costmap import ClearanceMap
 from otonav.nav._geometry import wrap_angle
+from otonav.params import NavigationParams as Params
 
 __all__ = (
     "LADDER",

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav._params import SafetyParams
+from otonav.params import SafetyParams
 
 __all__ = ("MAX_STEPS", "SafetyParams", "SafetyResult", "safe_command", "stopping_reach")
 

@@ -26,8 +26,8 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav._params import LocalizerParams
 from otonav.nav._costmap import square_grid
+from otonav.params import LocalizerParams
 
 _LOC = LocalizerParams()
 

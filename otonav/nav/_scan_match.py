@@ -39,9 +39,9 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from otonav._params import MatchParams
 from otonav.nav._geometry import wrap_angle
 from otonav.nav._scan_map import ScanMap
+from otonav.params import MatchParams
 
 __all__ = (
     "MatchParams",

@@ -9,9 +9,9 @@ from pathlib import Path
 from typing import Any
 
 from otonav import limits
-from otonav._params import NavConfig
 from otonav.hal import RobotHardwareInterface
 from otonav.hal._types import Reach
+from otonav.params import NavConfig
 from otonav.record._outlock import lock_output
 from otonav.runtime import (
     Actor,

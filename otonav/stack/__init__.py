@@ -10,7 +10,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING
 
-from otonav._params import BaseConfig, DwaConfig, GuardConfig, NavConfig, SafetyConfig
+from otonav.params import BaseConfig, DwaConfig, GuardConfig, NavConfig, SafetyConfig
 from otonav.stack._config import RatesConfig, StackConfig, WorldConfig
 from otonav.stack._files import ConfigFileError, describe_validation_error, to_json
 from otonav.stack._overrides import apply_overrides

@@ -8,16 +8,6 @@ from dataclasses import fields
 from functools import reduce
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from otonav._params import (
-    CONFIG_KEYS,
-    DwaParams,
-    GoToGoalParams,
-    GuardParams,
-    LocalizerParams,
-    MatchParams,
-    NavigationParams,
-    SafetyParams,
-)
 from otonav.actors import (
     EXTERNAL_COMMAND_WAIT,
     AvoidingNavigator,
@@ -37,6 +27,16 @@ from otonav.hal import BoxObstacle, RobotGeometry, RobotHardwareInterface
 from otonav.hal._types import Reach
 from otonav.hal.mujoco import MujocoInterface
 from otonav.nav._footprint import centre_clearance
+from otonav.params import (
+    CONFIG_KEYS,
+    DwaParams,
+    GoToGoalParams,
+    GuardParams,
+    LocalizerParams,
+    MatchParams,
+    NavigationParams,
+    SafetyParams,
+)
 from otonav.runtime import Actor
 from otonav.stack._config import StackConfig
 from otonav.stack._files import ConfigFileError
@@ -245,7 +245,7 @@ def build_actors(
 
 
 def _from_config(cls: type[P], config: StackConfig, **derived: Any) -> P:
-    """``cls`` with each field its config key sets (:data:`otonav._params.CONFIG_KEYS`)
+    """``cls`` with each field its config key sets (:data:`otonav.params.CONFIG_KEYS`)
     read from ``config``, but those ``derived`` here."""
     keys = CONFIG_KEYS[cls].items()
     read = {name: reduce(getattr, key.split("."), config) for name, key in keys}
@@ -257,7 +257,7 @@ def navigation_params(
 ) -> NavigationParams:
     """The avoiding navigator's settings from ``nav.*`` and the base's limits: the
     ``nav.dwa``, ``nav.map`` and ``nav.recovery`` sections pass through by their keys
-    (``otonav._params.CONFIG_KEYS``); what depends on the base or the footprint is
+    (``otonav.params.CONFIG_KEYS``); what depends on the base or the footprint is
     derived here. ``reach``: what the robot really reaches (ADR
     0066): the DWA's window grows by the accelerations it really has, and a robot slower
     than asked gets a progress window as much longer as it is slower. The window's top

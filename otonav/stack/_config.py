@@ -1,7 +1,7 @@
 """The launch file as data: pydantic models are the schema, defaults live in them (an
 installed wheel runs with no checkout); YAML files in ``config/`` override them. The
 sections that set the robot's base, the navigator, the guard and the safety layer are
-the parameter models' (:mod:`otonav._params`, numpy-free)."""
+the parameter models' (:mod:`otonav.params`, numpy-free)."""
 
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ from pydantic import (
 )
 
 from otonav import limits
-from otonav._params import (
+from otonav.params import (
     LIDAR_BEAMS,
     LIDAR_RANGE,
     BaseConfig,

@@ -10,7 +10,7 @@
   runtime-safe ones. An actor whose ``params`` are partly read once (the navigator's map
   size) names the ones it reads every step in ``live_parameters`` (paths under
   ``params``, a trailing ``.`` for a whole nested dataclass); the others are read-only.
-  Settable only where a config key sets it (:data:`otonav._params.CONFIG_KEYS`, which
+  Settable only where a config key sets it (:data:`otonav.params.CONFIG_KEYS`, which
   ``stack.build`` builds them from): a new value passes that key's bounds, exactly as
   ``--set KEY=VALUE`` does (issue 41: a client set
   ``safety.params.scales`` to 1e8, which ``--set`` caps at 100, and the safety layer
@@ -29,7 +29,7 @@ from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, TypeAdapter, ValidationError
 
-from otonav._params import CONFIG_KEYS
+from otonav.params import CONFIG_KEYS
 from otonav.runtime import Actor
 from otonav.stack._config import StackConfig
 

@@ -8,11 +8,11 @@ import warnings
 from pathlib import Path
 from typing import Final
 
-from otonav._params import BaseConfig, NavConfig
 from otonav.actors._topics import FRAMES, Frames
 from otonav.hal._description import BUILTIN_ROBOTS, Mount, RobotDescription, builtin_robot
 from otonav.hal._interface import RobotHardwareInterface
 from otonav.hal._types import Reach
+from otonav.params import BaseConfig, NavConfig
 from otonav.stack._config import MountConfig, RobotConfig, StackConfig
 from otonav.stack._files import ConfigFileError
 

@@ -177,7 +177,7 @@ def _heavy_modules(module: str) -> set[str]:
 
 def test_importing_the_stack_config_loads_no_numpy() -> None:
     assert _heavy_modules("otonav.stack") == set()
-    assert _heavy_modules("otonav._params") == set()
+    assert _heavy_modules("otonav.params") == set()
 
 
 def test_the_import_probe_sees_numpy() -> None:

@@ -21,7 +21,7 @@ sys.path.insert(0, str(ROOT / "scripts"))
 
 import docs_hooks  # noqa: E402
 
-PUBLIC_MODULES = ("otonav.errors", "otonav.limits")
+PUBLIC_MODULES = ("otonav.errors", "otonav.limits", "otonav.params")
 """Top-level modules that are public as they are (no package around them)."""
 
 SOURCES: dict[str, str] = {

@@ -11,7 +11,6 @@ import pytest
 from numpy.typing import NDArray
 from synthetic_scans import ROOM, box, scan
 
-from otonav._params import NavigationParams
 from otonav.actors import Bridge, topics
 from otonav.actors._localized_navigator import LocalizedNavigator
 from otonav.actors._localizer import Localizer, LocalizerParams
@@ -19,6 +18,7 @@ from otonav.actors._odometry_error import OdometryError
 from otonav.hal import FakeHardware
 from otonav.msgs import OccupancyGrid, Odometry, Time, WheelCommand
 from otonav.nav._scan_match import compose, inverse
+from otonav.params import NavigationParams
 from otonav.record.cdr import decode, encode
 from otonav.runtime import QoS, Reliability, System, virtual_loop_factory
 

@@ -14,9 +14,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from otonav._params import LocalizationConfig
 from otonav.nav._scan_map import ScanMap
 from otonav.nav._scan_match import MatchParams, correlative_search, match_scan, refine
+from otonav.params import LocalizationConfig
 
 pytestmark = pytest.mark.unit
 

@@ -9,9 +9,9 @@ from typing import Any
 
 import pytest
 
-from otonav._params import CONFIG_KEYS
 from otonav.actors import AvoidingNavigator, Navigator, SafetyLayer
 from otonav.nav import GoToGoalParams, NavigationParams, SafetyParams
+from otonav.params import CONFIG_KEYS
 from otonav.stack import StackConfig
 from otonav.stack._files import ConfigFileError
 from otonav.stack._live_parameters import ActorParameters, ParameterError

@@ -10,9 +10,9 @@ from typing import Any
 
 import pytest
 
-from otonav._params import CONFIG_KEYS, DwaParams, GoToGoalParams, NavigationParams, SafetyParams
 from otonav.actors import Navigator
 from otonav.hal._fake import FakeHardware
+from otonav.params import CONFIG_KEYS, DwaParams, GoToGoalParams, NavigationParams, SafetyParams
 from otonav.stack import StackConfig, build_actors
 from otonav.stack._build import navigation_params, safety_params
 from otonav.stack._overrides import apply_overrides
