@@ -33,24 +33,16 @@ ALIASES = {"rotate_threshold": "turn_in_place_threshold"}
 """Fields of the nav math named apart from the config key that sets them."""
 
 KNOWN: dict[tuple[str, object], str] = {
-    ("arrival", "stop"): "scenario/config.py scenario/judge.py",
     ("backend", "process"): "sweep/api.py",
     ("deadlock_grace", 0.5): "runtime/loop.py",
     ("depth", 10000): "actors/recorder.py runtime/funnel.py",
-    ("expect", "reached"): "scenario/config.py scenario/verdict.py",
-    ("goal_tolerance", 0.15): "scenario/config.py scenario/generator.py",
-    ("max_attempts", 50): "scenario/generator.py scenario/generator_indoor.py",
     ("name", "external"): "runtime/system.py",
     ("name", "sweep"): "sweep/api.py sweep/report.py sweep/spec.py",
     ("rate", 1.0): "replay/feed.py ros2/play.py",
     ("rate_hz", 20.0): "hal/can/tap.py params.py",
-    ("resolution", 0.05): "params.py scenario/generator.py scenario/generator_grid.py",
     ("scale", 1.0): "msgs/otonav_msgs.py runtime/clock.py runtime/timemode.py",
     ("scene", "obstacles"): "hal/mujoco/world.py stack/config.py",
-    ("source", "scenario"): "embed/runs.py scenario/assembly.py scenario/run.py "
-    "scenario/validate.py",
     ("wake", "timers"): "replay/runner.py",
-    ("wall_ceiling", 300.0): "embed/runs.py scenario/run.py",
     ("wall_ceiling", 600.0): "replay/runner.py",
 }
 """(name, default) -> the files (under otonav/, a private ``_`` dropped) that still write
