@@ -10,14 +10,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING
 
-from otonav.params import (
-    BaseConfig,
-    DwaConfig,
-    GuardConfig,
-    NavConfig,
-    RatesConfig,
-    SafetyConfig,
-)
+from otonav.params import BaseConfig, DwaConfig, GuardConfig, NavConfig, RatesConfig, SafetyConfig
 from otonav.stack._config import StackConfig, WorldConfig
 from otonav.stack._files import ConfigFileError, describe_validation_error, to_json
 from otonav.stack._overrides import apply_overrides
