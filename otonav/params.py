@@ -19,6 +19,7 @@ __all__ = (
     "CONFIG_KEYS",
     "LIDAR_BEAMS",
     "LIDAR_RANGE",
+    "AxisParams",
     "BaseConfig",
     "DwaConfig",
     "DwaParams",
@@ -29,8 +30,10 @@ __all__ = (
     "LocalizerParams",
     "MapConfig",
     "MatchParams",
+    "MonitorLimits",
     "NavConfig",
     "NavigationParams",
+    "RatesConfig",
     "RecoveryConfig",
     "SafetyConfig",
     "SafetyParams",
@@ -69,6 +72,57 @@ class BaseConfig(Section):
     """m/s², linear acceleration limit."""
     max_alpha: PositiveFloat = Field(3.0, le=limits.MAX_BASE_ALPHA)
     """rad/s², angular acceleration limit."""
+
+
+class RatesConfig(Section):
+    """Bridge publishing rates, Hz. Each at most the physics tick rate (1 / timestep):
+    a timer cannot fire more often than the world ticks."""
+
+    clock_hz: PositiveFloat = 100.0
+    odom_hz: PositiveFloat = 100.0
+    imu_hz: PositiveFloat = 100.0
+    scan_hz: PositiveFloat = 10.0
+
+
+@dataclass(frozen=True, slots=True)
+class MonitorLimits:
+    """The CAN drive monitor's limits (``hal.can``): seconds of sim time, and the
+    tolerated encoder frame loss (0..1)."""
+
+    startup_timeout: float = 1.0
+    heartbeat_timeout: float = 0.25
+    encoder_timeout: float = 0.05
+    encoder_period: float = 0.01
+    max_frame_loss: float = 0.2
+    loss_window: float = 0.5
+    recovery_delay: float = 0.3
+    max_recovery_attempts: int = 3
+    recovery_reset: float = 5.0
+    """s of running without a fault after which each drive's attempts count from 0."""
+
+
+@dataclass(frozen=True, slots=True)
+class AxisParams:
+    """An emulated ODrive's configuration (``hal.sim``: what ``odrivetool`` would have
+    saved on the drive)."""
+
+    node_id: int
+    vel_limit: float = 20.0
+    """turns/s."""
+    vel_ramp_rate: float = 200.0
+    """turns/s²: how fast the setpoint may change."""
+    watchdog_timeout: float = 0.2
+    """s; 0 disables the watchdog."""
+    arm_time: float = 0.01
+    """s from the closed-loop request to closed loop."""
+    overspeed_factor: float = 1.5
+
+    def __post_init__(self) -> None:
+        for name in ("vel_limit", "vel_ramp_rate"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"AxisParams.{name} must be > 0, got {getattr(self, name)}")
+        if self.watchdog_timeout < 0 or self.arm_time < 0:
+            raise ValueError("AxisParams.watchdog_timeout and arm_time must be >= 0")
 
 
 _BASE = BaseConfig()

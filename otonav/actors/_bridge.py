@@ -45,7 +45,10 @@ from otonav.msgs import (
 )
 from otonav.msgs._flat import FlatLayout, reader
 from otonav.msgs._std import split_seconds
+from otonav.params import RatesConfig
 from otonav.runtime import Actor, Input, Output, Publisher
+
+_RATES = RatesConfig()
 
 log = logging.getLogger("otonav.hal")
 
@@ -209,10 +212,10 @@ class Bridge(Actor):
         self,
         hal: RobotHardwareInterface,
         *,
-        clock_hz: float = 100.0,
-        odom_hz: float = 100.0,
-        imu_hz: float = 100.0,
-        scan_hz: float = 10.0,
+        clock_hz: float = _RATES.clock_hz,
+        odom_hz: float = _RATES.odom_hz,
+        imu_hz: float = _RATES.imu_hz,
+        scan_hz: float = _RATES.scan_hz,
         diagnostics_hz: float = 1.0,
         joint_states_hz: float = 10.0,
         initial_pose: tuple[float, float, float] = (0.0, 0.0, 0.0),

@@ -11,7 +11,7 @@ import anyio
 from otonav.record._diskfull import DiskFullError
 from otonav.record._writer import RecordingWriter
 from otonav.runtime import Actor, Bus
-from otonav.runtime._funnel import Funnel
+from otonav.runtime._funnel import DEPTH, Funnel
 
 log = logging.getLogger("otonav.recorder")
 
@@ -39,7 +39,7 @@ class Recorder(Actor):
         writer: RecordingWriter,
         *,
         period: float = 0.1,
-        depth: int = 10_000,
+        depth: int = DEPTH,
         name: str = "recorder",
     ) -> None:
         super().__init__(name)

@@ -16,6 +16,7 @@ from otonav.engine._live import _wait_done
 from otonav.runtime import Actor
 from otonav.scenario import ScenarioConfig, Verdict, run_scenario
 from otonav.scenario._assembly import scenario_world
+from otonav.scenario._run import SOURCE, WALL_CEILING
 from otonav.stack import StackConfig
 
 #: Simulations run at once through :func:`run_scenario_async` with the default limiter.
@@ -70,7 +71,7 @@ class _RunControl:
 
 
 def check_run(
-    scenario: ScenarioConfig, stack: StackConfig = StackConfig(), *, source: str = "scenario"
+    scenario: ScenarioConfig, stack: StackConfig = StackConfig(), *, source: str = SOURCE
 ) -> None:
     """Raise what :func:`run_scenario_async` (and the CLI) would reject before running:
     an unknown or broken scene (:class:`~otonav.hal.mujoco.SceneError`), a goal outside
@@ -87,11 +88,11 @@ async def run_scenario_async(
     out_dir: Path | None,
     record: bool = True,
     plot: bool = True,
-    wall_ceiling: float | None = 300.0,
+    wall_ceiling: float | None = WALL_CEILING,
     extra_actors: tuple[Actor, ...] = (),
     limiter: anyio.CapacityLimiter | None = None,
     on_start: _OnStart | None = None,
-    source: str = "scenario",
+    source: str = SOURCE,
 ) -> Verdict:
     """:func:`~otonav.scenario.run_scenario` in a worker thread, on its own virtual-time
     loop, while the caller's loop keeps serving. Returns the same verdict (and

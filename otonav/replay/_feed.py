@@ -207,7 +207,7 @@ class ReplayClock(Clock):
     """
 
     def __init__(
-        self, gate: Gate, actor: str, *, wakes: Sequence[int] | None = None, rate: float = 1.0
+        self, gate: Gate, actor: str, *, wakes: Sequence[int] | None = None, rate: float
     ) -> None:
         self._gate = gate
         self._loop = gate.loop

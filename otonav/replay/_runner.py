@@ -212,8 +212,8 @@ def _replay(
     overrides: Sequence[str] = (),
     stack: StackConfig | None = None,
     tolerance: float = 0.0,
-    wake: Literal["timers", "recorded"] = "timers",
-    wall_ceiling: float | None = 600.0,
+    wake: Literal["timers", "recorded"],
+    wall_ceiling: float | None,
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
 ) -> ReplayResult:
     """The body of :func:`replay_recording`."""

@@ -131,6 +131,9 @@ class VirtualClock(Clock):
         # Woken by the timer: it has run, nothing to cancel (a cancel call per wake less).
 
 
+REAL_TIME_SCALE = 1.0
+"""Sim seconds per wall second unless told: real time (:class:`RealTimeClock`, and so
+:class:`~otonav.runtime.RealTime`)."""
 MAX_STEP_BATCH = 0.05
 """s of sim time: the most a real-time run steps at once after the loop was held up (the
 excess slips): 25 MuJoCo steps of 2 ms, well under a millisecond for the shipped robot.
@@ -158,7 +161,7 @@ class RealTimeClock(Clock):
         self,
         source: TimeSource,
         *,
-        scale: float = 1.0,
+        scale: float = REAL_TIME_SCALE,
         max_step_batch: float | None = MAX_STEP_BATCH,
     ) -> None:
         if not (scale > 0 and math.isfinite(scale)):

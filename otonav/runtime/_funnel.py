@@ -48,6 +48,10 @@ class Delivery(NamedTuple):
     message: Any
 
 
+DEPTH = 10_000
+"""Messages a funnel holds before its publishers wait (the recorder's default)."""
+
+
 # The loosest request: matches every publisher (ROS 2 rules), so tapping a topic can
 # never make wiring fail. Nothing is dropped anyway: the funnel applies backpressure.
 TAP_QOS = QoS(Reliability.BEST_EFFORT, depth=1)
@@ -113,7 +117,7 @@ class Funnel:
         now: Callable[[], float],
         *,
         wanted: Callable[[str], bool] = lambda _name: True,
-        depth: int = 10_000,
+        depth: int = DEPTH,
         high_water: int | None = None,
     ) -> None:
         if depth < 1:

@@ -35,6 +35,10 @@ from otonav.runtime._watchdog import LoopWatchdog
 _T = TypeVar("_T")
 _Ts = TypeVarTuple("_Ts")
 
+DEADLOCK_GRACE = 0.5
+"""Wall seconds with no timer due and no I/O before a virtual-time loop reports a
+deadlock (the default of the loop, its factory and ``@pytest.mark.sim``)."""
+
 
 class VirtualTimeLoop(SteppedSelectorLoop):
     """An asyncio loop whose ``time()`` is the simulated time of ``source``.
@@ -53,7 +57,7 @@ class VirtualTimeLoop(SteppedSelectorLoop):
         source: TimeSource | None = None,
         *,
         wall_ceiling: float | None = None,
-        deadlock_grace: float | None = 0.5,
+        deadlock_grace: float | None = DEADLOCK_GRACE,
         hold_grace: float = 2.0,
     ) -> None:
         super().__init__()
@@ -290,7 +294,7 @@ def virtual_loop_factory(
     source: TimeSource | None = None,
     *,
     wall_ceiling: float | None = None,
-    deadlock_grace: float | None = 0.5,
+    deadlock_grace: float | None = DEADLOCK_GRACE,
 ) -> Callable[[], VirtualTimeLoop]:
     """A zero-argument loop factory for ``asyncio.Runner``, ``anyio.run`` and pytest.
 

@@ -70,6 +70,10 @@ class _ActorState:
     done: anyio.Event | None = None  # set when its supervisor has returned
 
 
+_EXTERNAL = "external"
+"""The endpoint name of code outside the actors (tests, hosts)."""
+
+
 class System:
     """Actors on one bus; see the module docstring."""
 
@@ -131,13 +135,13 @@ class System:
     # -- for code outside the actors (tests, hosts) -------------------------------------
 
     def subscribe(
-        self, topic: str, msg_type: type[Any], qos: QoS = DEFAULT_QOS, *, name: str = "external"
+        self, topic: str, msg_type: type[Any], qos: QoS = DEFAULT_QOS, *, name: str = _EXTERNAL
     ) -> Subscription[Any]:
         """A mailbox on ``topic`` for code outside the actors; same checks as ports."""
         return self.bus.subscribe(topic, msg_type, qos, endpoint=Endpoint(name, topic))
 
     def publisher(
-        self, topic: str, msg_type: type[Any], qos: QoS = DEFAULT_QOS, *, name: str = "external"
+        self, topic: str, msg_type: type[Any], qos: QoS = DEFAULT_QOS, *, name: str = _EXTERNAL
     ) -> Publisher[Any]:
         """A publisher on ``topic`` for code outside the actors; same checks as ports."""
         return self.bus.publisher(topic, msg_type, qos, endpoint=Endpoint(name, topic))

@@ -15,7 +15,7 @@ import math
 from dataclasses import dataclass
 
 from otonav.limits import check_scale
-from otonav.runtime._clock import MAX_STEP_BATCH, RealTimeClock
+from otonav.runtime._clock import MAX_STEP_BATCH, REAL_TIME_SCALE, RealTimeClock
 from otonav.runtime._timesource import TimeSource
 
 __all__ = ["RealTime", "TimeMode", "Virtual"]
@@ -37,7 +37,7 @@ class RealTime:
     steps at most ``max_step_batch`` s of sim time (after a stall sim time slips behind
     instead of catching up in a burst; None: no cap)."""
 
-    scale: float = 1.0
+    scale: float = REAL_TIME_SCALE
     max_step_batch: float | None = MAX_STEP_BATCH
 
     def __post_init__(self) -> None:

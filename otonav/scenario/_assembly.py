@@ -51,7 +51,7 @@ def for_robot(
 
 
 def scenario_world(
-    scenario: ScenarioConfig, stack: StackConfig, *, source: str = "scenario"
+    scenario: ScenarioConfig, stack: StackConfig, *, source: str
 ) -> tuple[ScenarioConfig, StackConfig, RobotHardwareInterface]:
     """The scenario as run with the stack's robot (:func:`for_robot`), the stack config
     with the scenario's scene, and its world with the scenario's obstacles and start

@@ -35,7 +35,7 @@ import numpy as np
 
 from otonav.hal import BoxObstacle
 from otonav.scenario._config import BoxSpec, GoalSpec, ScenarioConfig, StartSpec
-from otonav.scenario._generator_grid import GridPath, occupancy, shortest_path
+from otonav.scenario._generator_grid import CELL, GridPath, occupancy, shortest_path
 
 __all__ = (
     "DENSE",
@@ -68,6 +68,8 @@ compares them with what the MuJoCo HAL reads)."""
 FOOTPRINT_RADIUS = math.hypot(0.21, 0.1225)
 """m (0.243): the circle about base_link that holds the robot's outline (chassis box
 reaching 0.21 m ahead of the axle, wheels at y = +-0.1225 m; ``robot.xml``)."""
+
+_SCENARIO = ScenarioConfig()
 
 
 @dataclass(frozen=True, slots=True)
@@ -110,11 +112,11 @@ class WorldParams:
     keepout: float = 0.9
     footprint_radius: float = FOOTPRINT_RADIUS
     clearance: float = 0.3
-    goal_tolerance: float = 0.15
+    goal_tolerance: float = _SCENARIO.goal_tolerance
     max_speed: float = 0.4
     budget_factor: float = 3.0
     budget_slack: float = 30.0
-    resolution: float = 0.05
+    resolution: float = CELL
     walled_in: bool = False
     ring_inner: tuple[float, float] = (0.7, 1.0)
     ring_thickness: float = 0.2
@@ -252,7 +254,7 @@ def plan_path(
     goal: tuple[float, float],
     inflation: float,
     *,
-    resolution: float = 0.05,
+    resolution: float = CELL,
     half: float = EMPTY_ARENA_HALF,
 ) -> GridPath | None:
     """The shortest path (m) for a disc of radius ``inflation`` from start to goal in

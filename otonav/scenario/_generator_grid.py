@@ -35,6 +35,11 @@ __all__ = ("Grid", "GridPath", "occupancy", "shortest_path")
 _SQRT2 = math.sqrt(2.0)
 
 
+CELL = 0.05
+"""m, the labelling grid's cell (``WorldParams.resolution``): the generator's own, not
+the localizer's map (``nav.localization.resolution``), which only happens to match."""
+
+
 @dataclass(frozen=True, slots=True)
 class Grid:
     """A square occupancy grid over ``[-half, half]^2`` m: ``blocked[i, j]`` is the cell
@@ -86,7 +91,7 @@ def box_distances(
 
 
 def occupancy(
-    boxes: Sequence[BoxObstacle], half: float, inflation: float, resolution: float = 0.05
+    boxes: Sequence[BoxObstacle], half: float, inflation: float, resolution: float = CELL
 ) -> Grid:
     """The grid over the arena ``[-half, half]^2`` (m), each cell blocked when its centre
     is within ``inflation`` (m) of a box (inside one, for 0) or closer to the arena's edge."""

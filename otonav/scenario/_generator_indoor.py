@@ -205,7 +205,9 @@ def _turn_yaw(yaw: float, k: int) -> float:
     return _r(math.remainder(yaw + (k // 2) * math.pi / 2, math.tau))
 
 
-def generate_indoor(seed: int, family: str, max_attempts: int = 50) -> GeneratedWorld:
+def generate_indoor(
+    seed: int, family: str, max_attempts: int = INDOOR.max_attempts
+) -> GeneratedWorld:
     """One world of ``family`` drawn from ``seed`` (>= 0); the same pair always gives
     the same world. Reachable families redraw (same stream) until the labelling
     finds a path, at most ``max_attempts`` times."""

@@ -11,7 +11,9 @@ from otonav.hal import BoxObstacle, RobotHardwareInterface
 from otonav.msgs import NavDiagnostics, NavState, Odometry
 from otonav.runtime import Actor, Input, QoS, Reliability
 from otonav.scenario._clearance import ClearanceTracker
+from otonav.scenario._config import ScenarioConfig
 
+_SCENARIO = ScenarioConfig()
 #: s of sim time the judge keeps watching after the robot first enters the tolerance.
 ARRIVAL_SETTLE_S = 2.0
 #: m/s: the true speed below which the robot counts as stopped at the goal.
@@ -59,7 +61,7 @@ class Judge(Actor):
         settle_s: float = ARRIVAL_SETTLE_S,
         max_speed: float = ARRIVAL_MAX_SPEED,
         nav_must_say_reached: bool = True,
-        arrival: Literal["stop", "enter"] = "stop",
+        arrival: Literal["stop", "enter"] = _SCENARIO.arrival,
         name: str = "judge",
     ) -> None:
         super().__init__(name)

@@ -25,6 +25,12 @@ from otonav.scenario._verdict import Verdict
 from otonav.stack import StackConfig
 from otonav.stack._session import StackSession
 
+SOURCE = "scenario"
+"""What configuration errors name a scenario given as an object (the CLI names its
+file)."""
+WALL_CEILING = 300.0
+"""s of wall time after which a judged run in virtual time counts as hung."""
+
 
 async def _main(
     scenario: ScenarioConfig,
@@ -43,10 +49,10 @@ def run_scenario(
     out_dir: Path | None = None,
     record: bool = True,
     plot: PlotWhen = True,
-    wall_ceiling: float | None = 300.0,
+    wall_ceiling: float | None = WALL_CEILING,
     extra_actors: tuple[Actor, ...] = (),
     on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
-    source: str = "scenario",
+    source: str = SOURCE,
     progress: Callable[[Judge, float], None] | None = None,
     time: TimeMode = Virtual(),
     gui: bool = False,

@@ -36,7 +36,7 @@ def check_goal(
     obstacles: tuple[BoxObstacle, ...],
     walls: tuple[BoxObstacle, ...],
     *,
-    source: str = "scenario",
+    source: str,
 ) -> None:
     """Raise :class:`ConfigFileError` when the goal or the start is outside the arena or
     closer to an obstacle than the clearance the scenario demands."""
@@ -68,9 +68,7 @@ def check_goal(
                 )
 
 
-def check_cost(
-    scenario: ScenarioConfig, stack: StackConfig, boxes: int, *, source: str = "scenario"
-) -> None:
+def check_cost(scenario: ScenarioConfig, stack: StackConfig, boxes: int, *, source: str) -> None:
     """Raise :class:`ConfigFileError` when a run of this scenario on this stack is
     estimated to take more wall time than :data:`~otonav.limits.WALL_BUDGET_S`
     (each value within its own bound, together too much: a tiny timestep and a long

@@ -13,6 +13,8 @@ from otonav.scenario._judge import Judge
 from otonav.stack import StackConfig
 from otonav.stack._robot import describe_robot, reached
 
+_SCENARIO = ScenarioConfig()
+
 
 @dataclass(frozen=True, slots=True)
 class Verdict:
@@ -31,7 +33,7 @@ class Verdict:
     rtf: float
     recording: str | None = None
     plot: str | None = None
-    expect: str = "reached"
+    expect: str = _SCENARIO.expect
     """The scenario's expected outcome: ``reached`` or ``unreachable``."""
     unreachable_at_s: float | None = None
     """s of sim time when the navigator reported the goal unreachable; None if never."""

@@ -10,8 +10,8 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING
 
-from otonav.params import BaseConfig, DwaConfig, GuardConfig, NavConfig, SafetyConfig
-from otonav.stack._config import RatesConfig, StackConfig, WorldConfig
+from otonav.params import BaseConfig, DwaConfig, GuardConfig, NavConfig, RatesConfig, SafetyConfig
+from otonav.stack._config import StackConfig, WorldConfig
 from otonav.stack._files import ConfigFileError, describe_validation_error, to_json
 from otonav.stack._overrides import apply_overrides
 

@@ -21,9 +21,12 @@ from otonav import limits
 from otonav.params import (
     LIDAR_BEAMS,
     LIDAR_RANGE,
+    AxisParams,
     BaseConfig,
     GuardConfig,
+    MonitorLimits,
     NavConfig,
+    RatesConfig,
     SafetyConfig,
     Section,
 )
@@ -49,6 +52,9 @@ _CanDelay = Annotated[float, _within(0.0, limits.MAX_CAN_TIMEOUT_S, " s")]
 """A CAN wait where 0 means none (or off), s."""
 _NodeId = Annotated[int, _within(0, 63)]
 """An ODrive CAN Simple node id: 6 bits."""
+
+_MONITOR = MonitorLimits()
+_DRIVE = AxisParams(0)
 
 
 class OdometryErrorConfig(Section):
@@ -95,16 +101,6 @@ class WorldConfig(Section):
     """Simulated odometry drift (off by default): see :class:`OdometryErrorConfig`."""
 
 
-class RatesConfig(Section):
-    """Bridge publishing rates, Hz. Each at most the physics tick rate (1 / timestep):
-    a timer cannot fire more often than the world ticks."""
-
-    clock_hz: PositiveFloat = 100.0
-    odom_hz: PositiveFloat = 100.0
-    imu_hz: PositiveFloat = 100.0
-    scan_hz: PositiveFloat = 10.0
-
-
 class CanAxisConfig(Section):
     """One wheel's drive as the host sees it: CAN node id, direction sign, gearing."""
 
@@ -129,23 +125,25 @@ class CanConfig(Section):
     """Run the drive emulator at the far end of the bus (false: real drives)."""
     left: CanAxisConfig = CanAxisConfig(node_id=0, sign=-1)
     right: CanAxisConfig = CanAxisConfig(node_id=1, sign=1)
-    encoder_period: _CanPeriod = 0.01
+    encoder_period: _CanPeriod = _MONITOR.encoder_period
     """The drives' Get_Encoder_Estimates period (ODrive ``encoder_msg_rate_ms``)."""
-    startup_timeout: _CanTimeout = 1.0
-    heartbeat_timeout: _CanTimeout = 0.25
-    encoder_timeout: _CanTimeout = 0.05
+    startup_timeout: _CanTimeout = _MONITOR.startup_timeout
+    heartbeat_timeout: _CanTimeout = _MONITOR.heartbeat_timeout
+    encoder_timeout: _CanTimeout = _MONITOR.encoder_timeout
     """s: an encoder estimate older than this (none arrived, or its frame's timestamp is
     that old) is a fault for as long as it lasts. Must be longer than ``encoder_period``."""
-    max_frame_loss: Annotated[float, _within(0.0, 1.0)] = 0.2
+    max_frame_loss: Annotated[float, _within(0.0, 1.0)] = _MONITOR.max_frame_loss
     """Fraction of encoder frames that may be lost over ``loss_window`` s."""
-    loss_window: _CanTimeout = 0.5
+    loss_window: _CanTimeout = _MONITOR.loss_window
     """At least ``encoder_period``."""
-    recovery_delay: _CanDelay = 0.3
+    recovery_delay: _CanDelay = _MONITOR.recovery_delay
     """s a fault's cause must stay clear before recovery starts."""
-    max_recovery_attempts: Annotated[int, _within(0, limits.MAX_RECOVERY_ATTEMPTS)] = 3
+    max_recovery_attempts: Annotated[int, _within(0, limits.MAX_RECOVERY_ATTEMPTS)] = (
+        _MONITOR.max_recovery_attempts
+    )
     """Recovery attempts per drive, whatever the fault; then the fault is permanent and
     a scenario run ends on it."""
-    recovery_reset: _CanTimeout = 5.0
+    recovery_reset: _CanTimeout = _MONITOR.recovery_reset
     """s a drive must run without a fault before its count of recovery attempts starts
     again from zero."""
     command_keepalive: _CanDelay = 0.1
@@ -245,18 +243,19 @@ class DriveSimConfig(Section):
     left_node_id: _NodeId = 0
     right_node_id: _NodeId = 1
     heartbeat_period: _CanPeriod = 0.1
-    encoder_period: _CanPeriod = 0.01
+    encoder_period: _CanPeriod = _MONITOR.encoder_period
+    """By default the drives send as often as the host expects (``hal.can``)."""
     vel_limit: Annotated[
         float, _within(0.0, limits.MAX_DRIVE_VEL_TURNS_S, " turns/s", open_low=True)
-    ] = 20.0
+    ] = _DRIVE.vel_limit
     """turns/s."""
     vel_ramp_rate: Annotated[
         float, _within(0.0, limits.MAX_DRIVE_RAMP_TURNS_S2, " turns/s^2", open_low=True)
-    ] = 200.0
+    ] = _DRIVE.vel_ramp_rate
     """turns/s^2: the setpoint's slew in input mode VEL_RAMP (``hal.can.input_mode``)."""
-    watchdog_timeout: _CanDelay = 0.2
+    watchdog_timeout: _CanDelay = _DRIVE.watchdog_timeout
     """s without Set_Input_Vel before the axis stops (0: off)."""
-    arm_time: _CanDelay = 0.01
+    arm_time: _CanDelay = _DRIVE.arm_time
     seed: int = Field(0, ge=0, le=limits.MAX_SEED)
     """Seeds the injected faults' random numbers."""
     faults: FaultsConfig = FaultsConfig()

@@ -19,21 +19,25 @@ from typing import Any
 from otonav.sweep import _runner as runner
 from otonav.sweep._plan import RunTask
 from otonav.sweep._report import summarize, write_report
+from otonav.sweep._spec import SweepSpec
 
 _DONE = object()
+BACKEND = "process"
+"""Where the runs go unless told (``otonav sweep --backend`` says it again)."""
+_NAME: str = SweepSpec.model_fields["name"].default
 
 
 async def sweep_results(
     tasks: Sequence[RunTask],
     *,
     out: Path,
-    backend: str = "process",
+    backend: str = BACKEND,
     workers: int | None = None,
     ray_address: str | None = None,
     resume: bool = False,
     retry_errors: bool = False,
     report: bool = True,
-    name: str = "sweep",
+    name: str = _NAME,
 ) -> AsyncIterator[dict[str, Any]]:
     """Yield one record (the line written to ``results.jsonl``) per run as it finishes.
     With ``report``, a sweep that ran to its end also writes ``summary.json`` and
@@ -96,12 +100,12 @@ def run_sweep(
     tasks: Sequence[RunTask],
     *,
     out: Path,
-    backend: str = "process",
+    backend: str = BACKEND,
     workers: int | None = None,
     ray_address: str | None = None,
     resume: bool = False,
     report: bool = True,
-    name: str = "sweep",
+    name: str = _NAME,
 ) -> dict[str, Any]:
     """Run the sweep to its end in this thread; return its summary (see
     :func:`~otonav.sweep._report.summarize`)."""

@@ -27,9 +27,7 @@ _FAILURE_KEYS = (
 )  # fmt: skip
 
 
-def summarize(
-    records: Sequence[dict[str, Any]], *, planned: int, name: str = "sweep"
-) -> dict[str, Any]:
+def summarize(records: Sequence[dict[str, Any]], *, planned: int, name: str) -> dict[str, Any]:
     """Everything the report says, as JSON data."""
     judged = [r for r in records if r.get("status") != "error"]
     failures = failures_by_reason(records)

@@ -24,7 +24,7 @@ import pytest
 
 from otonav.errors import UsageError
 from otonav.runtime._errors import SimTimeoutError
-from otonav.runtime._loop import virtual_loop_factory
+from otonav.runtime._loop import DEADLOCK_GRACE, virtual_loop_factory
 
 DEFAULT_WALL_CEILING = 60.0
 DEFAULT_ARTIFACTS = "out/test-artifacts"
@@ -69,7 +69,7 @@ def pytest_asyncio_loop_factories(
     return {
         "virtual": virtual_loop_factory(
             wall_ceiling=marker.kwargs.get("wall_ceiling", DEFAULT_WALL_CEILING),
-            deadlock_grace=marker.kwargs.get("deadlock_grace", 0.5),
+            deadlock_grace=marker.kwargs.get("deadlock_grace", DEADLOCK_GRACE),
         )
     }
 

@@ -74,7 +74,7 @@ class PoseProbe(Actor):
 
 def _run(overrides: list[str]) -> tuple[Verdict, PoseProbe]:
     stack = apply_overrides(StackConfig(), overrides)
-    scenario, stack, hal = scenario_world(CLUTTERED, stack)
+    scenario, stack, hal = scenario_world(CLUTTERED, stack, source="cluttered")
     judge = Judge(hal, (scenario.goal.x, scenario.goal.y), scenario.goal_tolerance)
     probe = PoseProbe(hal)
     session = scenario_session(scenario, stack, hal, judge, extra_actors=(probe,))

@@ -3,19 +3,13 @@ stack's config loads no numpy.
 
 The finder walks every module of otonav/ (AST, nothing imported): the literal defaults
 of class fields (dataclass and pydantic fields, ``Field(default, ...)`` and
-``field(default=...)`` too) and of function parameters, grouped by the name they set
-(``ALIASES``: one parameter, two names). A name with the same literal default in two
-places is one parameter written twice: the next change moves one and not the other.
-Neutral values (0, "", True, False, None) are not knowledge and are left out. A default
-that refers to another (``max_accel: float = _BASE.max_accel``) is not a literal: that
-is the fix.
-
-``KNOWN`` lists what is still written twice, by file, each in a part of otonav that
-issue 36's other items change in parallel (hal/, the bridge, scenario/, sweep/,
-replay/, runtime/, ros2/), or two parameters that share a name and a value by chance
-(the CAN tap's rate and the safety layer's, the generator's grid cell and the
-localizer's). A new duplicate fails; so does an entry that is gone: the list only
-shrinks.
+``field(default=...)`` too) and of function parameters, grouped by the parameter they
+set: by name, with ``ALIASES`` (one parameter, two names) and ``HOMONYMS`` (two
+parameters, one name). A parameter with the same literal default in two places is one
+parameter written twice: the next change moves one and not the other. Neutral values
+(0, "", True, False, None) are not knowledge and are left out. A default that refers to
+another (``max_accel: float = _BASE.max_accel``) is not a literal: that is the fix; so
+is no default, where every caller passes the value anyway.
 """
 
 from __future__ import annotations
@@ -32,50 +26,11 @@ ROOT = Path(__file__).resolve().parents[2]
 ALIASES = {"rotate_threshold": "turn_in_place_threshold"}
 """Fields of the nav math named apart from the config key that sets them."""
 
-KNOWN: dict[tuple[str, object], str] = {
-    ("arm_time", 0.01): "hal/sim/odrive.py stack/config.py",
-    ("arrival", "stop"): "scenario/config.py scenario/judge.py",
-    ("backend", "process"): "sweep/api.py",
-    ("clock_hz", 100.0): "actors/bridge.py stack/config.py",
-    ("command_keepalive", 0.1): "hal/can/interface.py stack/config.py",
-    ("deadlock_grace", 0.5): "runtime/loop.py",
-    ("depth", 10000): "actors/recorder.py runtime/funnel.py",
-    ("encoder_period", 0.01): "hal/can/monitor.py hal/sim/emulator.py stack/config.py",
-    ("encoder_timeout", 0.05): "hal/can/monitor.py stack/config.py",
-    ("expect", "reached"): "scenario/config.py scenario/verdict.py",
-    ("gear_ratio", 1.0): "hal/can/interface.py hal/sim/emulator.py stack/config.py",
-    ("goal_tolerance", 0.15): "scenario/config.py scenario/generator.py",
-    ("heartbeat_period", 0.1): "hal/sim/emulator.py stack/config.py",
-    ("heartbeat_timeout", 0.25): "hal/can/monitor.py stack/config.py",
-    ("imu_hz", 100.0): "actors/bridge.py stack/config.py",
-    ("loss_window", 0.5): "hal/can/monitor.py stack/config.py",
-    ("max_attempts", 50): "scenario/generator.py scenario/generator_indoor.py",
-    ("max_frame_loss", 0.2): "hal/can/monitor.py stack/config.py",
-    ("max_recovery_attempts", 3): "hal/can/monitor.py stack/config.py",
-    ("name", "external"): "runtime/system.py",
-    ("name", "sweep"): "sweep/api.py sweep/report.py sweep/spec.py",
-    ("odom_hz", 100.0): "actors/bridge.py stack/config.py",
-    ("rate", 1.0): "replay/feed.py ros2/play.py",
-    ("rate_hz", 20.0): "hal/can/tap.py params.py",
-    ("recovery_delay", 0.3): "hal/can/monitor.py stack/config.py",
-    ("recovery_reset", 5.0): "hal/can/monitor.py stack/config.py",
-    ("resolution", 0.05): "params.py scenario/generator.py scenario/generator_grid.py",
-    ("scale", 1.0): "msgs/otonav_msgs.py runtime/clock.py runtime/timemode.py",
-    ("scan_hz", 10.0): "actors/bridge.py stack/config.py",
-    ("scene", "obstacles"): "hal/mujoco/world.py stack/config.py",
-    ("sign", 1): "hal/can/interface.py hal/sim/emulator.py stack/config.py",
-    ("source", "scenario"): "embed/runs.py scenario/assembly.py scenario/run.py "
-    "scenario/validate.py",
-    ("startup_timeout", 1.0): "hal/can/monitor.py stack/config.py",
-    ("vel_limit", 20.0): "hal/sim/odrive.py stack/config.py",
-    ("vel_ramp_rate", 200.0): "hal/sim/odrive.py stack/config.py",
-    ("wake", "timers"): "replay/runner.py",
-    ("wall_ceiling", 300.0): "embed/runs.py scenario/run.py",
-    ("wall_ceiling", 600.0): "replay/runner.py",
-    ("watchdog_timeout", 0.2): "hal/sim/odrive.py stack/config.py",
-}
-"""(name, default) -> the files (under otonav/, a private ``_`` dropped) that still write
-it, as they do today."""
+HOMONYMS = {("hal/can/tap.py", "rate_hz"): "can_tap.rate_hz"}
+"""(module, name) -> the parameter it is, where a name means two things. The CAN tap's
+``rate_hz`` is how often it flushes the bus frames it logged to /can/frames, the safety
+layer's (``safety.rate_hz``) how often it checks a command: 20 Hz both, by chance."""
+
 
 Default = tuple[str, object, str]
 
@@ -115,7 +70,8 @@ def _defaults(path: Path, label: str) -> Iterator[Default]:
         for name, default in pairs:
             value = _literal(default)
             if value is not None:
-                yield ALIASES.get(name, name), value, label
+                name = ALIASES.get(name, name)
+                yield HOMONYMS.get((label, name), name), value, label
 
 
 def duplicated_defaults(package: Path) -> dict[tuple[str, object], str]:
@@ -132,15 +88,13 @@ def duplicated_defaults(package: Path) -> dict[tuple[str, object], str]:
 
 def test_no_default_is_written_twice() -> None:
     found = duplicated_defaults(ROOT / "otonav")
-    new = {key: at for key, at in found.items() if KNOWN.get(key) != at}
-    assert not new, f"a default written twice (keep it in one place, refer to it): {new}"
-    gone = sorted(set(KNOWN) - set(found), key=str)
-    assert not gone, f"written once now: remove {gone} from KNOWN"
+    assert not found, f"a default written twice (keep it in one place, refer to it): {found}"
 
 
 def test_the_finder_finds_a_default_written_twice(tmp_path: Path) -> None:
     """The check can fail: a config field, a dataclass field under its alias and a
-    keyword default with the same literal; a reference and a neutral value pass."""
+    keyword default with the same literal; a reference, a neutral value and a homonym
+    (the CAN tap's flush rate against the safety layer's) pass."""
     (tmp_path / "config.py").write_text(
         "class NavConfig:\n"
         "    turn_in_place_threshold: float = Field(0.6, gt=0.0)\n"
@@ -154,6 +108,9 @@ def test_the_finder_finds_a_default_written_twice(tmp_path: Path) -> None:
     (tmp_path / "actor.py").write_text(
         "def start(period, *, turn_in_place_threshold=0.6, rate_hz=_NAV.rate_hz): ...\n"
     )
+    (tmp_path / "safety.py").write_text("class SafetyConfig:\n    rate_hz: float = 20.0\n")
+    (tmp_path / "hal" / "can").mkdir(parents=True)
+    (tmp_path / "hal" / "can" / "_tap.py").write_text("def tap(*, rate_hz=20.0): ...\n")
     assert duplicated_defaults(tmp_path) == {
         ("turn_in_place_threshold", 0.6): "actor.py config.py dwa.py"
     }

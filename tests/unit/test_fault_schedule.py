@@ -7,7 +7,7 @@ import pytest
 from otonav.hal import FakeHardware
 from otonav.hal.can import _protocol as p
 from otonav.hal.can._bus import CAN_ERR_BUSOFF, CAN_ERR_RESTARTED, open_endpoint
-from otonav.hal.sim import AxisParams, DriveEmulator
+from otonav.hal.sim import AxisParams, DriveEmulator, DriveMount
 from otonav.hal.sim._schedule import FaultPlan, Window
 from otonav.stack import StackConfig
 from otonav.stack._faults import fault_plan
@@ -27,6 +27,8 @@ def test_each_fault_starts_and_ends_at_its_time() -> None:
     emulator = DriveEmulator(
         open_endpoint("virtual", "test-fault-schedule"),
         world, AxisParams(0), AxisParams(1), schedule=plan,
+        left_mount=DriveMount(1, 1.0), right_mount=DriveMount(1, 1.0),
+        heartbeat_period=0.1, encoder_period=0.01,
     )  # fmt: skip
     drop_rate: dict[float, float] = {}
     bus_errors: list[tuple[float, int]] = []

@@ -59,8 +59,8 @@ class WheelAxis:
     """One wheel's drive: its CAN node id, direction sign and gear ratio."""
 
     node_id: int
-    sign: int = 1
-    gear_ratio: float = 1.0
+    sign: int
+    gear_ratio: float
     """Motor turns per wheel revolution."""
     label: str = "wheel"
 
@@ -112,7 +112,7 @@ class CanBusInterface(RobotHardwareInterface):
         *,
         peer: BusPeer | None = None,
         frame_log: int = 50_000,
-        command_keepalive: float = 0.1,
+        command_keepalive: float,
         input_mode: p.InputMode = p.InputMode.PASSTHROUGH,
     ) -> None:
         if not 0.0 <= command_keepalive < math.inf:

@@ -45,6 +45,7 @@ from dataclasses import dataclass
 
 from otonav.hal._health import HardwareHealth, HealthLevel
 from otonav.hal.can._protocol import AxisState, error_names
+from otonav.params import MonitorLimits
 
 __all__ = ["Action", "DriveMonitor", "MonitorLimits", "NodeLabel", "Phase"]
 
@@ -78,20 +79,7 @@ class NodeLabel:
         return f"node {self.node_id} ({self.label})"
 
 
-@dataclass(frozen=True, slots=True)
-class MonitorLimits:
-    """Seconds of sim time, and the tolerated encoder frame loss (0..1)."""
-
-    startup_timeout: float = 1.0
-    heartbeat_timeout: float = 0.25
-    encoder_timeout: float = 0.05
-    encoder_period: float = 0.01
-    max_frame_loss: float = 0.2
-    loss_window: float = 0.5
-    recovery_delay: float = 0.3
-    max_recovery_attempts: int = 3
-    recovery_reset: float = 5.0
-    """s of running without a fault after which each drive's attempts count from 0."""
+_LIMITS = MonitorLimits()
 
 
 class _Node:
@@ -109,7 +97,7 @@ class _Node:
 class DriveMonitor:
     """Startup, fault detection and recovery for the drives ``nodes``."""
 
-    def __init__(self, nodes: Sequence[NodeLabel], limits: MonitorLimits = MonitorLimits()):
+    def __init__(self, nodes: Sequence[NodeLabel], limits: MonitorLimits = _LIMITS):
         self.limits = limits
         self._nodes = {n.node_id: _Node(n) for n in nodes}
         self._foreign: set[int] = set()

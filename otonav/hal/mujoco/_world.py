@@ -84,7 +84,7 @@ class MujocoInterface(RobotHardwareInterface):
 
     def __init__(
         self,
-        scene: str | os.PathLike[str] = "obstacles",
+        scene: str | os.PathLike[str],
         *,
         lidar_beams: int = _LIDAR.beams,
         lidar_range_min: float = _LIDAR.range_min,

@@ -8,8 +8,9 @@ stopped at, and :meth:`DriveEmulator.next_event_tick` says the next instant it n
 At each exchange: receive frames (Set_Axis_State, Set_Controller_Mode, Set_Input_Vel,
 Estop, Clear_Errors), update both axes (:class:`~otonav.hal.sim._odrive.AxisModel`),
 put their velocity setpoints on the world's wheels (rad/s), then send what is due:
-Get_Encoder_Estimates every ``encoder_period`` (10 ms) and the heartbeat every
-``heartbeat_period`` (100 ms) of sim time, on whole ticks counted from tick 0.
+Get_Encoder_Estimates every ``encoder_period`` and the heartbeat every
+``heartbeat_period`` (``hal.sim``: 10 ms and 100 ms) of sim time, on whole ticks
+counted from tick 0.
 
 The wheels are the world's: a drive's encoder reads the wheel joint, converted to motor
 turns through its mounting ``sign`` and ``gear_ratio`` (the physical robot).
@@ -46,8 +47,8 @@ _pack_two_f32 = p.pack_two_f32
 class DriveMount:
     """How a drive's motor is mounted on its wheel: wheel rad = sign * 2 pi * turns / gear."""
 
-    sign: int = 1
-    gear_ratio: float = 1.0
+    sign: int
+    gear_ratio: float
     """Motor turns per wheel revolution."""
 
     def __post_init__(self) -> None:
@@ -91,10 +92,10 @@ class DriveEmulator:
         left: AxisParams,
         right: AxisParams,
         *,
-        left_mount: DriveMount = DriveMount(),
-        right_mount: DriveMount = DriveMount(),
-        heartbeat_period: float = 0.1,
-        encoder_period: float = 0.01,
+        left_mount: DriveMount,
+        right_mount: DriveMount,
+        heartbeat_period: float,
+        encoder_period: float,
         seed: int = 0,
         schedule: FaultPlan | None = None,
     ) -> None:

@@ -20,9 +20,9 @@ time, and asks for the velocity setpoint (turns/s, motor side) to put on the whe
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 from otonav.hal.can._protocol import AxisError, AxisState, ControlMode, InputMode
+from otonav.params import AxisParams
 
 __all__ = ["AxisModel", "AxisParams"]
 
@@ -30,29 +30,6 @@ _CLOSED_LOOP = AxisState.CLOSED_LOOP_CONTROL
 _VELOCITY_CONTROL = ControlMode.VELOCITY_CONTROL
 _PASSTHROUGH = InputMode.PASSTHROUGH
 _VEL_RAMP = InputMode.VEL_RAMP
-
-
-@dataclass(frozen=True, slots=True)
-class AxisParams:
-    """Drive configuration (what ``odrivetool`` would have saved on the drive)."""
-
-    node_id: int
-    vel_limit: float = 20.0
-    """turns/s."""
-    vel_ramp_rate: float = 200.0
-    """turns/s²: how fast the setpoint may change."""
-    watchdog_timeout: float = 0.2
-    """s; 0 disables the watchdog."""
-    arm_time: float = 0.01
-    """s from the closed-loop request to closed loop."""
-    overspeed_factor: float = 1.5
-
-    def __post_init__(self) -> None:
-        for name in ("vel_limit", "vel_ramp_rate"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"AxisParams.{name} must be > 0, got {getattr(self, name)}")
-        if self.watchdog_timeout < 0 or self.arm_time < 0:
-            raise ValueError("AxisParams.watchdog_timeout and arm_time must be >= 0")
 
 
 class AxisModel:

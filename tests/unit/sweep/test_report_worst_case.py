@@ -36,7 +36,9 @@ def test_among_passes_the_closest_to_the_floor_is_worst() -> None:
 def test_the_report_opens_with_the_worst_case(tmp_path: Path) -> None:
     records = [record("a", "passed", 0.5, overrides={"nav.max_v": 0.2}),
                record("b", "passed", 0.4, overrides={"nav.max_v": 0.4})]  # fmt: skip
-    report = write_report(tmp_path, summarize(records, planned=2), records).read_text()
+    report = write_report(
+        tmp_path, summarize(records, planned=2, name="worst"), records
+    ).read_text()
     assert report.index("## Worst case") < report.index("| group |")
     assert "nav.max_v=0.4" in report.split("## Worst case")[1].split("\n\n")[1]
     assert (tmp_path / "pass_fail.png").stat().st_size > 1000
