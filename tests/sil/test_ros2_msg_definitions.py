@@ -39,9 +39,10 @@ _CONSTANT = re.compile(r"^(\w+) (\w+)=(\S+)$")
 
 
 def _lines(text: str, pkg: str) -> list[str]:
-    """``.msg`` text of ``pkg`` -> ``type name`` and ``NAME=value`` lines: types with their
-    package, no comments, no field defaults, no constant type (Humble's ``Log`` constants are ``byte``, Jazzy's ``uint8``:
-    constants are not part of the type hash nor of the CDR bytes)."""
+    """``.msg`` text of ``pkg`` -> ``type name`` and ``NAME=value`` lines: types with
+    their package, no comments, no field defaults, no constant type (Humble's ``Log``
+    constants are ``byte``, Jazzy's ``uint8``: constants are not part of the type hash
+    nor of the CDR bytes)."""
     lines = []
     for raw in text.splitlines():
         words = raw.split("#", 1)[0].split()

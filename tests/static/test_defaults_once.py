@@ -69,9 +69,7 @@ KNOWN: dict[tuple[str, object], str] = {
     ("startup_timeout", 1.0): "hal/can/monitor.py stack/config.py",
     ("vel_limit", 20.0): "hal/sim/odrive.py stack/config.py",
     ("vel_ramp_rate", 200.0): "hal/sim/odrive.py stack/config.py",
-    ("wake", "timers"): "replay/runner.py",
     ("wall_ceiling", 300.0): "embed/runs.py scenario/run.py",
-    ("wall_ceiling", 600.0): "replay/runner.py",
     ("watchdog_timeout", 0.2): "hal/sim/odrive.py stack/config.py",
 }
 """(name, default) -> the files (under otonav/, a private ``_`` dropped) that still write
