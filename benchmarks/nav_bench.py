@@ -7,7 +7,7 @@ metric per family.
 
 Families: the box densities ``sparse`` and ``dense`` (otonav.scenario._generator
 presets; each also runs ``--walled`` walled-in worlds of its density) and the indoor
-families of otonav.scenario._generator_indoor (rooms with doors, long walls with the
+families of benchmarks/indoor_worlds.py (rooms with doors, long walls with the
 start facing them, U traps, dead ends, slaloms down to the passable limit, alcove and
 corner goals, walled-in rooms), ``--worlds`` each (seeds seed0 .. seed0 + worlds - 1),
 headless in virtual time with the default stack (``--set`` overrides it), on a process
@@ -56,6 +56,7 @@ from typing import Any
 
 import numpy as np
 import yaml
+from indoor_worlds import INDOOR_FAMILIES, generate_indoor
 
 from otonav.nav._navigate import Navigation
 from otonav.scenario import run_scenario
@@ -68,7 +69,6 @@ from otonav.scenario._generator import (
     generate_world,
     walled_in,
 )
-from otonav.scenario._generator_indoor import INDOOR_FAMILIES, generate_indoor
 from otonav.stack import StackConfig
 from otonav.stack._overrides import apply_overrides
 

@@ -49,7 +49,6 @@ KNOWN: dict[tuple[str, object], str] = {
     ("heartbeat_timeout", 0.25): "hal/can/monitor.py stack/config.py",
     ("imu_hz", 100.0): "actors/bridge.py stack/config.py",
     ("loss_window", 0.5): "hal/can/monitor.py stack/config.py",
-    ("max_attempts", 50): "scenario/generator.py scenario/generator_indoor.py",
     ("max_frame_loss", 0.2): "hal/can/monitor.py stack/config.py",
     ("max_recovery_attempts", 3): "hal/can/monitor.py stack/config.py",
     ("name", "external"): "runtime/system.py",
