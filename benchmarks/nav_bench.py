@@ -65,7 +65,6 @@ from otonav.scenario._generator import (
     PRESETS,
     GeneratedWorld,
     WorldParams,
-    barn_metric,
     generate_world,
     walled_in,
 )
@@ -90,12 +89,20 @@ Task = tuple[str, int, bool, tuple[str, ...]]
 # - clearance violation: a run whose robot centre came closer than ``min_clearance`` to a
 #   box or wall, over *all* runs (walled-in included);
 # - BARN metric: mean over the reachable worlds of ``success * optimal / clip(actual,
-#   2 optimal, 8 optimal)`` (:func:`~otonav.scenario._generator.barn_metric`); 0.5 at
+#   2 optimal, 8 optimal)`` (:func:`barn_metric`); 0.5 at
 #   best, so the median of ``actual / optimal`` over the successes is given too (it can
 #   dip under 1: the optimal path keeps footprint + clearance from every box, the judge
 #   only the clearance, and the run ends at the goal tolerance);
 # - walled-in reported: the navigator said ``unreachable`` inside the budget;
 # - timeout: the budget ran out with neither the goal reached nor ``unreachable`` said.
+
+
+def barn_metric(success: bool, actual_s: float, optimal_s: float) -> float:
+    """BARN's score of one run: ``success * optimal / clip(actual, 2 optimal, 8
+    optimal)``; 0.5 at best (at twice the optimal time or faster), 0 on failure."""
+    if not success:
+        return 0.0
+    return optimal_s / min(max(actual_s, 2.0 * optimal_s), 8.0 * optimal_s)
 
 
 @dataclass(frozen=True, slots=True)
