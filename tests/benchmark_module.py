@@ -11,7 +11,10 @@ BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
 
 
 def load_benchmark(script: str) -> ModuleType:
-    """``benchmarks/<script>`` as the module ``<stem>_under_test``."""
+    """``benchmarks/<script>`` as the module ``<stem>_under_test`` (benchmarks/ on
+    ``sys.path``, as for a script run from there: it imports its siblings)."""
+    if str(BENCHMARKS) not in sys.path:
+        sys.path.append(str(BENCHMARKS))
     spec = importlib.util.spec_from_file_location(
         f"{Path(script).stem}_under_test", BENCHMARKS / script
     )

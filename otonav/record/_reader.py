@@ -7,6 +7,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
+from operator import itemgetter
 from pathlib import Path
 from typing import Any
 
@@ -17,6 +18,7 @@ from mcap.records import Message as Message_
 
 from otonav.errors import UsageError
 from otonav.msgs import Message
+from otonav.record._fastreader import ChunkDamageError, read_raw_messages
 from otonav.record._verify import (
     CUT_OFF_ERRORS,
     MAGIC,
@@ -254,51 +256,53 @@ def read_messages(
     :class:`RecordingError`) with ``start <= t < end`` (seconds of sim time). Each
     message is the :mod:`otonav.msgs` type its schema names (or a user's own
     :class:`~otonav.msgs.Message` subclass of that ``ros_type``), decoded by otonav's own
-    CDR decoder (:func:`otonav.record.cdr.decode`, as replay's inputs are). A cut-off
-    file yields the messages of its complete chunks, in file order.
+    CDR decoder (:func:`otonav.record.cdr.decode`) from the chunks replay's reader reads
+    (:mod:`otonav.record._fastreader`). A cut-off file yields the messages of its
+    complete chunks, in file order.
 
     Every chunk read is checked against its CRC: a damaged one raises
     :class:`DamagedRecordingError`, or, given a ``damage`` list, is skipped and appended
     to it (the file is then read front to back, in file order)."""
     path = Path(path)
     _check_file(path)
-    if damage is not None:
-        yield from _read_cut_off(path, topics, start, end, damage)
-        return
+    first = -1 if start is None else round(start * 1e9)
+    last = None if end is None else round(end * 1e9)
+    raw = _read_indexed(path, topics) if damage is None else None
+    for topic, kind, at, data in _read_front_to_back(path, topics, damage) if raw is None else raw:
+        if at >= first and (last is None or at < last):
+            yield topic, at / 1e9, _decode(path, topic, kind, at, data)
+
+
+_Raw = tuple[str, type[Message], int, bytes]
+"""(topic, its message class, log time ns, CDR data)"""
+
+
+def _read_indexed(path: Path, topics: Sequence[str] | None) -> list[_Raw] | None:
+    """The wanted messages by the index with replay's reader (file order, CRC checked),
+    stably sorted by log time; None when the file is cut off or its index damaged."""
     with path.open("rb") as f:
-        reader = make_reader(f, validate_crcs=True)
         try:
-            summary = reader.get_summary()
-            indexed = summary is not None and summary_damage(path) is None
+            summary = make_reader(f).get_summary()
+            if summary is None or summary_damage(path) is not None:
+                return None
         except CUT_OFF_ERRORS:
-            indexed = False
-        if not indexed:  # cut off, or a damaged index: the chunks, front to back
-            yield from _read_cut_off(path, topics, start, end)
-            return
-        assert summary is not None
+            return None
+        channels = summary.channels
         types = {
-            ch.id: _type_of(path, ch, summary.schemas, topics) for ch in summary.channels.values()
+            i: kind
+            for i, ch in channels.items()
+            if (kind := _type_of(path, ch, summary.schemas, topics)) is not None
         }
-        messages = reader.iter_messages(
-            topics=[summary.channels[i].topic for i, t in types.items() if t is not None],
-            starting_at=None if start is None else round(start * 1e9),
-            ending_before=None if end is None else round(end * 1e9),
-        )
-        while True:
-            try:
-                _schema, channel, message = next(messages)
-            except StopIteration:
-                return
-            except Exception as exc:  # a chunk that does not verify: say which
-                found: list[Damage] = []
-                for _record in iter_verified(path, found):
-                    pass
-                if found:
-                    raise DamagedRecordingError(describe_damage(path, found)) from None
-                raise DamagedRecordingError(f"{path}: unreadable ({_one_line(exc)})") from None
-            kind = types[channel.id]
-            assert kind is not None
-            yield channel.topic, message.log_time / 1e9, _decode(path, channel, kind, message)
+        try:
+            raw = read_raw_messages(f, summary, list(types))
+        except ChunkDamageError as exc:  # say which chunks
+            found: list[Damage] = []
+            for _record in iter_verified(path, found):
+                pass
+            raise DamagedRecordingError(describe_damage(path, found or [exc.damage])) from None
+    out = [(channels[i].topic, types[i], at, data) for i, at, data in raw]
+    out.sort(key=itemgetter(2))
+    return out
 
 
 def _message_types() -> dict[str, type[Message]]:
@@ -341,27 +345,21 @@ def _type_of(
     return kind
 
 
-def _decode(path: Path, channel: Channel, kind: type[Message], message: Message_) -> Message:
+def _decode(path: Path, topic: str, kind: type[Message], at: int, data: bytes) -> Message:
     try:
-        return decode(kind, message.data)
+        return decode(kind, data)
     except ValueError as exc:
         raise DamagedRecordingError(
-            f"{path}: the {channel.topic} message at {message.log_time / 1e9:.9f} s does not "
+            f"{path}: the {topic} message at {at / 1e9:.9f} s does not "
             f"decode as {kind.ros_type} ({_one_line(exc)})"
         ) from None
 
 
-def _read_cut_off(
-    path: Path,
-    topics: Sequence[str] | None,
-    start: float | None,
-    end: float | None,
-    damage: list[Damage] | None = None,
-) -> Iterator[tuple[str, float, Any]]:
+def _read_front_to_back(
+    path: Path, topics: Sequence[str] | None, damage: list[Damage] | None
+) -> Iterator[_Raw]:
     schemas: dict[int, Schema] = {}
-    channels: dict[int, tuple[Channel, type[Message]]] = {}
-    first = None if start is None else round(start * 1e9)
-    last = None if end is None else round(end * 1e9)
+    channels: dict[int, tuple[str, type[Message]]] = {}
     for record in iter_readable(path, damage):
         if isinstance(record, Schema):
             schemas[record.id] = record
@@ -370,11 +368,6 @@ def _read_cut_off(
                 continue  # its schema was in a damaged chunk (reported): its messages are lost
             kind = _type_of(path, record, schemas, topics)
             if kind is not None:
-                channels[record.id] = (record, kind)
+                channels[record.id] = (record.topic, kind)
         elif isinstance(record, Message_) and record.channel_id in channels:
-            if (first is not None and record.log_time < first) or (
-                last is not None and record.log_time >= last
-            ):
-                continue
-            channel, kind = channels[record.channel_id]
-            yield channel.topic, record.log_time / 1e9, _decode(path, channel, kind, record)
+            yield *channels[record.channel_id], record.log_time, record.data

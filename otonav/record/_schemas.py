@@ -1,13 +1,14 @@
 """ROS 2 layouts and ``ros2msg`` definitions of the otonav message types.
 
 A *layout* is the ROS field list of a message class: each field's name (our pydantic
-field names are the ROS names) and its ROS type. The pydantic models do not say
-everything ROS needs -- ``float32`` vs ``float64``, ``uint32`` vs ``int64``, fixed
-array sizes such as ``float64[36]`` -- so the known ROS layouts are an explicit table
-below. A message class that is not in the table (a type with no ROS equivalent) gets a
-layout generated from its pydantic fields. Both the schema text (this module) and the
-CDR encoder (:mod:`otonav.record.cdr`) are driven by the same layouts, and every layout
-is checked against its pydantic model, so the two cannot drift apart silently.
+field names are the ROS names) and its ROS type, in the model's field order (the wire
+order). A layout is generated from the pydantic fields (``float`` -> ``float64``, ``int``
+-> ``int64``, ``str`` -> ``string``, a message -> its type, ``tuple[X, ...]`` -> ``X[]``);
+what the models cannot say -- ``float32`` vs ``float64``, ``uint32`` vs ``int64``, fixed
+array sizes such as ``float64[36]`` -- is the short table of ROS types below, checked
+against the model. Both the schema text (this module) and the CDR codec
+(:mod:`otonav.record.cdr`) are driven by the same layouts; the SIL layer compares the
+schemas with the ``.msg`` files of real ROS 2 distributions.
 
 The definition text is what ``ros2 bag record`` stores in an MCAP schema record
 (encoding ``ros2msg``, rosbag2's ``LocalMessageDefinitionSource``): the top-level
@@ -24,40 +25,19 @@ from dataclasses import dataclass
 from typing import Final
 
 from otonav.msgs import (
-    Clock,
-    DiagnosticArray,
     DiagnosticStatus,
     Frame,
     HardwareStatus,
-    Header,
     Imu,
-    KeyValue,
     LaserScan,
     Log,
     MapMetaData,
     Message,
-    NavDiagnostics,
-    NavState,
     OccupancyGrid,
-    Odometry,
-    Parameter,
-    ParameterEvent,
     ParameterValue,
-    Point,
-    Pose,
-    PoseStamped,
     PoseWithCovariance,
-    Quaternion,
-    SafetyState,
-    TFMessage,
     Time,
-    Transform,
-    TransformStamped,
-    Twist,
-    TwistStamped,
     TwistWithCovariance,
-    Vector3,
-    WheelCommand,
 )
 
 __all__ = (
@@ -139,208 +119,32 @@ def short_name(message: type[Message]) -> str:
     return f"{pkg}/{name}"
 
 
-_F = Field
-_HEADER = _F("header", Header)
-_XYZ = (_F("x", "float64"), _F("y", "float64"), _F("z", "float64"))
-
-_KNOWN: Final[dict[type[Message], tuple[tuple[Field, ...], tuple[Constant, ...]]]] = {
-    Time: ((_F("sec", "int32"), _F("nanosec", "uint32")), ()),
-    Header: ((_F("stamp", Time), _F("frame_id", "string")), ()),
-    Clock: ((_F("clock", Time),), ()),
-    Log: (
-        (
-            _F("stamp", Time),
-            _F("level", "uint8"),
-            _F("name", "string"),
-            _F("msg", "string"),
-            _F("file", "string"),
-            _F("function", "string"),
-            _F("line", "uint32"),
-        ),
-        tuple(
-            Constant("byte", name, value)
-            for name, value in (
-                ("DEBUG", 10),
-                ("INFO", 20),
-                ("WARN", 30),
-                ("ERROR", 40),
-                ("FATAL", 50),
-            )
-        ),
-    ),
-    Vector3: (_XYZ, ()),
-    Point: (_XYZ, ()),
-    Quaternion: ((*_XYZ, _F("w", "float64")), ()),
-    Pose: ((_F("position", Point), _F("orientation", Quaternion)), ()),
-    PoseStamped: ((_HEADER, _F("pose", Pose)), ()),
-    PoseWithCovariance: ((_F("pose", Pose), _F("covariance", "float64", 36)), ()),
-    Twist: ((_F("linear", Vector3), _F("angular", Vector3)), ()),
-    ParameterValue: (
-        (
-            _F("type", "uint8"),
-            _F("bool_value", "bool"),
-            _F("integer_value", "int64"),
-            _F("double_value", "float64"),
-            _F("string_value", "string"),
-            _F("byte_array_value", "byte", SEQUENCE),
-            _F("bool_array_value", "bool", SEQUENCE),
-            _F("integer_array_value", "int64", SEQUENCE),
-            _F("double_array_value", "float64", SEQUENCE),
-            _F("string_array_value", "string", SEQUENCE),
-        ),
-        (),
-    ),
-    Parameter: ((_F("name", "string"), _F("value", ParameterValue)), ()),
-    ParameterEvent: (
-        (
-            _F("stamp", Time),
-            _F("node", "string"),
-            _F("new_parameters", Parameter, SEQUENCE),
-            _F("changed_parameters", Parameter, SEQUENCE),
-            _F("deleted_parameters", Parameter, SEQUENCE),
-        ),
-        (),
-    ),
-    TwistStamped: ((_HEADER, _F("twist", Twist)), ()),
-    TwistWithCovariance: ((_F("twist", Twist), _F("covariance", "float64", 36)), ()),
-    Transform: ((_F("translation", Vector3), _F("rotation", Quaternion)), ()),
-    TransformStamped: (
-        (_HEADER, _F("child_frame_id", "string"), _F("transform", Transform)),
-        (),
-    ),
-    Odometry: (
-        (
-            _HEADER,
-            _F("child_frame_id", "string"),
-            _F("pose", PoseWithCovariance),
-            _F("twist", TwistWithCovariance),
-        ),
-        (),
-    ),
-    Imu: (
-        (
-            _HEADER,
-            _F("orientation", Quaternion),
-            _F("orientation_covariance", "float64", 9),
-            _F("angular_velocity", Vector3),
-            _F("angular_velocity_covariance", "float64", 9),
-            _F("linear_acceleration", Vector3),
-            _F("linear_acceleration_covariance", "float64", 9),
-        ),
-        (),
-    ),
-    LaserScan: (
-        (
-            _HEADER,
-            _F("angle_min", "float32"),
-            _F("angle_max", "float32"),
-            _F("angle_increment", "float32"),
-            _F("time_increment", "float32"),
-            _F("scan_time", "float32"),
-            _F("range_min", "float32"),
-            _F("range_max", "float32"),
-            _F("ranges", "float32", SEQUENCE),
-            _F("intensities", "float32", SEQUENCE),
-        ),
-        (),
-    ),
-    TFMessage: ((_F("transforms", TransformStamped, SEQUENCE),), ()),
-    MapMetaData: (
-        (
-            _F("map_load_time", Time),
-            _F("resolution", "float32"),
-            _F("width", "uint32"),
-            _F("height", "uint32"),
-            _F("origin", Pose),
-        ),
-        (),
-    ),
-    OccupancyGrid: (
-        (_HEADER, _F("info", MapMetaData), _F("data", "int8", SEQUENCE)),
-        (),
-    ),
-    WheelCommand: ((_HEADER, _F("left", "float64"), _F("right", "float64")), ()),
-    NavState: (
-        (
-            _HEADER,
-            _F("state", "string"),
-            _F("distance_to_goal", "float64"),
-            _F("heading_error", "float64"),
-            _F("closest_ahead", "float64"),
-        ),
-        (),
-    ),
-    NavDiagnostics: (
-        (
-            _HEADER,
-            _F("planner", "string"),
-            _F("state", "string"),
-            _F("reason", "string"),
-            _F("stage", "string"),
-            _F("v", "float64"),
-            _F("omega", "float64"),
-            _F("admissible", "int64"),
-            _F("samples", "int64"),
-            _F("best_score", "float64"),
-            _F("clearance", "float64"),
-            _F("path_length", "float64"),
-            _F("replans", "int64"),
-        ),
-        (),
-    ),
-    SafetyState: (
-        (
-            _HEADER,
-            _F("reason", "string"),
-            _F("scale", "float64"),
-            _F("nearest", "float64"),
-            _F("v_in", "float64"),
-            _F("omega_in", "float64"),
-            _F("v_out", "float64"),
-            _F("omega_out", "float64"),
-        ),
-        (),
-    ),
-    Frame: (
-        (
-            _HEADER,
-            _F("id", "uint32"),
-            _F("is_rtr", "bool"),
-            _F("is_extended", "bool"),
-            _F("is_error", "bool"),
-            _F("dlc", "uint8"),
-            _F("data", "uint8", 8),
-        ),
-        (),
-    ),
-    KeyValue: ((_F("key", "string"), _F("value", "string")), ()),
-    DiagnosticStatus: (
-        (
-            _F("level", "byte"),
-            _F("name", "string"),
-            _F("message", "string"),
-            _F("hardware_id", "string"),
-            _F("values", KeyValue, SEQUENCE),
-        ),
-        tuple(
-            Constant("byte", name, value)
-            for name, value in (("OK", 0), ("WARN", 1), ("ERROR", 2), ("STALE", 3))
-        ),
-    ),
-    DiagnosticArray: ((_HEADER, _F("status", DiagnosticStatus, SEQUENCE)), ()),
-    HardwareStatus: (
-        (
-            _HEADER,
-            _F("level", "uint8"),
-            _F("ready", "bool"),
-            _F("fault", "string"),
-            _F("message", "string"),
-        ),
-        (),
-    ),
+_ROS_TYPES: Final[dict[type, str]] = {
+    Time: "int32 sec, uint32 nanosec",
+    Log: "uint8 level, uint32 line",
+    PoseWithCovariance: "float64[36] covariance",
+    TwistWithCovariance: "float64[36] covariance",
+    ParameterValue: "uint8 type, byte[] byte_array_value",
+    Imu: "float64[9] orientation_covariance, float64[9] angular_velocity_covariance, "
+    "float64[9] linear_acceleration_covariance",
+    LaserScan: "float32 angle_min, float32 angle_max, float32 angle_increment, "
+    "float32 time_increment, float32 scan_time, float32 range_min, float32 range_max, "
+    "float32[] ranges, float32[] intensities",
+    MapMetaData: "float32 resolution, uint32 width, uint32 height",
+    OccupancyGrid: "int8[] data",
+    Frame: "uint32 id, uint8 dlc, uint8[8] data",
+    DiagnosticStatus: "byte level",
+    HardwareStatus: "uint8 level",
 }
-"""The ROS 2 layouts (Humble/Jazzy) of the message types we share with ROS."""
+"""The fields whose ROS 2 (Humble/Jazzy) type is not the one generated from the model."""
 
+_CONSTANTS: Final[dict[type, str]] = {
+    Log: "DEBUG INFO WARN ERROR FATAL",
+    DiagnosticStatus: "OK WARN ERROR STALE",
+}
+"""The ``byte`` constants of a ``.msg``, valued as the model's class attributes."""
+
+_ROS_FIELD = re.compile(r"(\w+)(?:\[(\d*)\])? (\w+)")
 _GENERATED_PRIMITIVE: Final[dict[type, str]] = {
     str: "string",
     float: "float64",
@@ -368,12 +172,15 @@ def _field_from_annotation(message: type[Message], name: str, tp: object) -> Fie
     raise TypeError(f"{message.__name__}.{name}: no ROS 2 type for {tp!r}")
 
 
-def _generate(message: type[Message]) -> Layout:
-    fields = tuple(
-        _field_from_annotation(message, name, info.annotation)
-        for name, info in message.model_fields.items()
-    )
-    return Layout(message, fields)
+def _from_table(text: str) -> dict[str, Field | None]:
+    """``"float32 a, uint8[8] b"`` -> the fields ``a`` and ``b`` by name."""
+    fields: dict[str, Field | None] = {}
+    for match in map(_ROS_FIELD.fullmatch, filter(None, text.split(", "))):
+        assert match is not None, text
+        kind, size, name = match.groups()
+        array = None if size is None else int(size) if size else SEQUENCE
+        fields[name] = Field(name, kind, array)
+    return fields
 
 
 def _python_type(field: Field) -> object:
@@ -391,36 +198,31 @@ def _check(layout: Layout) -> None:
     if not _ROS_TYPE.match(getattr(message, "ros_type", "")):
         raise ValueError(f"{where}: ros_type must look like 'pkg/msg/Type'")
     model_fields = message.model_fields
-    names = [f.name for f in layout.fields]
-    if sorted(names) != sorted(model_fields):
-        raise ValueError(f"{where}: layout fields {names} != model fields {list(model_fields)}")
     for field in layout.fields:
         if not _FIELD_NAME.match(field.name):
             raise ValueError(f"{where}.{field.name}: not a valid ROS field name")
-        if isinstance(field.type, str) and field.type not in PRIMITIVES:
-            raise ValueError(f"{where}.{field.name}: unknown primitive {field.type!r}")
-        if field.array is not None and field.array != SEQUENCE and field.array < 1:
-            raise ValueError(f"{where}.{field.name}: bad array size {field.array}")
         annotation = model_fields[field.name].annotation
         if annotation != _python_type(field):
             raise ValueError(
                 f"{where}.{field.name}: model type {annotation!r} does not hold {field.msg_type}"
             )
-    for constant in layout.constants:
-        if getattr(message, constant.name, None) != constant.value:
-            raise ValueError(f"{where}.{constant.name}: differs from the model's constant")
 
 
 @functools.cache
 def layout_for(message: type[Message]) -> Layout:
-    """The checked ROS layout of ``message``: from the table, else generated."""
-    known = _KNOWN.get(message)
-    if known is None:
-        # A subclass that adds no field (a lazily decoded replay input) is its base.
-        base = next((c for c in message.__mro__[1:] if c in _KNOWN), None)
-        if base is not None and base.model_fields.keys() == message.model_fields.keys():
-            known = _KNOWN[base]
-    layout = _generate(message) if known is None else Layout(message, *known)
+    """The checked ROS layout of ``message``: generated, with the table's ROS types."""
+    # A subclass (a lazily decoded replay input) has its base's ROS types.
+    home = next((c for c in message.__mro__ if c in _ROS_TYPES or c in _CONSTANTS), message)
+    table = _from_table(_ROS_TYPES.get(home, ""))
+    fields = tuple(
+        table.pop(name, None) or _field_from_annotation(message, name, info.annotation)
+        for name, info in message.model_fields.items()
+    )
+    if table:
+        raise ValueError(f"{message.__name__}: no model field for {sorted(table)}")
+    names = _CONSTANTS.get(home, "").split()
+    constants = tuple(Constant("byte", name, getattr(message, name)) for name in names)
+    layout = Layout(message, fields, constants)
     _check(layout)
     return layout
 

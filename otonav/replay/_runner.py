@@ -153,6 +153,22 @@ def _feed_qos(requested: list[QoS]) -> QoS:
     )
 
 
+@contextlib.contextmanager
+def _fewer_collections() -> Iterator[None]:
+    """Run the cyclic garbage collector's youngest generation every 10,000 allocations
+    instead of every 700 while a replay runs (restored after). A replay allocates a few
+    objects per recorded message and keeps most of them until it ends; collecting them
+    over and over was ~5 ms of a ~75 ms navigator replay (CPU medians of 12, interleaved;
+    as much as with the collector off). Cycles are still collected, in larger batches."""
+    threshold = gc.get_threshold()
+    gc.set_threshold(max(threshold[0], 10_000), *threshold[1:])
+    try:
+        yield
+    finally:
+        gc.set_threshold(*threshold)
+
+
+@_fewer_collections()
 def replay_recording(
     recording: str | Path,
     nodes: Sequence[str | Actor],
@@ -177,46 +193,6 @@ def replay_recording(
 
     Raises :class:`ReplayInputError` for bad input (file, node, topic, override).
     """
-    with _fewer_collections():
-        return _replay(
-            recording,
-            nodes,
-            overrides=overrides,
-            stack=stack,
-            tolerance=tolerance,
-            wake=wake,
-            wall_ceiling=wall_ceiling,
-            on_start=on_start,
-        )
-
-
-@contextlib.contextmanager
-def _fewer_collections() -> Iterator[None]:
-    """Run the cyclic garbage collector's youngest generation every 10,000 allocations
-    instead of every 700 while a replay runs (restored after). A replay allocates a few
-    objects per recorded message and keeps most of them until it ends; collecting them
-    over and over was ~5 ms of a ~75 ms navigator replay (CPU medians of 12, interleaved;
-    as much as with the collector off). Cycles are still collected, in larger batches."""
-    threshold = gc.get_threshold()
-    gc.set_threshold(max(threshold[0], 10_000), *threshold[1:])
-    try:
-        yield
-    finally:
-        gc.set_threshold(*threshold)
-
-
-def _replay(
-    recording: str | Path,
-    nodes: Sequence[str | Actor],
-    *,
-    overrides: Sequence[str] = (),
-    stack: StackConfig | None = None,
-    tolerance: float = 0.0,
-    wake: Literal["timers", "recorded"],
-    wall_ceiling: float | None,
-    on_start: Callable[[asyncio.AbstractEventLoop, asyncio.Task[None]], None] | None = None,
-) -> ReplayResult:
-    """The body of :func:`replay_recording`."""
     if not tolerance >= 0:
         raise ReplayInputError(f"--tolerance {tolerance}: must be a number >= 0")
     wall_start = time.perf_counter()

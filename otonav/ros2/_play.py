@@ -14,6 +14,7 @@ import math
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from operator import itemgetter
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -21,8 +22,10 @@ from mcap.reader import make_reader
 
 import otonav.msgs
 from otonav.msgs import Message
+from otonav.record._fastreader import read_raw_messages
 from otonav.record._qos_profile import recorded_qos
 from otonav.record._reader import RecordingError, summarize
+from otonav.record._verify import describe_damage
 from otonav.ros2._naming import Ros2Error, dds_qos, dds_topic, discovery, domain_id
 
 if TYPE_CHECKING:
@@ -73,6 +76,8 @@ def play(
     summary = summarize(path)  # one line for a file that is not a readable recording
     if summary.truncated:
         raise RecordingError(f"{path}: not finished (no index); `otonav salvage` indexes it")
+    if summary.damaged:  # played, it would send damaged data as recorded
+        raise RecordingError(describe_damage(path, summary.damaged))
     where = discovery(env)
     dds_domain = domain_id(domain, env)
     from otonav.ros2._dds import Participant
@@ -94,8 +99,7 @@ def _play(
     on_start: Callable[[int, Sequence[str]], None] | None,
 ) -> PlayResult:
     with path.open("rb") as f:
-        reader = make_reader(f, validate_crcs=True)
-        summary = reader.get_summary()
+        summary = make_reader(f).get_summary()
         assert summary is not None, "summarize() refused a file without one"
         channels, schemas = summary.channels, summary.schemas
         present = {channel.topic for channel in channels.values()}
@@ -126,19 +130,18 @@ def _play(
             lambda: any(w.matched.count for w in writers.values()), wait
         ):
             participant.wait_quiet(0.5, wait)
+        messages = read_raw_messages(f, summary, list(writers))  # CRC checked, file order
+        messages.sort(key=itemgetter(1))  # stably: in log-time order
         sent, first, last = 0, math.nan, math.nan
         wall0 = time.monotonic()
-        for _schema, channel, record in reader.iter_messages(log_time_order=True):
-            writer = writers.get(channel.id)
-            if writer is None:
-                continue
-            t = record.log_time / 1e9
+        for channel_id, log_time, data in messages:
+            t = log_time / 1e9
             if math.isnan(first):
                 first = t
             delay = wall0 + (t - first) / rate - time.monotonic()
             if delay > 0:
                 time.sleep(delay)
-            if writer.write(bytes(record.data)):
+            if writers[channel_id].write(data):
                 sent += 1
             last = t
     return PlayResult(

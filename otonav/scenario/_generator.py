@@ -47,7 +47,6 @@ __all__ = (
     "WALLED_IN",
     "GeneratedWorld",
     "WorldParams",
-    "barn_metric",
     "budget_for",
     "generate_world",
     "generate_worlds",
@@ -238,14 +237,6 @@ def budget_for(path_m: float, params: WorldParams) -> float:
     at 0.4 m/s that is 3 * 17.5 + 30 = 83 s, comparable with BARN's 100 s for 10 m.
     Beyond 8 x optimal the BARN metric no longer distinguishes anyway."""
     return float(math.ceil(params.budget_factor * path_m / params.max_speed + params.budget_slack))
-
-
-def barn_metric(success: bool, actual_s: float, optimal_s: float) -> float:
-    """BARN's score of one run: ``success * optimal / clip(actual, 2 optimal, 8
-    optimal)``; 0.5 at best (at twice the optimal time or faster), 0 on failure."""
-    if not success:
-        return 0.0
-    return optimal_s / min(max(actual_s, 2.0 * optimal_s), 8.0 * optimal_s)
 
 
 def plan_path(

@@ -5,6 +5,7 @@ and the ``otonav_msgs`` interface package against the schemas in recordings."""
 from __future__ import annotations
 
 import inspect
+import sys
 import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any
@@ -26,7 +27,6 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 import otonav.msgs
 from otonav.msgs import Clock, Message, NavState, TFMessage, Time
 from otonav.record._bag import write_bag_directory
-from otonav.record._interface_package import PACKAGE, TYPES, msg_files
 from otonav.record._qos_profile import offered_qos_yaml
 from otonav.record._schemas import schema_for
 from otonav.record._type_hash import rihs01
@@ -36,6 +36,10 @@ from otonav.runtime._qos import DEFAULT_QOS, LATCHED_QOS, SENSOR_DATA_QOS, QoS
 pytestmark = pytest.mark.unit
 
 ROOT = Path(__file__).resolve().parents[3]
+sys.path.insert(0, str(ROOT / "scripts"))
+
+from interface_package import PACKAGE, TYPES, msg_files  # noqa: E402
+
 ALL_TYPES = sorted(
     (
         c
@@ -149,7 +153,7 @@ def test_the_interface_package_msg_files_are_the_recorded_schemas() -> None:
     on_disk = {p.name: p.read_text(encoding="utf-8") for p in (folder / "msg").glob("*.msg")}
     assert on_disk == files, (
         "otonav_msgs/msg differs from the schemas otonav records; regenerate it with "
-        "python -m otonav.record._interface_package otonav_msgs/msg"
+        "python scripts/interface_package.py otonav_msgs/msg"
     )
     cmake = (folder / "CMakeLists.txt").read_text()
     assert "rosidl_generate_interfaces" in cmake

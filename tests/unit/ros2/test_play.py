@@ -52,3 +52,24 @@ def test_a_topic_the_recording_lacks_is_one_line(
         "--topic /no_such_topic",
         "/odom",
     )
+
+
+def test_a_damaged_recording_is_one_line_before_anything_is_played(
+    cli_fails: CliFails, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from mcap.reader import make_reader
+
+    from otonav.cli import main
+
+    out = tmp_path / "out"
+    main(["run", "--out", str(out)])
+    capsys.readouterr()
+    path = out / "recording.mcap"
+    with path.open("rb") as f:
+        summary = make_reader(f).get_summary()
+    assert summary is not None
+    chunk = sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset)[2]
+    data = bytearray(path.read_bytes())
+    data[chunk.chunk_start_offset + chunk.chunk_length // 2] ^= 0xFF  # inside its records
+    path.write_bytes(data)
+    cli_fails(["play", str(path)], str(path), "1 damaged chunk", "CRC mismatch")

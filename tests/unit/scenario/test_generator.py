@@ -20,7 +20,6 @@ from otonav.scenario._generator import (
     EMPTY_WALLS,
     SPARSE,
     WALLED_IN,
-    barn_metric,
     budget_for,
     generate_world,
     generate_worlds,
@@ -242,20 +241,6 @@ def test_budgets_grow_with_the_path(a: float, b: float) -> None:
 def test_budget_example() -> None:
     # 7 m at 0.4 m/s: 17.5 s optimal; 3 x 17.5 + 30 = 82.5 -> 83 s
     assert budget_for(7.0, SPARSE) == 83.0
-
-
-@settings(deadline=None)
-@given(optimal=st.floats(0.1, 100.0), factor=st.floats(0.0, 20.0))
-def test_barn_metric_is_clipped_between_an_eighth_and_a_half(optimal: float, factor: float) -> None:
-    score = barn_metric(True, factor * optimal, optimal)
-    assert 1 / 8 - 1e-12 <= score <= 0.5 + 1e-12
-    if factor <= 2.0:
-        assert score == pytest.approx(0.5)
-    elif factor >= 8.0:
-        assert score == pytest.approx(1 / 8)
-    else:
-        assert score == pytest.approx(1 / factor)
-    assert barn_metric(False, factor * optimal, optimal) == 0.0
 
 
 @pytest.mark.parametrize(

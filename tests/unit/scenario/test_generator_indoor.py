@@ -6,10 +6,14 @@ from __future__ import annotations
 import math
 
 import pytest
-
-from otonav.scenario._generator_indoor import INDOOR_FAMILIES, PLAN_CLEARANCE, generate_indoor
+from benchmark_module import load_benchmark
 
 pytestmark = pytest.mark.unit
+
+INDOOR = load_benchmark("indoor_worlds.py")  # the indoor families are nav_bench.py's
+INDOOR_FAMILIES: tuple[str, ...] = INDOOR.INDOOR_FAMILIES
+PLAN_CLEARANCE: float = INDOOR.PLAN_CLEARANCE
+generate_indoor = INDOOR.generate_indoor
 
 
 @pytest.mark.parametrize("family", INDOOR_FAMILIES)

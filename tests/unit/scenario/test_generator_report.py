@@ -4,20 +4,28 @@ the BARN metric per family."""
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import Any
 
 import pytest
+from benchmark_module import load_benchmark
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from otonav.scenario._generator import SPARSE, WALLED_IN, generate_world
-from otonav.scenario._generator_report import RunResult, summarise
 
 pytestmark = pytest.mark.unit
+
+NAV_BENCH = load_benchmark("nav_bench.py")  # the scoring is benchmarks/nav_bench.py's
+RunResult = NAV_BENCH.RunResult
+summarise = NAV_BENCH.summarise
+barn_metric = NAV_BENCH.barn_metric
 
 WORLD = generate_world(1, SPARSE)
 WALLED = generate_world(1, WALLED_IN)
 OPT = WORLD.optimal_time_s or 0.0
 
 
-def _run(**kw: object) -> RunResult:
+def _run(**kw: object) -> Any:
     base = RunResult.of(
         "sparse",
         WORLD,
@@ -31,10 +39,10 @@ def _run(**kw: object) -> RunResult:
         wall_time_s=1.0,
         reason="reached the goal with clearance",
     )
-    return replace(base, **kw)  # type: ignore[arg-type]
+    return replace(base, **kw)
 
 
-def _walled(**kw: object) -> RunResult:
+def _walled(**kw: object) -> Any:
     base = RunResult.of(
         "sparse",
         WALLED,
@@ -48,7 +56,7 @@ def _walled(**kw: object) -> RunResult:
         wall_time_s=1.0,
         reason="reported unreachable",
     )
-    return replace(base, **kw)  # type: ignore[arg-type]
+    return replace(base, **kw)
 
 
 def test_a_family_row_counts_each_outcome_once() -> None:
@@ -100,3 +108,17 @@ def test_unreachable_said_after_the_budget_is_a_timeout() -> None:
     late = _walled(passed=False, unreachable_at_s=WALLED.scenario.sim_budget + 1.0)
     assert late.timed_out
     assert summarise("sparse", [late]).walled_reported == 0
+
+
+@settings(deadline=None)
+@given(optimal=st.floats(0.1, 100.0), factor=st.floats(0.0, 20.0))
+def test_barn_metric_is_clipped_between_an_eighth_and_a_half(optimal: float, factor: float) -> None:
+    score = barn_metric(True, factor * optimal, optimal)
+    assert 1 / 8 - 1e-12 <= score <= 0.5 + 1e-12
+    if factor <= 2.0:
+        assert score == pytest.approx(0.5)
+    elif factor >= 8.0:
+        assert score == pytest.approx(1 / 8)
+    else:
+        assert score == pytest.approx(1 / factor)
+    assert barn_metric(False, factor * optimal, optimal) == 0.0

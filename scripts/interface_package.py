@@ -5,7 +5,7 @@ A ROS 2 user builds that package (``colcon build``) to use otonav's own types in
 nodes; the gate checks that each file equals the top-level text of the schema otonav
 writes into recordings, so the two cannot drift. After changing one of these types:
 
-    python -m otonav.record._interface_package otonav_msgs/msg
+    python scripts/interface_package.py otonav_msgs/msg
 """
 
 from __future__ import annotations
@@ -54,7 +54,7 @@ def msg_files() -> dict[str, str]:
 
 def main(argv: list[str]) -> int:
     if len(argv) != 1:
-        print("usage: python -m otonav.record._interface_package DIR", file=sys.stderr)
+        print("usage: python scripts/interface_package.py DIR", file=sys.stderr)
         return 2
     folder = Path(argv[0])
     folder.mkdir(parents=True, exist_ok=True)
