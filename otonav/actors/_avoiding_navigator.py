@@ -148,6 +148,8 @@ class AvoidingNavigator(GoalNavigator):
         if out.state in _AT_REST and key == self._last_diag:
             return
         self._last_diag = key
+        if not self.diagnostics.get_subscription_count():  # none without a recorder
+            return
         await self.diagnostics.publish(
             NavDiagnostics.fast(
                 header=header,

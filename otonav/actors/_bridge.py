@@ -194,6 +194,10 @@ class Bridge(Actor):
     every publishing instant; a change is published on /hardware/status (latched, for
     the base and the navigator) and /diagnostics, and logged on /rosout. /diagnostics
     also repeats at ``diagnostics_hz``.
+
+    A stream no one subscribes to at its instant is not built (/clock, /odom, /tf, /imu,
+    /joint_states; as a ROS 2 driver checks ``get_subscription_count``); the hardware is
+    read the same either way, so a recorder changes nothing the robot does.
     """
 
     clock_out = Output(topics.CLOCK, Clock, topics.CLOCK_QOS)
@@ -361,7 +365,8 @@ class Bridge(Actor):
         self._pending.append((publisher, message))
 
     def _publish_clock(self, sec: int, nanosec: int, _now: float) -> None:
-        self._send(self.clock_out, CLOCK(sec, nanosec))
+        if self.clock_out.get_subscription_count():
+            self._send(self.clock_out, CLOCK(sec, nanosec))
 
     def _publish_odom(self, sec: int, nanosec: int, now: float) -> None:
         hal = self.hal
@@ -381,13 +386,18 @@ class Bridge(Actor):
         if error is not None:  # /odom's twist is what the mis-calibrated odometry believes
             gyro_z = odometry.yaw_rate
         qz, qw = math.sin(pose.yaw / 2), math.cos(pose.yaw / 2)  # Quaternion.from_yaw's
-        self._send(self.odom, self._odom_layout(sec, nanosec, pose.x, pose.y, qz, qw, v, gyro_z))
-        self._send(self.tf, self._tf_layout(sec, nanosec, pose.x, pose.y, qz, qw))
+        if self.odom.get_subscription_count():
+            odom = self._odom_layout(sec, nanosec, pose.x, pose.y, qz, qw, v, gyro_z)
+            self._send(self.odom, odom)
+        if self.tf.get_subscription_count():
+            self._send(self.tf, self._tf_layout(sec, nanosec, pose.x, pose.y, qz, qw))
 
     def _publish_joints(self, sec: int, nanosec: int, _now: float) -> None:
         """/joint_states: the wheel joints by the model's names, each in its own sign
         (the HAL reads positive-forward), after every other stream of the instant."""
         left, right, left_v, right_v = self.hal.wheel_values()
+        if not self.joint_states.get_subscription_count():
+            return
         sl, sr = self.hal.geometry.wheel_signs
         self._send(
             self.joint_states,
@@ -409,6 +419,8 @@ class Bridge(Actor):
 
     def _publish_imu(self, sec: int, nanosec: int, now: float) -> None:
         sample = self._imu_at(now)
+        if not self.imu.get_subscription_count():
+            return
         w, x, y, z = sample.orientation
         self._send(
             self.imu,

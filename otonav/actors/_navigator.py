@@ -134,15 +134,16 @@ class GoalNavigator(Actor):
                 angular=Vector3.fast(x=0.0, y=0.0, z=omega),
             )
         )
-        await self.state.publish(
-            NavState.fast(
-                header=header,
-                state=state,
-                distance_to_goal=distance,
-                heading_error=heading_error,
-                closest_ahead=closest,
+        if self.state.get_subscription_count():  # none in a run without a recorder
+            await self.state.publish(
+                NavState.fast(
+                    header=header,
+                    state=state,
+                    distance_to_goal=distance,
+                    heading_error=heading_error,
+                    closest_ahead=closest,
+                )
             )
-        )
         return header
 
 

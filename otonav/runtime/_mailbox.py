@@ -298,6 +298,12 @@ class Publisher(Generic[M]):
         self._accepted: type[Any] = self.msg_type
         """Another class whose messages this publisher takes as ``msg_type`` ones."""
 
+    def get_subscription_count(self) -> int:
+        """How many mailboxes the topic has now (rclpy's ``get_subscription_count``): a
+        publisher may skip building a message no one would receive. A late joiner is
+        counted at once; a latched publisher keeps history, so it should not skip."""
+        return len(self._topic.subscriptions)
+
     def _check_type(self, message: object) -> None:
         # A class that stands for the topic's type (a flat message, otonav.msgs._flat,
         # built on first use): accepted as it is, and from now on without this call.

@@ -388,3 +388,33 @@ def test_a_full_reliable_subscriber_holds_the_streams_back_in_order() -> None:
         assert names[i : i + 4] == [topics.CLOCK, topics.ODOM, topics.TF, topics.IMU], i
     times = [t for _, t, _ in got]
     assert times == sorted(times)
+
+
+def test_a_stream_with_no_subscriber_is_not_built_and_a_late_one_gets_the_next() -> None:
+    """As a ROS 2 driver checks ``get_subscription_count``: no mailbox, no message; a
+    subscriber that joins gets the stream from the next instant, and odometry integrated
+    all along (the hardware is read either way)."""
+    hal = FakeHardware()
+    kinds = {topics.CLOCK: Clock, topics.IMU: Imu, topics.ODOM: Odometry, topics.TF: TFMessage}
+
+    async def main() -> None:
+        async with System([Bridge(hal)]) as system:
+            wheels = system.publisher(topics.WHEEL_CMD, WheelCommand, topics.COMMAND_QOS)
+            await wheels.publish(WheelCommand(left=5.0, right=5.0))
+            await anyio.sleep(0.505)
+            published = {t: system.bus.topics[t].publishers[0].published for t in kinds}
+            assert published == dict.fromkeys(kinds, 0)
+            async with _observing(system, kinds) as log:
+                await anyio.sleep(0.1)
+        for topic in kinds:
+            first_at, first = log[topic][0]
+            stamped = first.transforms[0] if topic == topics.TF else first
+            assert first_at == pytest.approx(0.51)
+            assert _stamp(stamped).to_nanoseconds() == _ns(0.51)
+            assert len(log[topic]) == 10
+        odom = log[topics.ODOM][-1][1]
+        # The last /odom is at 0.6 s, the truth read at 0.605 s (the fake is exact).
+        assert odom.pose.pose.position.x == pytest.approx(hal.ground_truth().x, abs=2e-3)
+        assert odom.pose.pose.position.x > 0.1
+
+    _run(hal, main)
