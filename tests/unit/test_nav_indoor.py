@@ -104,7 +104,9 @@ def test_a_gap_under_the_limit_is_not_planned_through() -> None:
 
 
 def test_a_search_in_slices_is_the_search_in_one_go() -> None:
-    from otonav.nav._global_path import AstarSearch, astar
+    from grid_search import astar
+
+    from otonav.nav._global_path import AstarSearch
 
     rng = np.random.default_rng(3)
     free = rng.random((60, 60)) > 0.3

@@ -10,6 +10,7 @@ import sys
 import numpy as np
 import pytest
 from dwa_model import dwa_reference
+from grid_search import astar
 
 from otonav.hal import RobotGeometry
 from otonav.hal.mujoco import MujocoInterface
@@ -17,7 +18,6 @@ from otonav.nav import Navigation, NavigationParams
 from otonav.nav._costmap import ClearanceMap
 from otonav.nav._dwa import DwaParams, clear_arc, dwa_step
 from otonav.nav._footprint import centre_clearance
-from otonav.nav._global_path import astar
 from otonav.nav._planner import Plan
 from otonav.nav._recovery import ProgressChecker, boundary_side, follow_boundary
 from otonav.nav._scan import ScanRays, nearest_return, scan_in_frame, scan_points, to_frame
