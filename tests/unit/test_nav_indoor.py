@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+from grid_search import cell_of
 
 from otonav.nav import Navigation, NavigationParams
 from otonav.nav._dwa import DwaParams
@@ -262,7 +263,7 @@ def test_the_spin_rung_clears_the_map_around_the_robot() -> None:
     nav.observe(_segment(3.0, 2.0, 3.0, 3.0))
     far = int(nav.planner.map.occupied.sum())
     _drive(nav, lambda t: (0.0, 0.0, 0.0), 10.0, lambda out: out.stage == "spin")
-    row, col, _ = nav.planner.map.cell_of(np.array([0.6]), np.array([0.0]))
+    row, col, _ = cell_of(nav.planner.map, np.array([0.6]), np.array([0.0]))
     assert not nav.planner.map.occupied[row, col].any()  # the smear is gone
     assert 0 < int(nav.planner.map.occupied.sum()) < far
 
