@@ -25,7 +25,6 @@ from typing import Any
 
 from otonav.bench._harness import Case, run_in_children
 from otonav.nav import _navigate as navigate
-from otonav.nav import _navigation as navigation
 from otonav.scenario import GoalSpec, ScenarioConfig, StartSpec, run_scenario
 from otonav.scenario._config import BoxSpec
 
@@ -55,7 +54,7 @@ def step_times() -> None:
     original_step = navigate.Navigation.step
     original_observe = navigate.Navigation.observe
 
-    def step(self: navigate.Navigation, *args: Any) -> navigation.NavOutput:
+    def step(self: navigate.Navigation, *args: Any) -> navigate.NavOutput:
         t0 = time.perf_counter()
         out = original_step(self, *args)
         dt = time.perf_counter() - t0

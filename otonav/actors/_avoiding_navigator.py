@@ -12,8 +12,7 @@ from otonav.actors._navigator import NAME, RATE_HZ, SCAN_TIMEOUT, GoalNavigator
 from otonav.actors._odom_history import OdomHistory
 from otonav.actors._scan_cache import odom_xy_of, points_of, rays_of
 from otonav.msgs import LaserScan, NavDiagnostics, Time
-from otonav.nav._navigate import Navigation
-from otonav.nav._navigation import NavOutput
+from otonav.nav._navigate import Navigation, NavOutput
 from otonav.nav._scan import to_frame
 from otonav.params import NavigationParams
 from otonav.runtime import Output

@@ -25,7 +25,6 @@ __all__ = [
     "RoundObstacle",
     "WheelSetpoint",
     "WheelState",
-    "convex_hull",
 ]
 
 
@@ -293,23 +292,3 @@ class PolygonObstacle:
             t = min(max((wx * ex + wy * ey) / length2, 0.0), 1.0) if length2 > 0.0 else 0.0
             best = min(best, math.hypot(wx - t * ex, wy - t * ey))
         return 0.0 if inside else best
-
-
-def convex_hull(points: list[tuple[float, float]]) -> tuple[tuple[float, float], ...]:
-    """The convex hull of ``points``, counter-clockwise (Andrew's monotone chain)."""
-    pts = sorted(set(points))
-    if len(pts) < 3:
-        return tuple(pts)
-
-    def half(seq: list[tuple[float, float]]) -> list[tuple[float, float]]:
-        chain: list[tuple[float, float]] = []
-        for p in seq:
-            while len(chain) >= 2:
-                (ox, oy), (ax, ay) = chain[-2], chain[-1]
-                if (ax - ox) * (p[1] - oy) - (ay - oy) * (p[0] - ox) > 0.0:
-                    break
-                chain.pop()
-            chain.append(p)
-        return chain
-
-    return tuple(half(pts)[:-1] + half(pts[::-1])[:-1])

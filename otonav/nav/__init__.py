@@ -7,8 +7,7 @@ from otonav.nav._footprint import centre_clearance
 from otonav.nav._geometry import goal_problem, wrap_angle
 from otonav.nav._go_to_goal import GoalCommand, GoToGoalParams, go_to_goal
 from otonav.nav._guard import GuardParams, guard_blocked
-from otonav.nav._navigate import Navigation
-from otonav.nav._navigation import NavOutput
+from otonav.nav._navigate import Navigation, NavOutput
 from otonav.nav._safety import SafetyParams, SafetyResult, safe_command
 from otonav.params import NavigationParams
 

@@ -210,17 +210,9 @@ def dwa_step(
     clearance: ClearanceFn,
     params: DwaParams,
 ) -> DwaResult:
-    """Choose (v, omega) for the next period (see the module docstring).
-
-    Args:
-        pose: robot pose (x, y, yaw) in odom.
-        v0: current forward speed, m/s.
-        omega0: current yaw rate, rad/s.
-        target: the point to head for (odom, m).
-        goal_distance: distance to the goal, m (caps the speed for arriving).
-        clearance: distance lookup in odom.
-        params: settings.
-    """
+    """Choose (v, omega) for the next period (module docstring): from ``pose`` (x, y,
+    yaw in odom) at ``v0`` m/s, ``omega0`` rad/s, heading for ``target`` (odom, m), the
+    speed capped for arriving ``goal_distance`` m away, ``clearance`` looked up in odom."""
     p = params
     x0, y0, th0 = pose
     # Arrive: braking at half the limit would stop at the goal (margin for the period).

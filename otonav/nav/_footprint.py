@@ -25,16 +25,9 @@ __all__ = ("centre_clearance",)
 
 
 def centre_clearance(clearance: float, footprint_radius: float, padding: float) -> float:
-    """Smallest allowed distance, m, from the robot centre (base_link) to any return.
-
-    Args:
-        clearance: centre-to-obstacle clearance to keep, m (>= 0).
-        footprint_radius: the footprint's radius about base_link, m (>= 0).
-        padding: extra gap between the footprint and an obstacle, m (>= 0).
-
-    Raises:
-        ValueError: if an argument is negative or not finite (the message names it).
-    """
+    """Smallest allowed distance, m, from the robot centre (base_link) to any return:
+    ``max(clearance, footprint_radius + padding)``, each m and >= 0 (ValueError naming
+    the argument otherwise)."""
     for name, value in (
         ("clearance", clearance),
         ("footprint_radius", footprint_radius),

@@ -19,14 +19,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ("AstarSearch", "GridPath", "astar")
+__all__ = ("AstarSearch", "GridPath")
 
 _SQRT2 = math.sqrt(2.0)
 
 
 @dataclass(frozen=True, slots=True)
 class GridPath:
-    """Result of :func:`astar`.
+    """Result of an :class:`AstarSearch`.
 
     Attributes:
         cells: (row, col) from start to goal; empty when no path was found.
@@ -51,30 +51,6 @@ MAX_EXPANSIONS = 200_000
 """Cells a search expands at most before it gives up (no proof either way)."""
 
 
-def astar(
-    free: NDArray[np.bool_],
-    penalty: NDArray[np.floating[Any]],
-    start: tuple[int, int],
-    goal: tuple[int, int],
-    *,
-    max_expansions: int = MAX_EXPANSIONS,
-) -> GridPath:
-    """Shortest 8-connected path of free cells from ``start`` to ``goal``, in one call
-    (:class:`AstarSearch` run to the end).
-
-    The start and goal cells count as free whatever ``free`` says (the robot is where it
-    is; a goal on an inflated cell is still the goal). A diagonal step needs both of its
-    side cells free (no corner cutting).
-
-    Raises:
-        ValueError: if the shapes differ or ``start``/``goal`` is outside the grid.
-    """
-    search = AstarSearch(free, penalty, start, goal, max_expansions=max_expansions)
-    result = search.advance(max_expansions)
-    assert result is not None  # the budget is the cap: the search ended
-    return result
-
-
 class AstarSearch:
     """A* that can stop after any number of expansions and go on later (issue 24: a
     navigator tick must stay short, and proving "no path" on a 200 x 200 grid took
@@ -82,9 +58,13 @@ class AstarSearch:
     change meanwhile, and the caller replans when the path it gets is blocked.
 
     ``advance(budget)`` expands at most ``budget`` more cells and returns the
-    :class:`GridPath`, or None when the search is not over yet. Same semantics as
-    :func:`astar` (which is this class run in one go): the same expansions in the same
-    order, whatever the budgets."""
+    :class:`GridPath`, or None when the search is not over yet: the same expansions in
+    the same order, whatever the budgets.
+
+    The start and goal cells count as free whatever ``free`` says (the robot is where it
+    is; a goal on an inflated cell is still the goal). A diagonal step needs both of its
+    side cells free (no corner cutting). ValueError if the shapes differ or
+    ``start``/``goal`` is outside the grid."""
 
     def __init__(
         self,

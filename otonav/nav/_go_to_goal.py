@@ -18,27 +18,16 @@ __all__ = ("GoToGoalParams", "GoalCommand", "go_to_goal")
 
 @dataclass(frozen=True, slots=True)
 class GoalCommand:
-    """Output of :func:`go_to_goal`.
-
-    Attributes:
-        v: forward speed command, m/s (never negative).
-        omega: yaw-rate command, rad/s (CCW positive).
-        reached: the goal is within tolerance; v and omega are then 0.
-        distance: Euclidean distance from pose to goal, m.
-        heading_error: bearing to goal minus yaw, wrapped to [-pi, pi], rad
-            (positive: goal is to the left).
-    """
+    """Output of :func:`go_to_goal`: ``v`` m/s (never negative), ``omega`` rad/s (CCW
+    positive), ``reached`` (within tolerance; v and omega are then 0), ``distance`` to
+    the goal, m, ``heading_error``: bearing to goal minus yaw in [-pi, pi] rad (positive:
+    goal to the left)."""
 
     v: float
     omega: float
     reached: bool
     distance: float
     heading_error: float
-
-
-def _require_finite(name: str, value: float) -> None:
-    if not math.isfinite(value):
-        raise ValueError(f"{name} must be finite, got {value!r}")
 
 
 def go_to_goal(pose: Pose2D, goal_x: float, goal_y: float, params: GoToGoalParams) -> GoalCommand:
@@ -48,24 +37,15 @@ def go_to_goal(pose: Pose2D, goal_x: float, goal_y: float, params: GoToGoalParam
     ``params.turn_in_place_threshold`` the robot turns in place (v = 0); otherwise
     ``v = min(kp_lin*distance, max_v) * max(cos(heading_error), 0)``. Always
     ``omega = clamp(kp_ang*heading_error, ±max_omega)``. Never reverses (v >= 0).
-
-    Args:
-        pose: robot pose in the odom frame.
-        goal_x: goal x in the odom frame, m.
-        goal_y: goal y in the odom frame, m.
-        params: gains and limits.
-
-    Returns:
-        The command and the errors it was computed from.
-
-    Raises:
-        ValueError: if an input is NaN or infinite; the message names it.
+    Pose and goal in odom; ValueError naming an input that is NaN or infinite.
     """
-    _require_finite("pose.x", pose.x)
-    _require_finite("pose.y", pose.y)
-    _require_finite("pose.yaw", pose.yaw)
-    _require_finite("goal_x", goal_x)
-    _require_finite("goal_y", goal_y)
+    for name, value in zip(
+        ("pose.x", "pose.y", "pose.yaw", "goal_x", "goal_y"),
+        (pose.x, pose.y, pose.yaw, goal_x, goal_y),
+        strict=True,
+    ):
+        if not math.isfinite(value):
+            raise ValueError(f"{name} must be finite, got {value!r}")
     dx = goal_x - pose.x
     dy = goal_y - pose.y
     distance = math.hypot(dx, dy)

@@ -46,30 +46,17 @@ def guard_blocked(
     valid return: finite, > 0, and within ``[range_min, range_max]`` (the LaserScan
     fields; by default no extra bound). So -1 (no hit), 0, +inf and NaN are ignored.
     ``-inf`` in the sector (REP 117: a return too close to measure) blocks, with
-    ``closest`` = ``-inf``.
+    ``closest`` = ``-inf``. Angles in rad, CCW from x forward; ranges in m.
 
-    Args:
-        ranges: 1-D array of ranges, m.
-        angle_min: angle of the first beam, rad (CCW from x forward).
-        angle_increment: angle between consecutive beams, rad.
-        params: sector and stop distance.
-        range_min: smallest valid range, m.
-        range_max: largest valid range, m.
-
-    Returns:
-        ``(blocked, closest)``: ``closest`` is the smallest valid range in the sector
-        in m (``inf`` if none, ``-inf`` if a return was too close to measure);
-        ``blocked`` is ``closest <= params.stop_distance``.
-
-    Raises:
-        ValueError: if ``ranges`` is not 1-D or an angle is not finite.
+    Returns ``(blocked, closest)``: ``closest`` is the smallest valid range in the
+    sector (``inf`` if none), ``blocked`` is ``closest <= params.stop_distance``.
+    ValueError if ``ranges`` is not 1-D or an angle is not finite.
     """
     if ranges.ndim != 1:
         raise ValueError(f"ranges must be 1-D, got shape {ranges.shape}")
-    if not math.isfinite(angle_min):
-        raise ValueError(f"angle_min must be finite, got {angle_min!r}")
-    if not math.isfinite(angle_increment):
-        raise ValueError(f"angle_increment must be finite, got {angle_increment!r}")
+    for name, angle in (("angle_min", angle_min), ("angle_increment", angle_increment)):
+        if not math.isfinite(angle):
+            raise ValueError(f"{name} must be finite, got {angle!r}")
     sector = _sector_mask(
         ranges.shape[0], float(angle_min), float(angle_increment), params.sector_half_angle
     )

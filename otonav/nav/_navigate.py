@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -27,13 +28,29 @@ from numpy.typing import NDArray
 from otonav.nav._controller import Controller
 from otonav.nav._dwa import DwaResult
 from otonav.nav._geometry import wrap_angle
-from otonav.nav._navigation import NavOutput
 from otonav.nav._planner import GlobalPlanner, Plan
 from otonav.nav._recovery import Points, Pose, ProgressChecker, Recovery, Stage
 from otonav.nav._scan import ScanRays
 from otonav.params import NavigationParams
 
-__all__ = ("Navigation",)
+__all__ = ("NavOutput", "Navigation")
+
+
+class NavOutput(NamedTuple):
+    """One step's command and what explains it. A named tuple, immutable like a frozen
+    dataclass but made in ~0.7 us instead of ~2.7 us (one per step)."""
+
+    v: float
+    omega: float
+    state: str
+    """idle | driving | avoiding | blocked | recovering | unreachable | reached."""
+    reason: str
+    distance: float
+    heading_error: float
+    dwa: DwaResult | None = None
+    stage: str = ""
+    path_length: float = math.nan
+    replans: int = 0
 
 
 @dataclass(slots=True)

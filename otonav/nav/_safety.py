@@ -95,16 +95,9 @@ def safe_command(
     points: NDArray[np.float64],
     params: SafetyParams,
 ) -> SafetyResult:
-    """The command limited so the robot can always stop in time (module docstring).
-
-    Args:
-        v_cmd: commanded forward speed, m/s.
-        omega_cmd: commanded yaw rate, rad/s.
-        v0: current forward speed, m/s.
-        omega0: current yaw rate, rad/s.
-        points: ``(N, 2)`` returns in the current base_link, m.
-        params: settings.
-    """
+    """The command (``v_cmd`` m/s, ``omega_cmd`` rad/s) limited so the robot, now at
+    ``v0``, ``omega0``, can always stop in time before ``points``, the ``(N, 2)`` returns
+    in the current base_link, m (module docstring)."""
     p = params
     d0 = np.hypot(points[:, 0], points[:, 1]) if points.shape[0] else np.empty(0)
     nearest = float(d0.min()) if d0.size else math.inf

@@ -113,11 +113,8 @@ def scan_points(
     range_max: float,
     laser_offset_x: float,
 ) -> ScanPoints:
-    """The scan's returns as points in base_link (see the module docstring).
-
-    Raises:
-        ValueError: if ``ranges`` is not 1-D or an angle is not finite.
-    """
+    """The scan's returns as points in base_link (module docstring); ValueError if
+    ``ranges`` is not 1-D or an angle is not finite."""
     rv, cv, sv, blocked = _returns(ranges, angle_min, angle_increment, range_min, range_max)
     xy = np.empty((rv.shape[0], 2))
     xy[:, 0] = laser_offset_x + rv * cv
@@ -137,11 +134,7 @@ def scan_in_frame(
     """The returns of :func:`scan_points` taken at the body pose ``pose`` (x, y, yaw)
     in odom, as x and y arrays: the same floats as ``to_frame(scan_points(...).xy,
     pose)`` without the (N, 2) arrays in between (the navigator's map update needs the
-    coordinates, not the points).
-
-    Raises:
-        ValueError: if ``ranges`` is not 1-D or an angle is not finite.
-    """
+    coordinates, not the points). Raises as :func:`scan_points`."""
     rv, cv, sv, _ = _returns(ranges, angle_min, angle_increment, range_min, range_max)
     px = laser_offset_x + rv * cv
     py = rv * sv

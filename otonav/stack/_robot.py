@@ -24,7 +24,6 @@ __all__ = [
     "robot_base",
     "robot_frames",
     "slower",
-    "top_speed",
 ]
 
 
@@ -142,11 +141,6 @@ def nav_speeds(stack: StackConfig) -> tuple[float, float]:
     v = _one_speed("max_v", robot.max_v, {"nav": (nav.max_v, defaults.max_v)})
     w = _one_speed("max_omega", robot.max_omega, {"nav": (nav.max_omega, defaults.max_omega)})
     return min(v, base.max_v), min(w, base.max_omega)
-
-
-def top_speed(stack: StackConfig) -> float:
-    """m/s: the fastest the robot may drive (the base's limit, capped by the robot's)."""
-    return robot_base(stack).max_v
 
 
 REACHED: Final = 0.95

@@ -1,10 +1,9 @@
 """One run of the robot stack: its world, time mode, recording, and one teardown.
 
-Every runner (the scenario runners in virtual and real time, ``running_stack``, the
-live stack of ``otonav.embed``, the benchmarks) hands a :class:`StackSession` its world
-and actors; the session adds the recorder, wires the :class:`~otonav.runtime.System`,
-puts the world in charge of time and tears everything down the same way, whatever
-ends the run (ADR 0007):
+Every runner (a judged scenario, the engine's live stack, the benchmarks) hands a
+:class:`StackSession` its world and actors; the session adds the recorder, wires the
+:class:`~otonav.runtime.System`, puts the world in charge of time and tears everything
+down the same way, whatever ends the run (ADR 0007):
 
 1. the robot actors stop, one after another in reverse start order, each ``on_stop``
    finished before the next one is cancelled (``System.stop``);
@@ -59,11 +58,8 @@ class StackSession:
 
     Use ``async with session.running() as system:`` (tears down on exit), or
     ``session.running(close=False)`` followed by :meth:`close` when something must be
-    appended to the recording after the run (a scenario's verdict).
-
-    Time: ``time=Virtual()`` (the default) or ``time=RealTime(scale)``, which paces the
-    world to the wall clock with a :class:`~otonav.runtime.RealTimeClock` the session
-    makes (:attr:`realtime_clock`).
+    appended to the recording after the run (a scenario's verdict). Time as in the
+    module docstring; in real time the session's clock is :attr:`realtime_clock`.
     """
 
     def __init__(

@@ -49,7 +49,7 @@ class FloorWatch(Actor):
         async for _scan in self.scan:
             assert isinstance(self.hal, MujocoInterface)
             self.scans += 1
-            self.floor_hits += self.hal.scan_floor_hits()
+            self.floor_hits += int(self.hal.scan_floor_mask().sum())
             self.max_pitch = max(self.max_pitch, abs(self.hal.ground_truth().pitch))
 
     def _true_clearance(self) -> float:

@@ -8,8 +8,9 @@ import dataclasses
 
 import numpy as np
 import pytest
+from grid_search import astar
 
-from otonav.nav._global_path import AstarSearch, GridPath, astar
+from otonav.nav._global_path import AstarSearch, GridPath
 
 pytestmark = pytest.mark.unit
 

@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+from grid_search import cell_of
 
 from otonav.nav import Navigation, NavigationParams
 from otonav.nav._dwa import DwaParams
@@ -104,7 +105,9 @@ def test_a_gap_under_the_limit_is_not_planned_through() -> None:
 
 
 def test_a_search_in_slices_is_the_search_in_one_go() -> None:
-    from otonav.nav._global_path import AstarSearch, astar
+    from grid_search import astar
+
+    from otonav.nav._global_path import AstarSearch
 
     rng = np.random.default_rng(3)
     free = rng.random((60, 60)) > 0.3
@@ -260,7 +263,7 @@ def test_the_spin_rung_clears_the_map_around_the_robot() -> None:
     nav.observe(_segment(3.0, 2.0, 3.0, 3.0))
     far = int(nav.planner.map.occupied.sum())
     _drive(nav, lambda t: (0.0, 0.0, 0.0), 10.0, lambda out: out.stage == "spin")
-    row, col, _ = nav.planner.map.cell_of(np.array([0.6]), np.array([0.0]))
+    row, col, _ = cell_of(nav.planner.map, np.array([0.6]), np.array([0.0]))
     assert not nav.planner.map.occupied[row, col].any()  # the smear is gone
     assert 0 < int(nav.planner.map.occupied.sum()) < far
 

@@ -10,6 +10,7 @@ import sys
 import numpy as np
 import pytest
 from dwa_model import dwa_reference
+from grid_search import astar, cell_of, mark
 
 from otonav.hal import RobotGeometry
 from otonav.hal.mujoco import MujocoInterface
@@ -17,7 +18,6 @@ from otonav.nav import Navigation, NavigationParams
 from otonav.nav._costmap import ClearanceMap
 from otonav.nav._dwa import DwaParams, clear_arc, dwa_step
 from otonav.nav._footprint import centre_clearance
-from otonav.nav._global_path import astar
 from otonav.nav._planner import Plan
 from otonav.nav._recovery import ProgressChecker, boundary_side, follow_boundary
 from otonav.nav._scan import ScanRays, nearest_return, scan_in_frame, scan_points, to_frame
@@ -128,8 +128,8 @@ def test_to_frame_round_trip() -> None:
 
 def test_clearance_is_a_lower_bound_capped_and_unknown_is_free() -> None:
     m = ClearanceMap(0.0, 0.0, half_size=2.0, resolution=0.025, max_distance=0.6)
-    assert m.mark(np.array([[1.0, 0.0]])) == 1
-    assert m.mark(np.array([[1.001, 0.001]])) == 0  # same cell: nothing new
+    assert mark(m, np.array([[1.0, 0.0]])) == 1
+    assert mark(m, np.array([[1.001, 0.001]])) == 0  # same cell: nothing new
     qx = np.array([1.0, 0.7, 0.5, -1.0, 5.0])
     qy = np.zeros(5)
     c = m.clearance(qx, qy)
@@ -143,15 +143,15 @@ def test_clearance_is_a_lower_bound_capped_and_unknown_is_free() -> None:
 def test_a_scan_adding_no_new_cell_leaves_the_map_as_it_was() -> None:
     m = ClearanceMap(0.0, 0.0, half_size=2.0, resolution=0.05, max_distance=0.6)
     wall = _wall(1.0, -0.5, 0.5)
-    assert m.mark(wall) > 0
+    assert mark(m, wall) > 0
     before, marked = m.clearance(*np.mgrid[-2:2:0.01, -2:2:0.01]).copy(), m.marked
     # the same cells again, and points outside the map (ignored): nothing changes
     again = np.concatenate((wall + 0.001, [[5.0, 0.0], [-9.0, -9.0]]))
-    assert m.mark(again) == 0
+    assert mark(m, again) == 0
     assert m.marked == marked
     assert (m.clearance(*np.mgrid[-2:2:0.01, -2:2:0.01]) == before).all()
     # a return on the map's edge stamps the ring just outside it (a true bound there)
-    assert m.mark(np.array([[1.99, 0.0]])) == 1
+    assert mark(m, np.array([[1.99, 0.0]])) == 1
     assert m.clearance(np.array([2.04]), np.array([0.0]))[0] < 0.6
     assert m.clearance(np.array([3.0]), np.array([0.0]))[0] == pytest.approx(0.6)
 
@@ -162,7 +162,7 @@ def test_clearance_lookups_agree_with_the_plain_formula_everywhere() -> None:
     the padded grid; points outside the map (and far outside) included."""
     rng = np.random.default_rng(3)
     m = ClearanceMap(0.3, -0.2, half_size=2.0, resolution=0.05, max_distance=0.6)
-    m.mark(rng.uniform(-2.5, 2.5, (40, 2)))
+    mark(m, rng.uniform(-2.5, 2.5, (40, 2)))
     x = np.concatenate((rng.uniform(-4.0, 4.0, 3000), [-1.7, 2.3, -1e6, 1e6]))
     y = np.concatenate((rng.uniform(-4.0, 4.0, 3000), [-2.2, 1.8, 1e6, -1e6]))
     inv, pad = 1.0 / m.resolution, m._pad
@@ -199,26 +199,26 @@ def test_cells_a_scan_sees_through_are_cleared_and_their_distances_recomputed() 
     m = ClearanceMap(0.0, 0.0, half_size=5.0, resolution=0.05, max_distance=0.6)
     gone = _wall(1.0, -0.2, 0.2)  # a phantom 1 m ahead (a moved obstacle, a misread)
     kept = _wall(-1.0, -0.2, 0.2)  # 1 m behind, where the beams end
-    m.mark(np.concatenate((gone, kept)))
+    mark(m, np.concatenate((gone, kept)))
     assert m.clearance(np.array([0.7]), np.array([0.0]))[0] < 0.35
     ranges = np.full(360, np.inf)  # nothing within 8 m ahead...
     angles = -math.pi + np.arange(360) * 2 * math.pi / 360
     ranges[np.abs(angles) > math.pi - 0.6] = 1.0  # ...and the real wall 1 m behind
-    row, col, _ = m.cell_of(gone[:, 0], gone[:, 1])
+    row, col, _ = cell_of(m, gone[:, 0], gone[:, 1])
     cells = len(set(zip(row.tolist(), col.tolist(), strict=True)))
     assert m.clear_seen(_rays(ranges), reach=3.0, margin=0.1) == cells
     assert m.cleared == cells
-    assert not m.occupied[m.cell_of(gone[:, 0], gone[:, 1])[:2]].any()
-    assert m.occupied[m.cell_of(kept[:, 0], kept[:, 1])[:2]].all()
+    assert not m.occupied[cell_of(m, gone[:, 0], gone[:, 1])[:2]].any()
+    assert m.occupied[cell_of(m, kept[:, 0], kept[:, 1])[:2]].all()
     # the distances around the phantom are back to the cap, those near the wall kept
     assert m.clearance(np.array([0.7, 1.0]), np.array([0.0, 0.0])) == pytest.approx([0.6, 0.6])
     assert m.clearance(np.array([-0.7]), np.array([0.0]))[0] < 0.35
-    assert m.mark(gone) > 0  # seen again, marked again
+    assert mark(m, gone) > 0  # seen again, marked again
 
 
 def test_a_return_or_an_unreadable_beam_keeps_its_cell() -> None:
     m = ClearanceMap(0.0, 0.0, half_size=5.0, resolution=0.05, max_distance=0.6)
-    m.mark(_wall(1.0, -0.2, 0.2))
+    mark(m, _wall(1.0, -0.2, 0.2))
     before = m.occupied.copy()
     hit = np.full(360, 1.0)  # every beam returns at 1 m: the wall is there
     assert m.clear_seen(_rays(hit), reach=3.0, margin=0.1) == 0
@@ -280,7 +280,7 @@ def test_astar_goes_around_a_wall_and_proves_an_enclosed_goal() -> None:
 
 def _map_with(points: np.ndarray) -> ClearanceMap:
     m = ClearanceMap(0.0, 0.0, half_size=5.0, resolution=0.025, max_distance=0.65)
-    m.mark(points)
+    mark(m, points)
     return m
 
 

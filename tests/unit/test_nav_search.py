@@ -12,8 +12,9 @@ import math
 
 import numpy as np
 import pytest
+from grid_search import astar
 
-from otonav.nav._global_path import AstarSearch, astar
+from otonav.nav._global_path import AstarSearch
 from otonav.nav._plan_grid import best_points, free_threshold, pooled
 
 pytestmark = pytest.mark.unit

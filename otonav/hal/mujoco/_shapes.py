@@ -8,9 +8,10 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from otonav.hal._types import BoxObstacle, PolygonObstacle, RoundObstacle, convex_hull
+from otonav.hal._types import BoxObstacle, PolygonObstacle, RoundObstacle
 from otonav.hal.mujoco._derive import _collides, _geom_corners
 from otonav.hal.mujoco._lib import mujoco
+from otonav.nav._observed_hull import convex_hull
 
 __all__: list[str] = []
 
@@ -67,9 +68,10 @@ def _static_shapes(m: Any) -> _Shapes:
         elif kind == kinds.mjGEOM_MESH:
             # its vertices on the floor: their convex hull (fewer than 3 corners: a mesh
             # edge-on to the floor, no area to measure from)
-            hull = convex_hull([(float(px), float(py)) for px, py, _ in _geom_corners(m, d, g)])
+            corners = _geom_corners(m, d, g)
+            hull = convex_hull(corners[:, 0], corners[:, 1]).tolist()
             if len(hull) >= 3:
-                polygons.append(PolygonObstacle(hull))
+                polygons.append(PolygonObstacle(tuple((px, py) for px, py in hull)))
             else:
                 unjudged.append(f"{name} (MESH)")
         else:

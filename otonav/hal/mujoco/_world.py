@@ -315,16 +315,10 @@ class MujocoInterface(RobotHardwareInterface):
         return self._lidar.hit_geoms()
 
     def scan_floor_mask(self) -> NDArray[np.bool_]:
-        """Per beam of the last :meth:`read_scan`: did it hit a floor plane within range?"""
+        """Per beam of the last :meth:`read_scan`: did it hit a floor plane within range?
+        Any does when the chassis is pitched or rolled enough for the lidar to read the
+        floor as an obstacle (the seeds' pitch bug)."""
         return self._lidar.floor_mask()
-
-    def scan_floor_hits(self) -> int:
-        """How many beams of the last :meth:`read_scan` hit a floor plane within range.
-
-        Non-zero means the chassis is pitched or rolled enough for the lidar to read the
-        floor as an obstacle (the seeds' pitch bug).
-        """
-        return int(np.count_nonzero(self.scan_floor_mask()))
 
     def geom_name(self, geom_id: int) -> str:
         """Name of a geom id (e.g. from :meth:`scan_hit_geoms`); ``""`` if unnamed."""

@@ -7,12 +7,13 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from otonav.hal import BoxObstacle, PolygonObstacle, RoundObstacle
-from otonav.hal._types import convex_hull
+from otonav.nav._observed_hull import convex_hull
 from otonav.scenario._clearance import ClearanceTracker
 
 pytestmark = pytest.mark.unit
@@ -179,7 +180,8 @@ def _as_polygon(b: BoxObstacle) -> PolygonObstacle:
         (b.x + c * u - s * v, b.y + s * u + c * v)
         for u, v in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))
     ]
-    return PolygonObstacle(convex_hull(corners))
+    xy = np.array(corners)
+    return PolygonObstacle(tuple(map(tuple, convex_hull(xy[:, 0], xy[:, 1]).tolist())))
 
 
 @settings(max_examples=200, deadline=None)
