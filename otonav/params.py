@@ -327,7 +327,7 @@ class LocalizerParams:
 
 @dataclass(frozen=True, slots=True)
 class NavigationParams:
-    """Settings of :class:`~otonav.nav._navigation.Navigation`. Each field means what the
+    """Settings of :class:`otonav.nav.Navigation`. Each field means what the
     config key that sets it says (:data:`CONFIG_KEYS`: ``nav.map.*``, ``nav.recovery.*``,
     ``nav.tolerance``, ...), and:
 
