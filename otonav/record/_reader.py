@@ -96,7 +96,8 @@ class RecordingSummary:
         return sum(t.count for t in self.topics)
 
 
-def _check_file(path: Path) -> None:
+def check_file(path: Path) -> None:
+    """One line for a path that cannot be a recording: missing, a directory, no MCAP magic."""
     if not path.exists():
         raise RecordingError(f"{path}: no such file")
     if path.is_dir():
@@ -111,7 +112,7 @@ def summarize(path: str | Path) -> RecordingSummary:
     """Topics, types, counts, rates and duration; falls back to a streaming scan of the
     complete chunks when the file was cut off (``truncated=True``)."""
     path = Path(path)
-    _check_file(path)
+    check_file(path)
     size = path.stat().st_size
     with path.open("rb") as f:
         try:
@@ -264,7 +265,7 @@ def read_messages(
     :class:`DamagedRecordingError`, or, given a ``damage`` list, is skipped and appended
     to it (the file is then read front to back, in file order)."""
     path = Path(path)
-    _check_file(path)
+    check_file(path)
     first = -1 if start is None else round(start * 1e9)
     last = None if end is None else round(end * 1e9)
     raw = _read_indexed(path, topics) if damage is None else None

@@ -23,7 +23,7 @@ from otonav.record._reader import (
     CUT_OFF_ERRORS,
     DamagedRecordingError,
     RecordingError,
-    _check_file,
+    check_file,
     iter_readable,
 )
 from otonav.record._verify import Damage, describe_damage
@@ -42,7 +42,7 @@ def salvage(
     chunks are not copied: they are appended to ``damaged``, or, without that list,
     reported by a :class:`DamagedRecordingError` once ``target`` is written."""
     source, target = Path(source), Path(target)
-    _check_file(source)
+    check_file(source)
     if source.resolve() == target.resolve():
         raise RecordingError(f"{target}: salvage writes a new file; choose another path")
     if target.is_dir():

@@ -22,7 +22,7 @@ from mcap.reader import NonSeekingReader, make_reader
 from pydantic import ValidationError
 
 from otonav.record._fastreader import ChunkDamageError, read_raw_messages
-from otonav.record._reader import CUT_OFF_ERRORS, MAGIC
+from otonav.record._reader import CUT_OFF_ERRORS, RecordingError, check_file
 from otonav.record._verify import _finished, _one_line, describe_damage, summary_damage
 from otonav.scenario._config import StartSpec
 from otonav.stack import StackConfig
@@ -97,14 +97,11 @@ def load_recording(path: Path, topics: Collection[str] | None) -> Recording:
     """Read ``path``: metadata, every topic's type, and the messages of ``topics`` (all
     when None; none, without reading a chunk, when empty). Raises
     :class:`ReplayInputError` for a missing, non-MCAP or cut-off file."""
-    if not path.exists():
-        raise ReplayInputError(f"{path}: no such file")
-    if path.is_dir():
-        raise ReplayInputError(f"{path}: is a directory, not an MCAP recording")
+    try:
+        check_file(path)  # the reader's checks: missing, a directory, no MCAP magic
+    except RecordingError as exc:
+        raise ReplayInputError(str(exc)) from None
     with path.open("rb") as f:
-        if f.read(len(MAGIC)) != MAGIC:
-            raise ReplayInputError(f"{path}: not an MCAP file (no MCAP magic at its start)")
-        f.seek(0)
         if not _has_header(f):  # the magic alone (issue 27: "Invalid argument")
             size = f.seek(0, 2)
             raise ReplayInputError(
