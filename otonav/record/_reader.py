@@ -15,13 +15,13 @@ from mcap.exceptions import McapError
 from mcap.reader import NonSeekingReader, make_reader
 from mcap.records import Channel, Metadata, Schema
 from mcap.records import Message as Message_
+from mcap.writer import MCAP0_MAGIC as MAGIC
 
 from otonav.errors import UsageError
 from otonav.msgs import Message
 from otonav.record._fastreader import ChunkDamageError, read_raw_messages
 from otonav.record._verify import (
     CUT_OFF_ERRORS,
-    MAGIC,
     Damage,
     _finished,
     _one_line,

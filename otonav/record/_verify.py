@@ -24,8 +24,7 @@ from typing import BinaryIO
 from mcap.exceptions import McapError
 from mcap.records import Channel, Chunk, DataEnd, Message, Metadata, Schema
 from mcap.stream_reader import CRCValidationError, StreamReader, breakup_chunk
-
-MAGIC = b"\x89MCAP0\r\n"
+from mcap.writer import MCAP0_MAGIC as MAGIC
 
 #: What mcap's readers raise where a file was cut off (a record or its length field
 #: ends mid-way: struct.error; a chunk ends early: EndOfFile, an McapError; ...).

@@ -28,6 +28,7 @@ from pathlib import Path
 from types import TracebackType
 from typing import IO
 
+from mcap.writer import MCAP0_MAGIC as _MAGIC
 from mcap.writer import CompressionType
 
 from otonav._version import __version__
@@ -74,7 +75,6 @@ def format_difference(recorded: int) -> str | None:
     )
 
 
-_MAGIC = b"\x89MCAP0\r\n"
 # DataEnd (CRC 0: not computed) and a Footer with no summary section, then the magic:
 # what closes a data section nobody can index any more (MCAP spec, records 0x0F, 0x02).
 _BARE_END = struct.pack("<BQI", 0x0F, 4, 0) + struct.pack("<BQQQI", 0x02, 20, 0, 0, 0) + _MAGIC
